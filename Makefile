@@ -1,0 +1,25 @@
+# Front door: `make demo` renders the default scene, `make test` runs every test.
+# Both install missing Debian packages first (scripts/install-deps.sh), then
+# configure and build Release in build/; quiet when everything is up to date.
+BUILD ?= build
+JOBS ?= $(shell nproc)
+SCENE ?= scenes/room/room.json
+
+.PHONY: deps build demo test clean
+
+deps:
+	@./scripts/install-deps.sh
+
+build: deps
+	@test -f $(BUILD)/CMakeCache.txt || cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release >/dev/null
+	@cmake --build $(BUILD) -j $(JOBS) >$(BUILD)/build.log 2>&1 || { cat $(BUILD)/build.log; exit 1; }
+
+demo: build
+	@mkdir -p out
+	@$(BUILD)/host/lightcuts render $(SCENE) -o out/room.exr --stats out/room-stats.json
+
+test: build
+	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+clean:
+	@rm -rf $(BUILD) out

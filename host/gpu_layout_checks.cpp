@@ -1,0 +1,44 @@
+// Compile-time checks that the shared structs have the std430 layout the
+// GLSL kernels expect: sizes and offsets of every field the shaders read.
+#include <cstddef>
+
+#include "shared/types.h"
+
+namespace lc::gpu {
+
+static_assert(sizeof(BvhNode) == 32);
+static_assert(offsetof(BvhNode, first_or_left) == 12);
+static_assert(offsetof(BvhNode, max_x) == 16);
+static_assert(offsetof(BvhNode, tri_count) == 28);
+
+static_assert(sizeof(Triangle) == 48);
+static_assert(offsetof(Triangle, v1_x) == 12);
+static_assert(offsetof(Triangle, v2_x) == 24);
+static_assert(offsetof(Triangle, material) == 36);
+
+static_assert(sizeof(TriangleNormals) == 48);
+static_assert(offsetof(TriangleNormals, n2_z) == 32);
+
+static_assert(sizeof(Material) == 32);
+static_assert(offsetof(Material, ks_r) == 12);
+static_assert(offsetof(Material, alpha) == 24);
+static_assert(offsetof(Material, flags) == 28);
+
+static_assert(sizeof(Light) == 32);
+static_assert(offsetof(Light, r) == 12);
+static_assert(offsetof(Light, type) == 24);
+
+static_assert(sizeof(LightNode) == 64);
+static_assert(offsetof(LightNode, max_x) == 12);
+static_assert(offsetof(LightNode, intensity_r) == 24);
+static_assert(offsetof(LightNode, rep_light) == 36);
+static_assert(offsetof(LightNode, left) == 40);
+static_assert(offsetof(LightNode, flags) == 44);
+static_assert(offsetof(LightNode, cone_x) == 48);
+
+static_assert(sizeof(GBufferTexel) == 48);
+static_assert(offsetof(GBufferTexel, nx) == 12);
+static_assert(offsetof(GBufferTexel, wo_x) == 24);
+static_assert(offsetof(GBufferTexel, material) == 36);
+
+}  // namespace lc::gpu

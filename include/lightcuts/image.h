@@ -1,0 +1,62 @@
+// Linear RGB float images, OpenEXR and PNG files, and image comparison.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace lc {
+
+// Row-major, row 0 at the top, three floats per pixel.
+struct Image {
+    std::uint32_t width = 0;
+    std::uint32_t height = 0;
+    std::vector<float> rgb;
+
+    Image() = default;
+    Image(std::uint32_t w, std::uint32_t h) : width(w), height(h), rgb(std::size_t(w) * h * 3, 0.0f) {}
+    glm::vec3 at(std::uint32_t x, std::uint32_t y) const {
+        const float* p = &rgb[(std::size_t(y) * width + x) * 3];
+        return {p[0], p[1], p[2]};
+    }
+    void set(std::uint32_t x, std::uint32_t y, glm::vec3 c) {
+        float* p = &rgb[(std::size_t(y) * width + x) * 3];
+        p[0] = c.x; p[1] = c.y; p[2] = c.z;
+    }
+};
+
+// Rec.709 luminance.
+inline float luminance(glm::vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+// File writers go through a temporary name in the same folder and rename on
+// success, so a failed write never leaves a half-written file. They throw
+// std::runtime_error naming the file on failure.
+void write_exr(const std::filesystem::path& file, const Image& image);   // RGB float32
+Image read_exr(const std::filesystem::path& file);                        // throws InputError
+void write_png_rgb8(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
+                    const std::vector<std::uint8_t>& rgb8);
+// Tone-mapped sRGB preview: exposure * value, clamped to [0,1], sRGB-encoded.
+// exposure <= 0 picks one that maps the 99th percentile luminance to 1.
+void write_png_tonemapped(const std::filesystem::path& file, const Image& image, float exposure = 0.0f);
+
+struct CompareResult {
+    double relative_rmse = 0.0;       // sqrt(sum (a-r)^2 / sum r^2), all pixels and channels
+    double fraction_above_1pct = 0.0; // of pixels whose relative luminance error exceeds 1%
+    double fraction_above_2pct = 0.0;
+    double fraction_above_5pct = 0.0;
+    double max_relative_error = 0.0;
+    std::vector<float> per_pixel;     // relative luminance error per pixel
+};
+
+// Relative luminance error per pixel: |Y(a) - Y(r)| / max(Y(r), 1e-3 * mean Y(r)).
+// Throws std::invalid_argument if the sizes differ.
+CompareResult compare_images(const Image& image, const Image& reference);
+
+// False-colour PNG of values in [0, max_value] (above max is clamped) with a
+// colour bar and its scale drawn along the bottom. Used for error and cut-size maps.
+void write_heatmap_png(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
+                       const std::vector<float>& values, float max_value);
+
+}  // namespace lc

@@ -1,0 +1,62 @@
+// Scene description: camera, triangles, materials, lights, render settings.
+// The vectors hold exactly the records the GPU reads (shaders/shared/types.h).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "../../shaders/shared/types.h"
+
+namespace lc {
+
+struct Camera {
+    glm::vec3 position{0.0f, 0.0f, 1.0f};
+    glm::vec3 look_at{0.0f, 0.0f, 0.0f};
+    glm::vec3 up{0.0f, 1.0f, 0.0f};
+    float fov_y_degrees = 40.0f;
+    std::uint32_t width = 256;
+    std::uint32_t height = 256;
+};
+
+struct RenderSettings {
+    std::string method = "brute";   // "brute" or "lightcuts"
+    std::uint32_t spp = 1;          // camera rays per pixel (stratified, jittered)
+    float relative_error = 0.02f;   // lightcuts: refine while bound > this * estimate
+    std::uint32_t max_cut = 1000;   // lightcuts: largest cut per shaded point
+    std::uint32_t seed = 1;         // pixel jitter and light-tree representatives
+};
+
+struct Scene {
+    Camera camera;
+    std::vector<gpu::Triangle> triangles;        // material index inside
+    std::vector<gpu::TriangleNormals> normals;   // parallel to triangles
+    std::vector<gpu::Material> materials;
+    std::vector<gpu::Light> lights;              // all types, in file order
+    RenderSettings render;
+    std::filesystem::path file;                  // the scene file it came from
+    std::size_t degenerate_triangles_dropped = 0;
+
+    // Bounds of the geometry and the point lights (empty box if neither).
+    glm::vec3 bounds_min{0.0f};
+    glm::vec3 bounds_max{0.0f};
+
+    std::size_t count_lights(std::uint32_t type) const;
+};
+
+// Loads a scene from JSON (docs/scene-format.md). Throws InputError naming
+// the file and the field on any problem; never returns a half-loaded scene.
+Scene load_scene(const std::filesystem::path& file);
+
+// Parses "x,y,z,r,g,b" lines into point lights (optional header line, '#'
+// comments). Throws InputError naming the file and line number.
+std::vector<gpu::Light> load_points_csv(const std::filesystem::path& file);
+
+// Recomputes scene.bounds_min/max from triangles and point lights.
+void update_bounds(Scene& scene);
+
+}  // namespace lc

@@ -1,0 +1,16 @@
+// Lets the kernel headers in this folder compile as C++ as well as GLSL.
+// C++: include inside a struct body after `using namespace glm;` at namespace
+// scope, so the kernel functions become member functions that see the
+// struct's buffer pointers through the LC_* accessor macros.
+#ifndef LC_SHARED_GLSL_COMPAT_H
+#define LC_SHARED_GLSL_COMPAT_H
+#ifdef __cplusplus
+#define LC_OUT(T) T&
+#define LC_INOUT(T) T&
+#define LC_KCONST static constexpr
+#else
+#define LC_KCONST const
+#define LC_OUT(T) out T
+#define LC_INOUT(T) inout T
+#endif
+#endif

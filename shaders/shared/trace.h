@@ -1,0 +1,185 @@
+// Ray/triangle intersection and BVH traversal, shared by the CPU tracer and
+// the Vulkan kernels (see glsl_compat.h for how it compiles as C++).
+//
+// The includer defines:
+//   LC_BVH_NODE(i)   -> BvhNode
+//   LC_TRIANGLE(i)   -> Triangle
+#ifndef LC_SHARED_TRACE_H
+#define LC_SHARED_TRACE_H
+
+// Shadow rays stop this fraction of the distance short of the light, so a
+// light mounted on a surface is not shadowed by that surface.
+LC_KCONST float kShadowEndRelative = 1e-4f;
+LC_KCONST float kRayInfinity = 1e30f;
+
+vec3 lc_tri_v0(Triangle t) { return vec3(t.v0_x, t.v0_y, t.v0_z); }
+vec3 lc_tri_v1(Triangle t) { return vec3(t.v1_x, t.v1_y, t.v1_z); }
+vec3 lc_tri_v2(Triangle t) { return vec3(t.v2_x, t.v2_y, t.v2_z); }
+
+// Watertight ray/triangle test (Woop, Benthin, Wald, JCGT 2013): rays through
+// a shared edge or vertex hit at least one of the triangles, so nothing leaks
+// between neighbours. Returns t in (0, t_max), or -1 for a miss; b1 and b2
+// are the barycentric weights of v1 and v2.
+float lc_intersect_triangle(vec3 org, vec3 dir, Triangle tri, float t_max,
+                            LC_OUT(float) b1, LC_OUT(float) b2) {
+    b1 = 0.0f;
+    b2 = 0.0f;
+    vec3 ad = abs(dir);
+    int kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
+    int kx = kz == 2 ? 0 : kz + 1;
+    int ky = kx == 2 ? 0 : kx + 1;
+    if (dir[kz] < 0.0f) {
+        int tmp = kx;
+        kx = ky;
+        ky = tmp;
+    }
+    float sz = 1.0f / dir[kz];
+    float sx = dir[kx] * sz;
+    float sy = dir[ky] * sz;
+
+    vec3 a = lc_tri_v0(tri) - org;
+    vec3 b = lc_tri_v1(tri) - org;
+    vec3 c = lc_tri_v2(tri) - org;
+    float ax = a[kx] - sx * a[kz];
+    float ay = a[ky] - sy * a[kz];
+    float bx = b[kx] - sx * b[kz];
+    float by = b[ky] - sy * b[kz];
+    float cx = c[kx] - sx * c[kz];
+    float cy = c[ky] - sy * c[kz];
+
+    float u = cx * by - cy * bx;
+    float v = ax * cy - ay * cx;
+    float w = bx * ay - by * ax;
+    if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return -1.0f;
+    float det = u + v + w;
+    if (det == 0.0f) return -1.0f;
+
+    float t_scaled = (u * a[kz] + v * b[kz] + w * c[kz]) * sz;
+    float t = t_scaled / det;
+    if (!(t > 0.0f && t < t_max)) return -1.0f;
+    b1 = v / det;
+    b2 = w / det;
+    return t;
+}
+
+// Slab test. The far distance is widened by 2*gamma(3) (Ize, "Robust BVH Ray
+// Traversal", JCGT 2013) so rounding never culls a box the ray touches.
+bool lc_hit_box(BvhNode node, vec3 org, vec3 inv_dir, float t_max, LC_OUT(float) t_entry) {
+    vec3 t0 = (vec3(node.min_x, node.min_y, node.min_z) - org) * inv_dir;
+    vec3 t1 = (vec3(node.max_x, node.max_y, node.max_z) - org) * inv_dir;
+    vec3 tn = min(t0, t1);
+    vec3 tf = max(t0, t1);
+    float t_near = max(max(tn.x, tn.y), max(tn.z, 0.0f));
+    float t_far = min(min(tf.x, tf.y), min(tf.z, t_max)) * 1.0000004f;
+    t_entry = t_near;
+    return t_near <= t_far;
+}
+
+vec3 lc_safe_inverse(vec3 d) {
+    // A zero component would give 0 * inf = NaN in the slab test.
+    LC_KCONST float tiny = 1e-30f;
+    return vec3(1.0f / (abs(d.x) > tiny ? d.x : (d.x < 0.0f ? -tiny : tiny)),
+                1.0f / (abs(d.y) > tiny ? d.y : (d.y < 0.0f ? -tiny : tiny)),
+                1.0f / (abs(d.z) > tiny ? d.z : (d.z < 0.0f ? -tiny : tiny)));
+}
+
+// Closest hit along org + t*dir, t in (0, t_max). Returns the triangle index
+// (in BVH order) or kInvalidIndex; t, b1, b2 describe the hit.
+uint lc_trace_closest(vec3 org, vec3 dir, float t_max, LC_OUT(float) t_hit, LC_OUT(float) b1,
+                      LC_OUT(float) b2) {
+    vec3 inv_dir = lc_safe_inverse(dir);
+    uint hit = kInvalidIndex;
+    t_hit = t_max;
+    b1 = 0.0f;
+    b2 = 0.0f;
+    uint stack[kBvhStackSize];
+    uint sp = 0u;
+    uint node_index = 0u;
+    float t_entry;
+    if (!lc_hit_box(LC_BVH_NODE(0u), org, inv_dir, t_hit, t_entry)) return hit;
+    while (true) {
+        BvhNode node = LC_BVH_NODE(node_index);
+        if (node.tri_count > 0u) {
+            for (uint i = node.first_or_left; i < node.first_or_left + node.tri_count; ++i) {
+                float u, v;
+                float t = lc_intersect_triangle(org, dir, LC_TRIANGLE(i), t_hit, u, v);
+                if (t > 0.0f) {
+                    t_hit = t;
+                    b1 = u;
+                    b2 = v;
+                    hit = i;
+                }
+            }
+        } else {
+            // Visit the nearer child first; push the other.
+            uint left = node.first_or_left;
+            float t_left, t_right;
+            bool hit_left = lc_hit_box(LC_BVH_NODE(left), org, inv_dir, t_hit, t_left);
+            bool hit_right = lc_hit_box(LC_BVH_NODE(left + 1u), org, inv_dir, t_hit, t_right);
+            if (hit_left && hit_right) {
+                uint near_child = t_left <= t_right ? left : left + 1u;
+                uint far_child = t_left <= t_right ? left + 1u : left;
+                stack[sp++] = far_child;
+                node_index = near_child;
+                continue;
+            }
+            if (hit_left || hit_right) {
+                node_index = hit_left ? left : left + 1u;
+                continue;
+            }
+        }
+        // Pop, skipping nodes that now lie beyond the closest hit.
+        bool found = false;
+        while (sp > 0u && !found) {
+            node_index = stack[--sp];
+            found = lc_hit_box(LC_BVH_NODE(node_index), org, inv_dir, t_hit, t_entry);
+        }
+        if (!found) break;
+    }
+    return hit;
+}
+
+// Any hit with t in (0, t_max): true if something blocks the segment.
+bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
+    vec3 inv_dir = lc_safe_inverse(dir);
+    uint stack[kBvhStackSize];
+    uint sp = 0u;
+    stack[sp++] = 0u;
+    while (sp > 0u) {
+        uint node_index = stack[--sp];
+        BvhNode node = LC_BVH_NODE(node_index);
+        float t_entry;
+        if (!lc_hit_box(node, org, inv_dir, t_max, t_entry)) continue;
+        if (node.tri_count > 0u) {
+            for (uint i = node.first_or_left; i < node.first_or_left + node.tri_count; ++i) {
+                float u, v;
+                if (lc_intersect_triangle(org, dir, LC_TRIANGLE(i), t_max, u, v) > 0.0f) return true;
+            }
+        } else {
+            stack[sp++] = node.first_or_left + 1u;
+            stack[sp++] = node.first_or_left;
+        }
+    }
+    return false;
+}
+
+// Moves a surface point off the surface along the (geometric) normal n by a
+// few ulps of its coordinates (Waechter and Binder, "A Fast and Robust Method
+// for Avoiding Self-Intersection", Ray Tracing Gems, 2019). The offset scales
+// with the magnitude of p, so it works far from the origin too, and stays far
+// smaller than any wall thickness a scene would model.
+float lc_offset_component(float p, float n) {
+    LC_KCONST float kOrigin = 1.0f / 32.0f;
+    LC_KCONST float kFloatScale = 1.0f / 65536.0f;
+    LC_KCONST float kIntScale = 256.0f;
+    int of = int(kIntScale * n);
+    float p_i = intBitsToFloat(floatBitsToInt(p) + (p < 0.0f ? -of : of));
+    return abs(p) < kOrigin ? p + kFloatScale * n : p_i;
+}
+
+vec3 lc_offset_ray_origin(vec3 p, vec3 n) {
+    return vec3(lc_offset_component(p.x, n.x), lc_offset_component(p.y, n.y),
+                lc_offset_component(p.z, n.z));
+}
+
+#endif

@@ -1,0 +1,112 @@
+// Structs and constants shared by the C++ host and the GLSL kernels.
+//
+// This file compiles both as C++ (host/) and as GLSL (shaders/). Every struct
+// is made of 4-byte scalars only, so its std430 layout is the C layout: no
+// vec3 padding rules, no bool, no matrices. The C++ side checks every size
+// and offset in host/gpu_layout_checks.cpp.
+#ifndef LC_SHARED_TYPES_H
+#define LC_SHARED_TYPES_H
+
+#ifdef __cplusplus
+#include <cstdint>
+namespace lc::gpu {
+using uint = std::uint32_t;
+#define LC_CONST constexpr
+#else
+#define LC_CONST const
+#endif
+
+// ---------------------------------------------------------------------------
+// Limits and flags
+// ---------------------------------------------------------------------------
+LC_CONST uint kInvalidIndex = 0xFFFFFFFFu;
+LC_CONST uint kBvhStackSize = 32u;    // build caps the BVH depth below this
+LC_CONST uint kBvhMaxLeafTriangles = 4u;
+
+LC_CONST uint kLightPoint = 0u;
+LC_CONST uint kLightDirectional = 1u;
+LC_CONST uint kLightTypeCount = 2u;
+
+// LightNode.flags
+LC_CONST uint kNodeLeaf = 1u;          // node is a single light
+LC_CONST uint kNodeRepFromRight = 2u;  // representative is the right child's
+
+// Material.flags
+LC_CONST uint kMaterialHasSpecular = 1u;
+
+// ---------------------------------------------------------------------------
+// BVH over triangles (32 bytes). Interior: child0 = first_or_left,
+// child1 = first_or_left + 1. Leaf (tri_count > 0): triangles
+// [first_or_left, first_or_left + tri_count) of the reordered triangle array.
+// ---------------------------------------------------------------------------
+struct BvhNode {
+    float min_x, min_y, min_z;
+    uint first_or_left;
+    float max_x, max_y, max_z;
+    uint tri_count;
+};
+
+// Triangle positions for ray intersection, in BVH leaf order (48 bytes).
+struct Triangle {
+    float v0_x, v0_y, v0_z;
+    float v1_x, v1_y, v1_z;
+    float v2_x, v2_y, v2_z;
+    uint material;
+    uint pad0, pad1;
+};
+
+// Shading normals, one per vertex, same order as Triangle (48 bytes).
+// Face normals are stored three times when the OBJ has none.
+struct TriangleNormals {
+    float n0_x, n0_y, n0_z;
+    float n1_x, n1_y, n1_z;
+    float n2_x, n2_y, n2_z;
+    uint pad0, pad1, pad2;
+};
+
+// Lambert albedo kd plus an optional GGX lobe with reflectance ks and
+// roughness alpha (GGX alpha = roughness^2) (32 bytes).
+struct Material {
+    float kd_r, kd_g, kd_b;
+    float ks_r, ks_g, ks_b;
+    float alpha;
+    uint flags;
+};
+
+// One light (32 bytes). Point: position and radiant intensity (W/sr).
+// Directional: unit vector *towards* the light and irradiance (W/m^2).
+struct Light {
+    float x, y, z;
+    float r, g, b;
+    uint type;
+    uint pad0;
+};
+
+// Light tree node (64 bytes); one array of 2n-1 nodes per light type, root
+// first. Interior: children are left and left + 1. Leaf: light == rep_light.
+// The box bounds the positions (point lights) or the unit directions
+// (directional lights). cone_* is reserved for oriented lights.
+struct LightNode {
+    float min_x, min_y, min_z;
+    float max_x, max_y, max_z;
+    float intensity_r, intensity_g, intensity_b;  // sum over the cluster
+    uint rep_light;   // index into the leaf-ordered light array
+    uint left;        // first child index; kInvalidIndex for leaves
+    uint flags;       // kNode* bits
+    float cone_x, cone_y, cone_z, cone_cos;       // reserved, cos = -1
+};
+
+// Per-pixel surface record written by the camera-ray kernel (48 bytes).
+// material == kInvalidIndex means the ray left the scene (black).
+struct GBufferTexel {
+    float px, py, pz;        // hit point, already offset off the surface
+    float nx, ny, nz;        // shading normal, flipped to face the camera
+    float wo_x, wo_y, wo_z;  // unit direction towards the camera
+    uint material;
+    uint pad0, pad1;
+};
+
+#ifdef __cplusplus
+}  // namespace lc::gpu
+#endif
+#endif
