@@ -1,6 +1,6 @@
 // The shared kernel headers (shaders/shared/*.h) compiled as C++ for the CPU
-// reference: the same intersection, traversal, shading and bound code the
-// Vulkan kernels run, here as member functions reading the host arrays.
+// reference: the same intersection, traversal, shading, bound and cut code
+// the Vulkan kernels run, here as member functions reading host arrays.
 #pragma once
 
 #include <glm/glm.hpp>
@@ -13,6 +13,7 @@ namespace lc::cpu {
 using namespace glm;
 using namespace lc::gpu;
 
+// Ray tracing only: BVH traversal and triangle intersection.
 struct TraceKernel {
     const BvhNode* bvh_nodes = nullptr;
     const Triangle* triangles = nullptr;
@@ -22,6 +23,43 @@ struct TraceKernel {
 #include "shared/trace.h"
 #undef LC_BVH_NODE
 #undef LC_TRIANGLE
+};
+
+// Everything a pixel needs. `heap` must hold max(max_cut, 2) entries; one
+// kernel object per thread.
+struct ShadeKernel {
+    const BvhNode* bvh_nodes = nullptr;
+    const Triangle* triangles = nullptr;
+    const TriangleNormals* normals = nullptr;
+    const Material* materials = nullptr;
+    const Light* lights = nullptr;
+    const LightNode* light_nodes = nullptr;
+    CutEntry* heap = nullptr;
+
+    // The CPU reference always runs the full kernel; the GPU switches parts
+    // off only where the scene cannot use them.
+    static constexpr bool kEnableGgx = true;
+    static constexpr bool kEnableShadows = true;
+
+#define LC_BVH_NODE(i) bvh_nodes[i]
+#define LC_TRIANGLE(i) triangles[i]
+#define LC_NORMALS(i) normals[i]
+#define LC_MATERIAL(i) materials[i]
+#define LC_LIGHT(i) lights[i]
+#define LC_LIGHT_NODE(i) light_nodes[i]
+#define LC_HEAP_LOAD(i) heap[i]
+#define LC_HEAP_STORE(i, e) (heap[i] = (e))
+#include "shared/trace.h"
+#include "shared/shading.h"
+#include "shared/lightcuts.h"
+#undef LC_BVH_NODE
+#undef LC_TRIANGLE
+#undef LC_NORMALS
+#undef LC_MATERIAL
+#undef LC_LIGHT
+#undef LC_LIGHT_NODE
+#undef LC_HEAP_LOAD
+#undef LC_HEAP_STORE
 };
 
 }  // namespace lc::cpu

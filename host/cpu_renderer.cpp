@@ -1,1 +1,110 @@
-// placeholder
+// CPU reference renderer: the shared kernels (host/cpu_kernel.h) run per
+// pixel over 16x16 tiles handed out to worker threads. Every pixel is
+// computed independently in a fixed order, so the image is bit-identical
+// whatever the thread count.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <stdexcept>
+#include <thread>
+
+#include "cpu_kernel.h"
+#include "lightcuts/render.h"
+#include "progress.h"
+
+namespace lc {
+namespace {
+
+constexpr std::uint32_t kTile = 16;
+
+struct ThreadTotals {
+    std::uint64_t shadow_rays = 0;
+    std::uint64_t max_cut_hits = 0;
+};
+
+}  // namespace
+
+RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& options) {
+    if (options.method != "brute" && options.method != "lightcuts")
+        throw std::invalid_argument("unknown method '" + options.method + "' (brute or lightcuts)");
+    const bool lightcuts = options.method == "lightcuts";
+    const gpu::FrameParams frame = make_frame_params(prepared, options);
+    auto start = std::chrono::steady_clock::now();
+
+    RenderResult result;
+    result.image = Image(frame.width, frame.height);
+    RenderStats& stats = result.stats;
+    stats.device = "cpu";
+    if (lightcuts) stats.cut_size.assign(std::size_t(frame.width) * frame.height, 0.0f);
+
+    const std::uint32_t tiles_x = (frame.width + kTile - 1) / kTile;
+    const std::uint32_t tiles_y = (frame.height + kTile - 1) / kTile;
+    const std::uint32_t tile_count = tiles_x * tiles_y;
+    unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
+    threads = std::min(threads, tile_count);
+
+    std::atomic<std::uint32_t> next_tile{0};
+    std::atomic<std::uint32_t> tiles_done{0};
+    std::vector<ThreadTotals> totals(threads);
+    Progress progress(options.progress);
+
+    auto worker = [&](unsigned thread_index) {
+        std::vector<gpu::CutEntry> heap(std::max<std::uint32_t>(frame.max_cut, 2u));
+        cpu::ShadeKernel k;
+        k.bvh_nodes = prepared.bvh.nodes.data();
+        k.triangles = prepared.scene.triangles.data();
+        k.normals = prepared.scene.normals.data();
+        k.materials = prepared.scene.materials.data();
+        k.lights = prepared.tree.lights.data();
+        k.light_nodes = prepared.tree.nodes.data();
+        k.heap = heap.data();
+        ThreadTotals& t = totals[thread_index];
+        const glm::vec3 origin(frame.cam_pos_x, frame.cam_pos_y, frame.cam_pos_z);
+        for (std::uint32_t tile; (tile = next_tile.fetch_add(1)) < tile_count;) {
+            std::uint32_t x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+            for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); ++y) {
+                for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); ++x) {
+                    glm::vec3 sum(0.0f);
+                    std::uint32_t cut_sum = 0;
+                    for (std::uint32_t s = 0; s < frame.spp; ++s) {
+                        glm::vec2 pixel = k.lc_pixel_sample(x, y, s, frame.spp, frame.seed);
+                        glm::vec3 dir = k.lc_camera_ray_dir(frame, pixel);
+                        float t_hit, b1, b2;
+                        std::uint32_t tri = k.lc_trace_closest(origin, dir, k.kRayInfinity, t_hit, b1, b2);
+                        if (tri == gpu::kInvalidIndex) continue;
+                        cpu::ShadeKernel::SurfacePoint sp = k.lc_surface_point(tri, b1, b2, dir);
+                        cpu::ShadeKernel::ShadeStats ss{0u, 0u, 0u};
+                        if (lightcuts) {
+                            sum += k.lc_shade_lightcuts(sp, frame, ss);
+                        } else {
+                            sum += k.lc_shade_brute(sp, frame.light_count, frame.min_distance2, ss);
+                        }
+                        cut_sum += ss.cut_size;
+                        t.shadow_rays += ss.shadow_rays;
+                        t.max_cut_hits += ss.hit_max_cut;
+                    }
+                    result.image.set(x, y, sum / float(frame.spp));
+                    if (lightcuts)
+                        stats.cut_size[std::size_t(y) * frame.width + x] = float(cut_sum) / float(frame.spp);
+                }
+            }
+            progress.update(double(tiles_done.fetch_add(1) + 1) / tile_count);
+        }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned i = 1; i < threads; ++i) pool.emplace_back(worker, i);
+    worker(0);
+    for (auto& th : pool) th.join();
+    progress.finish();
+
+    for (const auto& t : totals) {
+        stats.shadow_rays += t.shadow_rays;
+        stats.max_cut_pixels += t.max_cut_hits;
+    }
+    stats.camera_rays = std::uint64_t(frame.width) * frame.height * frame.spp;
+    stats.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    stats.seconds_shading = stats.seconds_total;  // the CPU does not time the stages apart
+    return result;
+}
+
+}  // namespace lc

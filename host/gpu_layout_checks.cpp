@@ -41,4 +41,17 @@ static_assert(offsetof(GBufferTexel, nx) == 12);
 static_assert(offsetof(GBufferTexel, wo_x) == 24);
 static_assert(offsetof(GBufferTexel, material) == 36);
 
+static_assert(sizeof(CutEntry) == 20);
+static_assert(offsetof(CutEntry, unit_r) == 8);
+
+static_assert(sizeof(FrameParams) == 112);
+static_assert(offsetof(FrameParams, min_distance2) == 12);
+static_assert(offsetof(FrameParams, relative_error) == 28);
+static_assert(offsetof(FrameParams, max_cut) == 44);
+static_assert(offsetof(FrameParams, spp) == 60);
+static_assert(offsetof(FrameParams, width) == 64);
+static_assert(offsetof(FrameParams, root_point) == 80);
+static_assert(offsetof(FrameParams, tile_x) == 88);
+static_assert(offsetof(FrameParams, sample_index) == 104);
+
 }  // namespace lc::gpu

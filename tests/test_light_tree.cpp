@@ -1,1 +1,157 @@
+// Light tree invariants on random and degenerate light sets.
+#include <cstring>
+#include <random>
+
 #include <gtest/gtest.h>
+
+#include "lightcuts/light_tree.h"
+#include "test_util.h"
+
+namespace lc {
+namespace {
+
+// Checks every structural promise of the flattened tree; returns nothing,
+// fails the test on the first broken invariant.
+void check_tree(const LightTree& tree, std::span<const gpu::Light> input) {
+    std::size_t n_point = 0, n_dir = 0;
+    for (const auto& l : input) (l.type == gpu::kLightPoint ? n_point : n_dir) += 1;
+    std::size_t expected = (n_point ? 2 * n_point - 1 : 0) + (n_dir ? 2 * n_dir - 1 : 0);
+    ASSERT_EQ(tree.nodes.size(), expected);
+    ASSERT_EQ(tree.lights.size(), input.size());
+    ASSERT_EQ(tree.root_point, n_point ? 0u : gpu::kInvalidIndex);
+    ASSERT_EQ(tree.root_directional, n_dir ? std::uint32_t(n_point ? 2 * n_point - 1 : 0) : gpu::kInvalidIndex);
+
+    std::vector<int> light_seen(tree.lights.size(), 0);
+    for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
+        const gpu::LightNode& n = tree.nodes[i];
+        ASSERT_LT(n.rep_light, tree.lights.size());
+        for (float v : {n.min_x, n.min_y, n.min_z, n.max_x, n.max_y, n.max_z, n.intensity_r, n.intensity_g,
+                        n.intensity_b})
+            ASSERT_TRUE(std::isfinite(v));
+        if (n.flags & gpu::kNodeLeaf) {
+            const gpu::Light& l = tree.lights[n.rep_light];
+            EXPECT_EQ(n.min_x, l.x);
+            EXPECT_EQ(n.max_y, l.y);
+            EXPECT_EQ(n.intensity_r, l.r);
+            light_seen[n.rep_light] += 1;
+            continue;
+        }
+        ASSERT_LT(n.left + 1, tree.nodes.size());
+        ASSERT_GT(n.left, i);
+        const gpu::LightNode& a = tree.nodes[n.left];
+        const gpu::LightNode& b = tree.nodes[n.left + 1];
+        // Intensity is the sum of the children's.
+        auto near = [](float sum, float x, float y) { return std::abs(sum - (x + y)) <= 1e-5f * std::abs(sum) + 1e-30f; };
+        EXPECT_TRUE(near(n.intensity_r, a.intensity_r, b.intensity_r)) << i;
+        EXPECT_TRUE(near(n.intensity_g, a.intensity_g, b.intensity_g)) << i;
+        EXPECT_TRUE(near(n.intensity_b, a.intensity_b, b.intensity_b)) << i;
+        // The box contains the children's boxes.
+        for (const auto* c : {&a, &b}) {
+            EXPECT_LE(n.min_x, c->min_x); EXPECT_LE(n.min_y, c->min_y); EXPECT_LE(n.min_z, c->min_z);
+            EXPECT_GE(n.max_x, c->max_x); EXPECT_GE(n.max_y, c->max_y); EXPECT_GE(n.max_z, c->max_z);
+        }
+        // The representative is the flagged child's.
+        const gpu::LightNode& rep_child = (n.flags & gpu::kNodeRepFromRight) ? b : a;
+        EXPECT_EQ(n.rep_light, rep_child.rep_light) << i;
+    }
+    for (std::size_t i = 0; i < light_seen.size(); ++i) ASSERT_EQ(light_seen[i], 1) << "light " << i;
+
+    // Leaves appear in light order in a depth-first walk: subtrees are ranges.
+    for (std::uint32_t root : {tree.root_point, tree.root_directional}) {
+        if (root == gpu::kInvalidIndex) continue;
+        std::vector<std::uint32_t> stack{root};
+        std::uint32_t expected_light = tree.nodes[root].flags & gpu::kNodeLeaf ? tree.nodes[root].rep_light : 0;
+        bool first = true;
+        while (!stack.empty()) {
+            std::uint32_t i = stack.back();
+            stack.pop_back();
+            const auto& n = tree.nodes[i];
+            if (n.flags & gpu::kNodeLeaf) {
+                if (first) expected_light = n.rep_light, first = false;
+                ASSERT_EQ(n.rep_light, expected_light);
+                ++expected_light;
+            } else {
+                stack.push_back(n.left + 1);
+                stack.push_back(n.left);
+            }
+        }
+    }
+}
+
+std::vector<gpu::Light> random_mixed(std::size_t n, std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-5.0f, 5.0f), w(0.0f, 2.0f);
+    std::vector<gpu::Light> lights;
+    for (std::size_t i = 0; i < n; ++i) {
+        if (i % 7 == 3)
+            lights.push_back(test::directional_light({u(rng), u(rng) - 6.0f, u(rng)}, {w(rng), w(rng), w(rng)}));
+        else
+            lights.push_back(test::point_light({u(rng), u(rng), u(rng)}, {w(rng), w(rng), w(rng)}));
+    }
+    return lights;
+}
+
+TEST(LightTree, InvariantsOnRandomSets) {
+    for (std::size_t n : {1u, 2u, 3u, 10u, 1000u, 100000u}) {
+        SCOPED_TRACE(n);
+        auto lights = random_mixed(n, std::uint32_t(n));
+        check_tree(build_light_tree(lights, 5), lights);
+        if (n <= 1000) check_tree(build_light_tree(lights, 5, TreeBuilder::kExact), lights);
+    }
+}
+
+TEST(LightTree, InvariantsOnDegenerateSets) {
+    std::vector<std::vector<gpu::Light>> cases;
+    cases.emplace_back(1000, test::point_light({1, 2, 3}, {1, 1, 1}));  // coincident
+    std::vector<gpu::Light> line, plane, zeros;
+    for (int i = 0; i < 1000; ++i) line.push_back(test::point_light({float(i) * 0.01f, 0, 0}, {1, 0.5f, 0.25f}));
+    for (int i = 0; i < 1024; ++i)
+        plane.push_back(test::point_light({float(i % 32), 0, float(i / 32)}, {0.1f, 0.1f, 0.1f}));
+    for (int i = 0; i < 1000; ++i)
+        zeros.push_back(test::point_light({float(i % 10), float(i / 100), float((i / 10) % 10)},
+                                          i % 3 ? glm::vec3(0.0f) : glm::vec3(1.0f)));
+    cases.push_back(line);
+    cases.push_back(plane);
+    cases.push_back(zeros);
+    cases.emplace_back(10, test::point_light({0, 0, 0}, {0, 0, 0}));  // all zero
+    for (std::size_t c = 0; c < cases.size(); ++c) {
+        SCOPED_TRACE(c);
+        check_tree(build_light_tree(cases[c], 1), cases[c]);
+        check_tree(build_light_tree(cases[c], 1, TreeBuilder::kExact), cases[c]);
+    }
+}
+
+TEST(LightTree, ZeroIntensityChildIsNeverTheRepresentative) {
+    std::vector<gpu::Light> lights;
+    for (int i = 0; i < 200; ++i)
+        lights.push_back(test::point_light({float(i), 0, 0}, i % 2 ? glm::vec3(0.0f) : glm::vec3(1.0f)));
+    LightTree tree = build_light_tree(lights, 9);
+    for (const auto& n : tree.nodes) {
+        if (n.intensity_r > 0.0f) {
+            EXPECT_GT(tree.lights[n.rep_light].r, 0.0f);
+        }
+    }
+}
+
+TEST(LightTree, SameSeedSameTree) {
+    auto lights = random_mixed(20000, 3);
+    LightTree a = build_light_tree(lights, 11), b = build_light_tree(lights, 11);
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    EXPECT_EQ(0, std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(gpu::LightNode)));
+    EXPECT_EQ(0, std::memcmp(a.lights.data(), b.lights.data(), a.lights.size() * sizeof(gpu::Light)));
+    // A different seed changes some representatives.
+    LightTree c = build_light_tree(lights, 12);
+    int differ = 0;
+    for (std::size_t i = 0; i < a.nodes.size(); ++i) differ += a.nodes[i].rep_light != c.nodes[i].rep_light;
+    EXPECT_GT(differ, 0);
+}
+
+TEST(LightTree, EmptyInputGivesNoTree) {
+    LightTree t = build_light_tree({}, 1);
+    EXPECT_TRUE(t.nodes.empty());
+    EXPECT_EQ(t.root_point, gpu::kInvalidIndex);
+    EXPECT_EQ(t.root_directional, gpu::kInvalidIndex);
+}
+
+}  // namespace
+}  // namespace lc

@@ -4,8 +4,8 @@
 // The includer defines:
 //   LC_BVH_NODE(i)   -> BvhNode
 //   LC_TRIANGLE(i)   -> Triangle
-#ifndef LC_SHARED_TRACE_H
-#define LC_SHARED_TRACE_H
+// No include guard: each kernel context (a GLSL shader, a C++ kernel
+// struct in host/cpu_kernel.h) includes it exactly once.
 
 // Shadow rays stop this fraction of the distance short of the light, so a
 // light mounted on a surface is not shadowed by that surface.
@@ -181,5 +181,3 @@ vec3 lc_offset_ray_origin(vec3 p, vec3 n) {
     return vec3(lc_offset_component(p.x, n.x), lc_offset_component(p.y, n.y),
                 lc_offset_component(p.z, n.z));
 }
-
-#endif

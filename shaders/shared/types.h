@@ -106,6 +106,36 @@ struct GBufferTexel {
     uint pad0, pad1;
 };
 
+// One entry of the per-pixel cut heap (20 bytes): a refinable interior node,
+// its error bound and the representative's unscaled contribution
+// (material * geometry * visibility), which its child with the same
+// representative inherits without another shadow ray.
+struct CutEntry {
+    uint node;
+    float error;
+    float unit_r, unit_g, unit_b;
+};
+
+// Everything a frame's kernels need besides the buffers (112 bytes). The
+// camera basis vectors are pre-scaled by tan(fov/2) (and aspect for right).
+struct FrameParams {
+    float cam_pos_x, cam_pos_y, cam_pos_z;
+    float min_distance2;          // inverse-square falloff is clamped here
+    float cam_right_x, cam_right_y, cam_right_z;
+    float relative_error;
+    float cam_up_x, cam_up_y, cam_up_z;
+    uint max_cut;
+    float cam_fwd_x, cam_fwd_y, cam_fwd_z;
+    uint spp;
+    uint width, height, seed, light_count;
+    uint root_point;              // light tree roots; kInvalidIndex if absent
+    uint root_directional;
+    uint tile_x, tile_y;          // first pixel of the dispatched tile
+    uint tile_width, tile_height;
+    uint sample_index;            // which of the spp samples this pass renders
+    uint pad0;
+};
+
 #ifdef __cplusplus
 }  // namespace lc::gpu
 #endif

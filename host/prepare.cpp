@@ -1,0 +1,86 @@
+// Turns a loaded scene into what both renderers read: BVH, light tree and
+// frame constants.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "lightcuts/render.h"
+
+namespace lc {
+namespace {
+
+// The inverse-square falloff 1/d^2 is evaluated as 1/max(d^2, min_d^2) in
+// the exact term and in the bound alike, so bounds stay conservative and a
+// light on a surface (d = 0) gives a bright but finite spot, never Inf/NaN.
+// min_d is relative to the scene's size so it scales with the scene's units.
+constexpr float kMinDistanceRelative = 1e-4f;
+
+// True when every triangle lies in one plane: then no segment from a point
+// on that plane to a light can cross it again, and shadow rays are useless.
+bool all_coplanar(const std::vector<gpu::Triangle>& tris) {
+    if (tris.empty()) return true;
+    const auto& t0 = tris[0];
+    glm::dvec3 a(t0.v0_x, t0.v0_y, t0.v0_z), b(t0.v1_x, t0.v1_y, t0.v1_z), c(t0.v2_x, t0.v2_y, t0.v2_z);
+    glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
+    double scale = 0.0;
+    for (const auto& t : tris)
+        for (float v : {t.v0_x, t.v0_y, t.v0_z, t.v1_x, t.v1_y, t.v1_z, t.v2_x, t.v2_y, t.v2_z})
+            scale = std::max(scale, double(std::abs(v)));
+    double tolerance = 1e-6 * std::max(scale, 1.0);
+    for (const auto& t : tris) {
+        for (glm::dvec3 p : {glm::dvec3(t.v0_x, t.v0_y, t.v0_z), glm::dvec3(t.v1_x, t.v1_y, t.v1_z),
+                             glm::dvec3(t.v2_x, t.v2_y, t.v2_z)}) {
+            if (std::abs(glm::dot(p - a, n)) > tolerance) return false;
+        }
+    }
+    return true;
+}
+
+}  // namespace
+
+PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
+    PreparedScene prepared;
+    prepared.has_occluders = !all_coplanar(scene.triangles);
+    prepared.bvh = build_bvh(scene.triangles, scene.normals);
+    prepared.tree = build_light_tree(scene.lights, seed);
+    for (const auto& m : scene.materials)
+        prepared.has_specular |= (m.flags & gpu::kMaterialHasSpecular) != 0u;
+    float diagonal = glm::length(scene.bounds_max - scene.bounds_min);
+    float min_d = kMinDistanceRelative * diagonal;
+    prepared.min_distance2 = std::max(min_d * min_d, std::numeric_limits<float>::min());
+    prepared.scene = std::move(scene);
+    return prepared;
+}
+
+gpu::FrameParams make_frame_params(const PreparedScene& prepared, const RenderOptions& options) {
+    const Camera& cam = prepared.scene.camera;
+    gpu::FrameParams f{};
+    f.width = options.width ? options.width : cam.width;
+    f.height = options.height ? options.height : cam.height;
+    glm::vec3 fwd = glm::normalize(cam.look_at - cam.position);
+    glm::vec3 right = glm::normalize(glm::cross(fwd, cam.up));
+    glm::vec3 up = glm::cross(right, fwd);
+    float tan_half = std::tan(glm::radians(cam.fov_y_degrees) * 0.5f);
+    float aspect = float(f.width) / float(f.height);
+    right *= tan_half * aspect;
+    up *= tan_half;
+    f.cam_pos_x = cam.position.x; f.cam_pos_y = cam.position.y; f.cam_pos_z = cam.position.z;
+    f.cam_right_x = right.x; f.cam_right_y = right.y; f.cam_right_z = right.z;
+    f.cam_up_x = up.x; f.cam_up_y = up.y; f.cam_up_z = up.z;
+    f.cam_fwd_x = fwd.x; f.cam_fwd_y = fwd.y; f.cam_fwd_z = fwd.z;
+    f.min_distance2 = prepared.min_distance2;
+    f.relative_error = options.relative_error;
+    f.max_cut = options.max_cut;
+    f.spp = std::max(options.spp, 1u);
+    f.seed = options.seed;
+    f.light_count = static_cast<std::uint32_t>(prepared.tree.lights.size());
+    f.root_point = prepared.tree.root_point;
+    f.root_directional = prepared.tree.root_directional;
+    f.tile_x = f.tile_y = 0;
+    f.tile_width = f.width;
+    f.tile_height = f.height;
+    f.sample_index = 0;
+    return f;
+}
+
+}  // namespace lc

@@ -1,0 +1,86 @@
+// Rendering a loaded scene, on the CPU reference or through Vulkan compute.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "bvh.h"
+#include "image.h"
+#include "light_tree.h"
+#include "scene.h"
+
+namespace lc {
+
+// A scene ready to render: triangles reordered by the BVH, the light tree
+// built, frame constants filled. Built once, rendered by either device.
+struct PreparedScene {
+    Scene scene;                 // triangles/normals in BVH leaf order
+    Bvh bvh;
+    LightTree tree;              // lights in leaf order (also used by brute force)
+    float min_distance2 = 0.0f;  // clamp of the inverse-square falloff
+    bool has_specular = false;   // any material with a GGX lobe
+    bool has_occluders = true;   // false: no triangle can block a light
+};
+
+// Takes ownership of the scene; builds the BVH and the light tree.
+PreparedScene prepare_scene(Scene scene, std::uint32_t seed);
+
+struct RenderOptions {
+    std::string method = "brute";     // "brute" or "lightcuts"
+    std::uint32_t width = 0, height = 0;  // 0: the scene's camera size
+    std::uint32_t spp = 1;
+    float relative_error = 0.02f;
+    std::uint32_t max_cut = 1000;
+    std::uint32_t seed = 1;
+    unsigned threads = 0;             // CPU: 0 = all cores
+    bool progress = false;            // show percentage and ETA on stderr
+};
+
+struct RenderStats {
+    std::string device;               // "cpu" or the Vulkan device name
+    double seconds_total = 0.0;
+    double seconds_primary = 0.0;     // camera rays (GPU: timestamp queries)
+    double seconds_shading = 0.0;     // cut selection + shading or brute force
+    std::uint64_t camera_rays = 0;
+    std::uint64_t shadow_rays = 0;
+    std::uint64_t max_cut_pixels = 0;       // samples where refinement hit max_cut
+    std::uint64_t heap_spill_pixels = 0;    // GPU: samples whose heap spilled to global memory
+    std::uint32_t heap_capacity_shared = 0; // GPU: heap slots per invocation in shared memory
+    std::vector<float> cut_size;      // per pixel, mean over samples (lightcuts only)
+    std::vector<std::pair<std::string, std::uint64_t>> buffer_bytes;
+};
+
+struct RenderResult {
+    Image image;
+    RenderStats stats;
+};
+
+// Frame constants for a tile of the image; shared by CPU and GPU paths.
+gpu::FrameParams make_frame_params(const PreparedScene& prepared, const RenderOptions& options);
+
+RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& options);
+
+struct VulkanOptions {
+    std::string gpu;                  // "" = best available; an index or a name substring
+    bool validation = false;          // enable VK_LAYER_KHRONOS_validation; messages are errors
+};
+
+// Thrown when there is no Vulkan loader or no Vulkan device at all (as
+// opposed to a device that exists but fails); the CLI then falls back to the
+// CPU for --device auto.
+struct NoVulkanDevice : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// Throws NoVulkanDevice when no Vulkan device exists, std::runtime_error on
+// other failures.
+RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& options,
+                           const VulkanOptions& vulkan);
+
+// Names of the Vulkan devices present, in index order ("" list if none / no loader).
+std::vector<std::string> list_vulkan_devices();
+
+}  // namespace lc

@@ -1,0 +1,242 @@
+// Camera rays, surface reconstruction, the BRDF, one light's contribution and
+// the Lightcuts error bounds. Shared by the CPU reference and the Vulkan
+// kernels (see glsl_compat.h); needs trace.h first.
+//
+// The includer defines:
+//   LC_MATERIAL(i)   -> Material
+//   LC_NORMALS(i)    -> TriangleNormals
+//   LC_LIGHT(i)      -> Light
+// and the feature switches kEnableGgx and kEnableShadows (specialization
+// constants on the GPU, so a scene without GGX materials or without
+// occluders gets a kernel without that code; always true on the CPU).
+// No include guard: each kernel context (a GLSL shader, a C++ kernel
+// struct in host/cpu_kernel.h) includes it exactly once.
+
+LC_KCONST float kPi = 3.14159265358979f;
+// Rounding in the bound formulas is covered by this relative slack, so a
+// bound is never below the value it bounds by an ulp.
+LC_KCONST float kBoundSlack = 1.0f + 1e-5f;
+LC_KCONST float kCosineAbsSlack = 1e-6f;
+
+// --- Random numbers for pixel jitter: PCG hash, identical on CPU and GPU.
+uint lc_hash(uint v) {
+    uint state = v * 747796405u + 2891336453u;
+    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+float lc_unit_float(uint h) { return float(h >> 8u) * (1.0f / 16777216.0f); }
+
+// Position on the image plane of sample `s` of `spp` in pixel (x, y):
+// spp = 1 is the pixel centre; otherwise stratified over a cols x rows grid,
+// jittered within each stratum by the seeded hash.
+vec2 lc_pixel_sample(uint x, uint y, uint s, uint spp, uint seed) {
+    if (spp <= 1u) return vec2(float(x) + 0.5f, float(y) + 0.5f);
+    uint cols = uint(ceil(sqrt(float(spp))));
+    uint rows = (spp + cols - 1u) / cols;
+    uint h = lc_hash(seed ^ lc_hash(x ^ lc_hash(y ^ lc_hash(s))));
+    float jx = lc_unit_float(h);
+    float jy = lc_unit_float(lc_hash(h));
+    return vec2(float(x) + (float(s % cols) + jx) / float(cols),
+                float(y) + (float(s / cols) + jy) / float(rows));
+}
+
+vec3 lc_camera_ray_dir(FrameParams f, vec2 pixel) {
+    float u = 2.0f * pixel.x / float(f.width) - 1.0f;
+    float v = 1.0f - 2.0f * pixel.y / float(f.height);  // row 0 at the top
+    vec3 d = vec3(f.cam_fwd_x, f.cam_fwd_y, f.cam_fwd_z) +
+             u * vec3(f.cam_right_x, f.cam_right_y, f.cam_right_z) +
+             v * vec3(f.cam_up_x, f.cam_up_y, f.cam_up_z);
+    return normalize(d);
+}
+
+// A shaded point: position offset off the surface, shading normal and view
+// direction both on the camera's side.
+struct SurfacePoint {
+    vec3 p;
+    vec3 n;
+    vec3 wo;
+    uint material;
+};
+
+SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) {
+    Triangle tri = LC_TRIANGLE(tri_index);
+    TriangleNormals tn = LC_NORMALS(tri_index);
+    vec3 v0 = lc_tri_v0(tri);
+    vec3 v1 = lc_tri_v1(tri);
+    vec3 v2 = lc_tri_v2(tri);
+    float b0 = 1.0f - b1 - b2;
+    // Barycentric interpolation is more accurate than org + t * dir.
+    vec3 p = b0 * v0 + b1 * v1 + b2 * v2;
+    vec3 ng = normalize(cross(v1 - v0, v2 - v0));
+    vec3 ns = b0 * vec3(tn.n0_x, tn.n0_y, tn.n0_z) + b1 * vec3(tn.n1_x, tn.n1_y, tn.n1_z) +
+              b2 * vec3(tn.n2_x, tn.n2_y, tn.n2_z);
+    float ns_len = length(ns);
+    ns = ns_len > 1e-12f ? ns / ns_len : ng;
+    // Two-sided surfaces: both normals turn to the side the ray came from.
+    if (dot(ng, ray_dir) > 0.0f) ng = -ng;
+    if (dot(ns, ng) < 0.0f) ns = -ns;
+    SurfacePoint sp;
+    sp.p = lc_offset_ray_origin(p, ng);
+    sp.n = ns;
+    sp.wo = -ray_dir;
+    sp.material = tri.material;
+    return sp;
+}
+
+// --- BRDF: Lambert kd/pi plus GGX with constant Fresnel ks and separable
+// Smith shadowing. The returned value is f * cos(theta_i); the GGX term is
+// written as D * G1(wi) * G1(wo) / (4 cos_o) so no division by cos_i occurs.
+float lc_ggx_d(float cos_h, float alpha) {
+    float a2 = alpha * alpha;
+    float c2 = cos_h * cos_h;
+    float denom = (a2 - 1.0f) * c2 + 1.0f;
+    return a2 / (kPi * denom * denom);
+}
+
+float lc_smith_g1(float cos_v, float alpha) {
+    float a2 = alpha * alpha;
+    return 2.0f * cos_v / (cos_v + sqrt(a2 + (1.0f - a2) * cos_v * cos_v));
+}
+
+vec3 lc_kd(Material m) { return vec3(m.kd_r, m.kd_g, m.kd_b); }
+vec3 lc_ks(Material m) { return vec3(m.ks_r, m.ks_g, m.ks_b); }
+
+vec3 lc_brdf_cos(Material m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
+    vec3 value = lc_kd(m) * (cos_i / kPi);
+    if (kEnableGgx && (m.flags & kMaterialHasSpecular) != 0u) {
+        float cos_o = dot(n, wo);
+        if (cos_o > 0.0f) {
+            vec3 h = normalize(wi + wo);
+            float cos_h = max(dot(n, h), 0.0f);
+            float spec = lc_ggx_d(cos_h, m.alpha) * lc_smith_g1(cos_i, m.alpha) *
+                         lc_smith_g1(cos_o, m.alpha) / (4.0f * cos_o);
+            value += lc_ks(m) * spec;
+        }
+    }
+    return value;
+}
+
+// One light's contribution per unit intensity (material * geometry), with
+// the shadow ray it needs: direction, and length (kRayInfinity for
+// directional lights). Zero when the light is behind the surface.
+vec3 lc_light_unit(SurfacePoint sp, Light light, float min_distance2, LC_OUT(vec3) wi,
+                   LC_OUT(float) t_max) {
+    vec3 lp = vec3(light.x, light.y, light.z);
+    float geometry = 1.0f;
+    if (light.type == kLightPoint) {
+        vec3 to_light = lp - sp.p;
+        float d2 = dot(to_light, to_light);
+        float d = sqrt(d2);
+        // A light exactly at the shaded point has no direction: it adds
+        // nothing (the cosine bound of such a cluster is zero as well).
+        if (!(d > 0.0f)) {
+            wi = sp.n;
+            t_max = 0.0f;
+            return vec3(0.0f);
+        }
+        wi = to_light / d;
+        t_max = d * (1.0f - kShadowEndRelative);
+        geometry = 1.0f / max(d2, min_distance2);
+    } else {
+        wi = lp;
+        t_max = kRayInfinity;
+    }
+    float cos_i = dot(sp.n, wi);
+    if (cos_i <= 0.0f) return vec3(0.0f);
+    return lc_brdf_cos(LC_MATERIAL(sp.material), sp.n, wi, sp.wo, cos_i) * geometry;
+}
+
+bool lc_visible(SurfacePoint sp, vec3 wi, float t_max) {
+    return !kEnableShadows || !lc_trace_any(sp.p, wi, t_max);
+}
+
+vec3 lc_light_intensity(Light light) { return vec3(light.r, light.g, light.b); }
+
+// --- Walter et al. 2005, section 4.1: upper bounds on a cluster's
+// contribution per unit intensity at a shaded point.
+
+// Orthonormal basis around n (Duff et al., JCGT 2017).
+void lc_basis(vec3 n, LC_OUT(vec3) t, LC_OUT(vec3) b) {
+    float s = n.z >= 0.0f ? 1.0f : -1.0f;
+    float a = -1.0f / (s + n.z);
+    float c = n.x * n.y * a;
+    t = vec3(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
+    b = vec3(c, s + n.y * n.y * a, -n.y);
+}
+
+float lc_min_abs_on_interval(float centre, float half_width) {
+    return max(abs(centre) - half_width, 0.0f);
+}
+
+// Upper bound of cos(angle between n and q - x) over all q in the box.
+// The box, relative to x, is expressed in the frame (t, b, n) and replaced by
+// the axis-aligned box around it in that frame, which contains it; Walter's
+// bound z_max / sqrt(min x^2 + min y^2 + z_max^2) over that box is then an
+// upper bound over the original box. Zero when the box lies below the
+// surface. (The seed report rotated a world-space box by a single angle,
+// which is not conservative.)
+float lc_cosine_bound(vec3 box_min, vec3 box_max, vec3 x, vec3 n) {
+    vec3 c = 0.5f * (box_min + box_max) - x;
+    vec3 e = 0.5f * (box_max - box_min);
+    // Near the tangent plane cos is tiny and the rounding of the exact term
+    // is absolute, not relative: widen z_max by a few ulps of the magnitudes
+    // it was computed from.
+    float z_max = dot(n, c) + dot(abs(n), e) + kCosineAbsSlack * (dot(abs(n), abs(c)) + dot(abs(n), e));
+    if (z_max <= 0.0f) return 0.0f;
+    vec3 t, b;
+    lc_basis(n, t, b);
+    float min_x = lc_min_abs_on_interval(dot(t, c), dot(abs(t), e));
+    float min_y = lc_min_abs_on_interval(dot(b, c), dot(abs(b), e));
+    float bound = z_max * inversesqrt(min_x * min_x + min_y * min_y + z_max * z_max);
+    return min(bound * kBoundSlack, 1.0f);
+}
+
+// Squared distance from x to the box (0 inside).
+float lc_box_distance2(vec3 box_min, vec3 box_max, vec3 x) {
+    vec3 d = max(max(box_min - x, x - box_max), vec3(0.0f));
+    return dot(d, d);
+}
+
+// Upper bound of the GGX term D * G1(wi) * G1(wo) / (4 cos_o) over all
+// directions wi towards the box (relative to x). G1(wi) <= 1. D grows with
+// cos(theta_h), so it is bounded by D at the smallest possible angle between
+// the half vector and n. The directions to the box lie in a cone (axis a,
+// half-angle theta_c, from the box's bounding sphere). For fixed wo the map
+// h -> wi = reflect(-wo, h) is 2-Lipschitz in angle and sends n to the mirror
+// direction wr, so angle(h, n) >= max(0, angle(wr, a) - theta_c) / 2.
+float lc_ggx_bound(Material m, vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec3 wo) {
+    float cos_o = dot(n, wo);
+    if (cos_o <= 0.0f) return 0.0f;
+    vec3 c = 0.5f * (box_min + box_max) - x;
+    float radius = 0.5f * length(box_max - box_min);
+    float dist = length(c);
+    float cos_h_max = 1.0f;
+    if (dist > radius) {
+        vec3 wr = 2.0f * cos_o * n - wo;
+        float angle_r = acos(clamp(dot(wr, c / dist), -1.0f, 1.0f));
+        float angle_c = asin(clamp(radius / dist, 0.0f, 1.0f));
+        float delta = max(angle_r - angle_c, 0.0f);
+        cos_h_max = min(cos(0.5f * delta) * kBoundSlack, 1.0f);
+    }
+    return lc_ggx_d(cos_h_max, m.alpha) * lc_smith_g1(cos_o, m.alpha) / (4.0f * cos_o) *
+           kBoundSlack;
+}
+
+// Bound of material * geometry (per unit intensity, RGB) for a cluster with
+// the node's box. Point lights: the box holds positions, G <= 1/d_min^2 with
+// the same clamp as the exact term. Directional lights: the box holds unit
+// directions, so x is the origin and G = 1.
+vec3 lc_cluster_bound(SurfacePoint sp, Material m, vec3 box_min, vec3 box_max, uint light_type,
+                      float min_distance2) {
+    vec3 x = light_type == kLightPoint ? sp.p : vec3(0.0f);
+    float cos_bound = lc_cosine_bound(box_min, box_max, x, sp.n);
+    if (cos_bound <= 0.0f) return vec3(0.0f);
+    vec3 bound = lc_kd(m) * (cos_bound / kPi);
+    if (kEnableGgx && (m.flags & kMaterialHasSpecular) != 0u)
+        bound += lc_ks(m) * lc_ggx_bound(m, box_min, box_max, x, sp.n, sp.wo);
+    float geometry = 1.0f;
+    if (light_type == kLightPoint)
+        geometry = kBoundSlack / max(lc_box_distance2(box_min, box_max, sp.p), min_distance2);
+    return bound * geometry;
+}

@@ -1,0 +1,134 @@
+// Small scene builders and helpers shared by the tests.
+#pragma once
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "lightcuts/render.h"
+#include "lightcuts/scene.h"
+
+namespace lc::test {
+
+inline gpu::Material lambert(glm::vec3 kd) {
+    gpu::Material m{};
+    m.kd_r = kd.x; m.kd_g = kd.y; m.kd_b = kd.z;
+    m.alpha = 1.0f;
+    return m;
+}
+
+inline gpu::Material glossy(glm::vec3 kd, glm::vec3 ks, float alpha) {
+    gpu::Material m = lambert(kd);
+    m.ks_r = ks.x; m.ks_g = ks.y; m.ks_b = ks.z;
+    m.alpha = alpha;
+    m.flags = gpu::kMaterialHasSpecular;
+    return m;
+}
+
+inline gpu::Light point_light(glm::vec3 p, glm::vec3 intensity) {
+    return {p.x, p.y, p.z, intensity.x, intensity.y, intensity.z, gpu::kLightPoint, 0u};
+}
+
+// `travel` is the way the light travels, as in the scene format.
+inline gpu::Light directional_light(glm::vec3 travel, glm::vec3 irradiance) {
+    glm::vec3 to_light = -glm::normalize(travel);
+    return {to_light.x, to_light.y, to_light.z, irradiance.x, irradiance.y, irradiance.z,
+            gpu::kLightDirectional, 0u};
+}
+
+// Adds a triangle with its face normal (or the given vertex normals).
+inline void add_triangle(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, std::uint32_t material) {
+    gpu::Triangle t{a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, material, 0u, 0u};
+    glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));
+    gpu::TriangleNormals tn{n.x, n.y, n.z, n.x, n.y, n.z, n.x, n.y, n.z, 0u, 0u, 0u};
+    s.triangles.push_back(t);
+    s.normals.push_back(tn);
+}
+
+inline void add_quad(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, std::uint32_t material) {
+    add_triangle(s, a, b, c, material);
+    add_triangle(s, a, c, d, material);
+}
+
+// Axis-aligned box, six faces.
+inline void add_box(Scene& s, glm::vec3 lo, glm::vec3 hi, std::uint32_t material) {
+    glm::vec3 p[8];
+    for (int i = 0; i < 8; ++i) p[i] = glm::vec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+    add_quad(s, p[0], p[1], p[3], p[2], material);
+    add_quad(s, p[4], p[6], p[7], p[5], material);
+    add_quad(s, p[0], p[4], p[5], p[1], material);
+    add_quad(s, p[2], p[3], p[7], p[6], material);
+    add_quad(s, p[0], p[2], p[6], p[4], material);
+    add_quad(s, p[1], p[5], p[7], p[3], material);
+}
+
+// Closed UV sphere with flat faces.
+inline void add_sphere(Scene& s, glm::vec3 centre, float radius, int stacks, int slices, std::uint32_t material) {
+    auto at = [&](int i, int j) {
+        float theta = float(M_PI) * float(i) / float(stacks);
+        float phi = 2.0f * float(M_PI) * float(j) / float(slices);
+        return centre + radius * glm::vec3(std::sin(theta) * std::cos(phi), std::cos(theta),
+                                           std::sin(theta) * std::sin(phi));
+    };
+    for (int i = 0; i < stacks; ++i) {
+        for (int j = 0; j < slices; ++j) {
+            glm::vec3 a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+            if (i > 0) add_triangle(s, a, b, d, material);
+            if (i + 1 < stacks) add_triangle(s, b, c, d, material);
+        }
+    }
+}
+
+inline Camera camera(glm::vec3 pos, glm::vec3 at, float fov, std::uint32_t w, std::uint32_t h) {
+    Camera c;
+    c.position = pos;
+    c.look_at = at;
+    c.up = glm::vec3(0, 1, 0);
+    if (std::abs(glm::dot(glm::normalize(at - pos), c.up)) > 0.99f) c.up = glm::vec3(0, 0, 1);
+    c.fov_y_degrees = fov;
+    c.width = w;
+    c.height = h;
+    return c;
+}
+
+// Lights uniformly in a box, intensities summing to `total` per channel.
+inline std::vector<gpu::Light> random_point_lights(std::size_t n, glm::vec3 lo, glm::vec3 hi, float total,
+                                                   std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::vector<gpu::Light> lights;
+    for (std::size_t i = 0; i < n; ++i) {
+        glm::vec3 p = lo + (hi - lo) * glm::vec3(u(rng), u(rng), u(rng));
+        glm::vec3 c = glm::vec3(0.5f + u(rng), 0.5f + u(rng), 0.5f + u(rng)) * (total / float(n));
+        lights.push_back(point_light(p, c));
+    }
+    return lights;
+}
+
+// A closed room [-1,1]^2 x [0,2] in y with two boxes inside and one glossy
+// sphere; camera at the front looking in.
+inline Scene room_scene(std::vector<gpu::Light> lights, std::uint32_t size) {
+    Scene s;
+    s.materials = {lambert({0.7f, 0.7f, 0.7f}), lambert({0.7f, 0.2f, 0.2f}),
+                   glossy({0.2f, 0.3f, 0.6f}, {0.5f, 0.5f, 0.5f}, 0.3f)};
+    glm::vec3 lo(-1, 0, -1), hi(1, 2, 1);
+    add_box(s, lo, hi, 0);
+    add_box(s, {-0.6f, 0.0f, -0.5f}, {-0.1f, 0.7f, 0.0f}, 1);
+    add_box(s, {0.2f, 0.0f, 0.1f}, {0.6f, 0.4f, 0.5f}, 0);
+    add_sphere(s, {0.3f, 1.0f, -0.3f}, 0.25f, 12, 24, 2);
+    s.lights = std::move(lights);
+    s.camera = camera({0.0f, 1.0f, 0.95f}, {0.0f, 0.8f, 0.0f}, 70.0f, size, size);
+    update_bounds(s);
+    return s;
+}
+
+inline RenderOptions options(const std::string& method, std::uint32_t size) {
+    RenderOptions o;
+    o.method = method;
+    o.width = o.height = size;
+    return o;
+}
+
+}  // namespace lc::test
