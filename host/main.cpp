@@ -73,7 +73,21 @@ void write_json_atomically(const fs::path& file, const json& j) {
     fs::rename(tmp, file);
 }
 
+// Fails before the render, not after it, when an output cannot be written.
+void check_output_folder(const std::string& file, const char* what) {
+    if (file.empty()) return;
+    fs::path folder = fs::path(file).parent_path();
+    if (folder.empty()) folder = ".";
+    if (!fs::is_directory(folder))
+        throw std::runtime_error(std::string(what) + " " + file + ": folder " + folder.string() + " does not exist");
+}
+
 int run_render(const RenderArgs& a) {
+    check_output_folder(a.output, "output");
+    check_output_folder(a.stats_file, "--stats");
+    check_output_folder(a.cut_heatmap, "--cut-heatmap");
+    if (fs::path(a.output).extension() != ".exr")
+        throw std::invalid_argument("output " + a.output + ": must end in .exr");
     auto t_load = std::chrono::steady_clock::now();
     lc::Scene scene = lc::load_scene(a.scene);
     double load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t_load).count();
