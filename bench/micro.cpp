@@ -1,0 +1,110 @@
+// Google Benchmark micro-benchmarks of single kernels on the CPU:
+// light-tree build, one bound evaluation, one cut selection, shadow rays.
+//
+//   build/bench/lc_micro [--benchmark_filter=...]
+#include <random>
+
+#include <benchmark/benchmark.h>
+
+#include "cpu_kernel.h"
+#include "lightcuts/render.h"
+#include "../tests/test_util.h"
+
+namespace {
+
+using lc::cpu::ShadeKernel;
+
+std::vector<lc::gpu::Light> lights_in_room(std::size_t n) {
+    return lc::test::random_point_lights(n, {-0.95f, 0.05f, -0.95f}, {0.95f, 1.95f, 0.95f}, 30.0f, 1);
+}
+
+void BM_TreeBuild(benchmark::State& state) {
+    auto lights = lights_in_room(std::size_t(state.range(0)));
+    for (auto _ : state) benchmark::DoNotOptimize(lc::build_light_tree(lights, 1).nodes.data());
+    state.SetItemsProcessed(state.iterations() * state.range(0));
+}
+BENCHMARK(BM_TreeBuild)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMillisecond);
+
+// A prepared room scene with a kernel bound to it, and shading points taken
+// from camera rays.
+struct Fixture {
+    lc::PreparedScene prepared;
+    lc::gpu::FrameParams frame;
+    std::vector<lc::gpu::CutEntry> heap;
+    ShadeKernel k;
+    std::vector<ShadeKernel::SurfacePoint> points;
+
+    explicit Fixture(std::size_t n_lights) {
+        prepared = lc::prepare_scene(lc::test::room_scene(lights_in_room(n_lights), 64), 1);
+        lc::RenderOptions o = lc::test::options("lightcuts", 64);
+        frame = lc::make_frame_params(prepared, o);
+        heap.resize(frame.max_cut + 2);
+        k.bvh_nodes = prepared.bvh.nodes.data();
+        k.triangles = prepared.scene.triangles.data();
+        k.normals = prepared.scene.normals.data();
+        k.materials = prepared.scene.materials.data();
+        k.lights = prepared.tree.lights.data();
+        k.light_nodes = prepared.tree.nodes.data();
+        k.heap = heap.data();
+        glm::vec3 origin(frame.cam_pos_x, frame.cam_pos_y, frame.cam_pos_z);
+        for (std::uint32_t y = 0; y < 64; y += 4)
+            for (std::uint32_t x = 0; x < 64; x += 4) {
+                glm::vec3 dir = k.lc_camera_ray_dir(frame, k.lc_pixel_sample(x, y, 0, 1, 1));
+                float t, b1, b2;
+                std::uint32_t tri = k.lc_trace_closest(origin, dir, k.kRayInfinity, t, b1, b2);
+                if (tri != lc::gpu::kInvalidIndex) points.push_back(k.lc_surface_point(tri, b1, b2, dir));
+            }
+    }
+};
+
+void BM_ClusterBound(benchmark::State& state) {
+    Fixture f(1000);
+    std::size_t i = 0;
+    const auto& nodes = f.prepared.tree.nodes;
+    for (auto _ : state) {
+        const auto& sp = f.points[i % f.points.size()];
+        const auto& n = nodes[i % nodes.size()];
+        benchmark::DoNotOptimize(f.k.lc_cluster_bound(sp, f.prepared.scene.materials[sp.material],
+                                                      glm::vec3(n.min_x, n.min_y, n.min_z),
+                                                      glm::vec3(n.max_x, n.max_y, n.max_z), lc::gpu::kLightPoint,
+                                                      f.frame.min_distance2));
+        ++i;
+    }
+}
+BENCHMARK(BM_ClusterBound);
+
+void BM_CutSelection(benchmark::State& state) {
+    Fixture f(std::size_t(state.range(0)));
+    std::size_t i = 0;
+    std::uint64_t rays = 0, cut = 0;
+    for (auto _ : state) {
+        ShadeKernel::ShadeStats ss{0, 0, 0};
+        benchmark::DoNotOptimize(f.k.lc_shade_lightcuts(f.points[i++ % f.points.size()], f.frame, ss));
+        rays += ss.shadow_rays;
+        cut += ss.cut_size;
+    }
+    state.counters["cut_size"] = benchmark::Counter(double(cut), benchmark::Counter::kAvgIterations);
+    state.counters["shadow_rays"] = benchmark::Counter(double(rays), benchmark::Counter::kAvgIterations);
+}
+BENCHMARK(BM_CutSelection)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMicrosecond);
+
+void BM_ShadowRays(benchmark::State& state) {
+    Fixture f(1000);
+    std::size_t i = 0;
+    std::uint64_t blocked = 0;
+    for (auto _ : state) {
+        const auto& sp = f.points[i % f.points.size()];
+        const auto& l = f.prepared.tree.lights[i % f.prepared.tree.lights.size()];
+        glm::vec3 d = glm::vec3(l.x, l.y, l.z) - sp.p;
+        float len = glm::length(d);
+        blocked += f.k.lc_trace_any(sp.p, d / len, len * 0.9999f);
+        ++i;
+    }
+    state.SetItemsProcessed(state.iterations());
+    state.counters["blocked_fraction"] = benchmark::Counter(double(blocked), benchmark::Counter::kAvgIterations);
+}
+BENCHMARK(BM_ShadowRays);
+
+}  // namespace
+
+BENCHMARK_MAIN();
