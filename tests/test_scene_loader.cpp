@@ -1,1 +1,519 @@
+// Scene loading: the shipped scenes, every documented input error, the CSV
+// light format, materials, transforms and degenerate geometry.
 #include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "lightcuts/error.h"
+#include "lightcuts/scene.h"
+
+namespace lc {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kFixtures = fs::path(LC_TEST_DATA_DIR) / "scenes";
+const fs::path kScenes = fs::path(LC_SOURCE_DIR) / "scenes";
+
+// A fresh directory under the system temp dir, removed with everything in it.
+class TempDir {
+public:
+    TempDir() {
+        static std::atomic<unsigned> counter{0};
+        std::random_device entropy;
+        path_ = fs::temp_directory_path() /
+                ("lc_scene_test_" + std::to_string(entropy()) + "_" + std::to_string(counter++));
+        fs::create_directories(path_);
+    }
+    ~TempDir() {
+        std::error_code ignored;
+        fs::remove_all(path_, ignored);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+
+    fs::path write(const std::string& name, const std::string& text) const {
+        const fs::path file = path_ / name;
+        std::ofstream(file, std::ios::binary) << text;
+        return file;
+    }
+
+private:
+    fs::path path_;
+};
+
+// Runs `load` and returns the InputError message; fails the test if nothing
+// (or something else) was thrown.
+template <typename Fn>
+std::string input_error_of(Fn&& load) {
+    try {
+        load();
+    } catch (const InputError& e) {
+        return e.what();
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "expected lc::InputError, got: " << e.what();
+        return {};
+    }
+    ADD_FAILURE() << "expected lc::InputError, nothing was thrown";
+    return {};
+}
+
+glm::vec3 vertex(const gpu::Triangle& t, int i) {
+    if (i == 0) return {t.v0_x, t.v0_y, t.v0_z};
+    if (i == 1) return {t.v1_x, t.v1_y, t.v1_z};
+    return {t.v2_x, t.v2_y, t.v2_z};
+}
+
+glm::vec3 normal(const gpu::TriangleNormals& n, int i) {
+    if (i == 0) return {n.n0_x, n.n0_y, n.n0_z};
+    if (i == 1) return {n.n1_x, n.n1_y, n.n1_z};
+    return {n.n2_x, n.n2_y, n.n2_z};
+}
+
+void expect_near(glm::vec3 actual, glm::vec3 expected, float tolerance = 1e-5f) {
+    EXPECT_NEAR(actual.x, expected.x, tolerance);
+    EXPECT_NEAR(actual.y, expected.y, tolerance);
+    EXPECT_NEAR(actual.z, expected.z, tolerance);
+}
+
+// ---------------------------------------------------------------------------
+// Shipped scenes
+// ---------------------------------------------------------------------------
+
+TEST(SceneLoader, LoadsDefaultRoomScene) {
+    const Scene scene = load_scene(kScenes / "room" / "room.json");
+    EXPECT_EQ(scene.camera.width, 256u);
+    EXPECT_EQ(scene.camera.height, 256u);
+    EXPECT_EQ(scene.render.method, "brute");
+    EXPECT_EQ(scene.render.spp, 1u);
+    EXPECT_EQ(scene.lights.size(), 1000u);
+    EXPECT_EQ(scene.count_lights(gpu::kLightPoint), 1000u);
+    EXPECT_EQ(scene.count_lights(gpu::kLightDirectional), 0u);
+    // 6 wall quads + 2 boxes of 6 quads = 36 triangles, plus the 72 x 24 torus.
+    EXPECT_EQ(scene.triangles.size(), 36u + 2u * 72u * 24u);
+    EXPECT_EQ(scene.normals.size(), scene.triangles.size());
+    EXPECT_EQ(scene.degenerate_triangles_dropped, 0u);
+
+    std::size_t specular = 0;
+    for (const gpu::Material& m : scene.materials) specular += (m.flags & gpu::kMaterialHasSpecular) ? 1 : 0;
+    EXPECT_GE(specular, 1u);
+    for (const gpu::Triangle& t : scene.triangles) ASSERT_LT(t.material, scene.materials.size());
+
+    // Closed room: the camera and every light are inside the bounds.
+    for (int a = 0; a < 3; ++a) {
+        EXPECT_LT(scene.bounds_min[a], scene.camera.position[a]);
+        EXPECT_GT(scene.bounds_max[a], scene.camera.position[a]);
+    }
+    expect_near(scene.bounds_min, {-2.5f, 0.0f, -3.0f});
+    expect_near(scene.bounds_max, {2.5f, 3.0f, 3.0f});
+}
+
+TEST(SceneLoader, RoomScalingVariantsReferenceTheirLightSets) {
+    // The lights_1eN.csv sets are generated on demand (gitignored); either they
+    // load with the right count or the error names the missing file.
+    for (const auto& [name, count] : {std::pair{"1e3", 1000u}, {"1e4", 10000u}, {"1e5", 100000u}}) {
+        const fs::path scene_file = kScenes / "room" / (std::string("room_") + name + ".json");
+        const fs::path csv = kScenes / "room" / (std::string("lights_") + name + ".csv");
+        if (fs::exists(csv)) {
+            EXPECT_EQ(load_scene(scene_file).count_lights(gpu::kLightPoint), count) << scene_file;
+        } else {
+            const std::string message = input_error_of([&] { load_scene(scene_file); });
+            EXPECT_NE(message.find(csv.filename().string()), std::string::npos) << message;
+        }
+    }
+}
+
+TEST(SceneLoader, LoadsBunnySceneWhenFetched) {
+    if (!fs::exists(kScenes / "bunny" / "bunny.obj")) {
+        GTEST_SKIP() << "scenes/bunny/bunny.obj missing; run scripts/fetch-bunny.sh";
+    }
+    const Scene scene = load_scene(kScenes / "bunny" / "bunny.json");
+    EXPECT_EQ(scene.count_lights(gpu::kLightPoint), 1000u);
+    EXPECT_GT(scene.triangles.size(), 3000u);
+    EXPECT_NEAR(scene.bounds_min.y, 0.0f, 1e-3f);  // the floor
+}
+
+// ---------------------------------------------------------------------------
+// Good input
+// ---------------------------------------------------------------------------
+
+TEST(SceneLoader, MinimalSceneUsesDefaults) {
+    const Scene scene = load_scene(kFixtures / "minimal.json");
+    const Camera defaults;
+    const RenderSettings render;
+    EXPECT_EQ(scene.file, kFixtures / "minimal.json");
+    EXPECT_FLOAT_EQ(scene.camera.fov_y_degrees, defaults.fov_y_degrees);
+    expect_near(scene.camera.up, defaults.up);
+    EXPECT_EQ(scene.camera.width, 32u);
+    EXPECT_EQ(scene.render.method, render.method);
+    EXPECT_EQ(scene.render.spp, render.spp);
+    EXPECT_FLOAT_EQ(scene.render.relative_error, render.relative_error);
+    EXPECT_EQ(scene.render.max_cut, render.max_cut);
+    EXPECT_EQ(scene.render.seed, render.seed);
+
+    ASSERT_EQ(scene.triangles.size(), 1u);
+    ASSERT_EQ(scene.lights.size(), 1u);
+    const gpu::Light& light = scene.lights[0];
+    EXPECT_EQ(light.type, gpu::kLightPoint);
+    expect_near({light.x, light.y, light.z}, {0, 2, 1});
+    expect_near({light.r, light.g, light.b}, {1, 1, 1});
+}
+
+TEST(SceneLoader, DefaultMaterialIsGreyLambert) {
+    const Scene scene = load_scene(kFixtures / "minimal.json");
+    ASSERT_EQ(scene.materials.size(), 1u);
+    const gpu::Material& m = scene.materials[0];
+    expect_near({m.kd_r, m.kd_g, m.kd_b}, glm::vec3(0.8f));
+    expect_near({m.ks_r, m.ks_g, m.ks_b}, glm::vec3(0.0f));
+    EXPECT_EQ(m.flags & gpu::kMaterialHasSpecular, 0u);
+    EXPECT_EQ(scene.triangles[0].material, 0u);
+    // No vertex normals in the OBJ: the face normal, three times.
+    for (int i = 0; i < 3; ++i) expect_near(normal(scene.normals[0], i), {0, 0, 1});
+}
+
+TEST(SceneLoader, AllLightTypesInFileOrderAndRenderBlock) {
+    const Scene scene = load_scene(kFixtures / "all_lights.json");
+    // point, directional, 3 from the CSV, directional.
+    ASSERT_EQ(scene.lights.size(), 6u);
+    EXPECT_EQ(scene.count_lights(gpu::kLightPoint), 4u);
+    EXPECT_EQ(scene.count_lights(gpu::kLightDirectional), 2u);
+
+    const gpu::Light& sun = scene.lights[1];
+    EXPECT_EQ(sun.type, gpu::kLightDirectional);
+    // Light travels along -y: stored as the unit vector towards the light.
+    expect_near({sun.x, sun.y, sun.z}, {0, 1, 0});
+    expect_near({sun.r, sun.g, sun.b}, glm::vec3(0.5f));
+    const gpu::Light& side = scene.lights[5];
+    expect_near({side.x, side.y, side.z}, {-0.6f, 0.0f, 0.8f});
+
+    EXPECT_EQ(scene.lights[2].type, gpu::kLightPoint);
+    expect_near({scene.lights[2].x, scene.lights[2].y, scene.lights[2].z}, {1, 2, 3});
+
+    EXPECT_EQ(scene.render.method, "lightcuts");
+    EXPECT_EQ(scene.render.spp, 4u);
+    EXPECT_FLOAT_EQ(scene.render.relative_error, 0.01f);
+    EXPECT_EQ(scene.render.max_cut, 64u);
+    EXPECT_EQ(scene.render.seed, 4000000000u);
+}
+
+TEST(SceneLoader, MtlMaterialsGiveLambertAndGgx) {
+    const Scene scene = load_scene(kFixtures / "materials.json");
+    // lambert, glossy_ns, glossy_pr from the MTL, then the default (first use).
+    ASSERT_EQ(scene.materials.size(), 4u);
+    ASSERT_EQ(scene.triangles.size(), 4u);
+    EXPECT_EQ(scene.triangles[0].material, 3u);  // face before any usemtl
+    EXPECT_EQ(scene.triangles[1].material, 0u);
+    EXPECT_EQ(scene.triangles[2].material, 1u);
+    EXPECT_EQ(scene.triangles[3].material, 2u);
+
+    const gpu::Material& lambert = scene.materials[0];
+    expect_near({lambert.kd_r, lambert.kd_g, lambert.kd_b}, {0.2f, 0.4f, 0.6f});
+    EXPECT_EQ(lambert.flags & gpu::kMaterialHasSpecular, 0u);
+
+    const gpu::Material& ns = scene.materials[1];
+    EXPECT_NE(ns.flags & gpu::kMaterialHasSpecular, 0u);
+    expect_near({ns.ks_r, ns.ks_g, ns.ks_b}, glm::vec3(0.25f));
+    EXPECT_NEAR(ns.alpha, std::sqrt(2.0f / 100.0f), 1e-6f);
+
+    const gpu::Material& pr = scene.materials[2];
+    EXPECT_NE(pr.flags & gpu::kMaterialHasSpecular, 0u);
+    EXPECT_NEAR(pr.alpha, 0.25f, 1e-6f);
+
+    expect_near({scene.materials[3].kd_r, scene.materials[3].kd_g, scene.materials[3].kd_b},
+                glm::vec3(0.8f));
+}
+
+TEST(SceneLoader, MaterialOverrideReplacesMtlForWholeMesh) {
+    const Scene scene = load_scene(kFixtures / "override.json");
+    ASSERT_EQ(scene.materials.size(), 2u);  // one per overridden mesh, none from the MTL
+    ASSERT_EQ(scene.triangles.size(), 5u);
+    for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(scene.triangles[i].material, 0u);
+    EXPECT_EQ(scene.triangles[4].material, 1u);
+
+    const gpu::Material& glossy = scene.materials[0];
+    expect_near({glossy.kd_r, glossy.kd_g, glossy.kd_b}, {0.3f, 0.2f, 0.1f});
+    expect_near({glossy.ks_r, glossy.ks_g, glossy.ks_b}, glm::vec3(0.5f));
+    EXPECT_NEAR(glossy.alpha, 0.16f, 1e-6f);  // roughness^2
+    EXPECT_NE(glossy.flags & gpu::kMaterialHasSpecular, 0u);
+
+    const gpu::Material& matte = scene.materials[1];
+    expect_near({matte.kd_r, matte.kd_g, matte.kd_b}, glm::vec3(0.9f));
+    EXPECT_EQ(matte.flags & gpu::kMaterialHasSpecular, 0u);
+}
+
+TEST(SceneLoader, TransformAppliesScaleThenRotateXyzThenTranslate) {
+    const Scene scene = load_scene(kFixtures / "transform.json");
+    ASSERT_EQ(scene.triangles.size(), 5u);
+
+    // tri.obj is (0,0,0), (1,0,0), (0,1,0). Scale x2, yaw 90 degrees, move (1,2,3).
+    const gpu::Triangle& a = scene.triangles[0];
+    expect_near(vertex(a, 0), {1, 2, 3});
+    expect_near(vertex(a, 1), {1, 2, 1});
+    expect_near(vertex(a, 2), {1, 3, 3});
+    for (int i = 0; i < 3; ++i) expect_near(normal(scene.normals[0], i), {1, 0, 0});
+
+    // X first, then Y: (0,1,0) -> X90 -> (0,0,1) -> Y90 -> (1,0,0).
+    // (Y first would leave it at (0,0,1).)
+    const gpu::Triangle& b = scene.triangles[1];
+    expect_near(vertex(b, 1), {0, 0, -1});
+    expect_near(vertex(b, 2), {1, 0, 0});
+
+    // Vertex normals go through the inverse transpose and are renormalised:
+    // (1,1,0) under scale (2,1,1) becomes (0.5,1,0) / |.|.
+    const gpu::TriangleNormals& n = scene.normals[2];
+    expect_near(normal(n, 0), glm::normalize(glm::vec3(0.5f, 1.0f, 0.0f)));
+    expect_near(normal(n, 1), {0, 0, 1});
+    expect_near(normal(n, 2), {0, 1, 0});
+
+    // A mirroring scale flips the winding; the face normal keeps the side the
+    // OBJ meant: the inverse transpose of diag(-1,1,1) maps (0,0,1) to (0,0,1).
+    for (int i = 0; i < 3; ++i) expect_near(normal(scene.normals[3], i), {0, 0, 1});
+    expect_near(vertex(scene.triangles[3], 1), {-1, 0, 0});
+
+    // A scalar scale is uniform.
+    expect_near(vertex(scene.triangles[4], 2), {0, 3, 0});
+}
+
+TEST(SceneLoader, DegenerateTrianglesAreDroppedAndCounted) {
+    const Scene scene = load_scene(kFixtures / "degenerate.json");
+    // degenerate.obj: 1 good + 3 degenerate; tri.obj: 1 good.
+    EXPECT_EQ(scene.triangles.size(), 2u);
+    EXPECT_EQ(scene.normals.size(), 2u);
+    EXPECT_EQ(scene.degenerate_triangles_dropped, 3u);
+}
+
+TEST(SceneLoader, BoundsCoverTrianglesAndPointLightsOnly) {
+    Scene scene = load_scene(kFixtures / "all_lights.json");
+    // tri.obj spans [0,1]^2 x {0}; point lights reach (0,2,1), (1,2,3), (-1.5,0.25,0.2), (4,5,6).
+    expect_near(scene.bounds_min, {-1.5f, 0.0f, 0.0f});
+    expect_near(scene.bounds_max, {4.0f, 5.0f, 6.0f});
+
+    Scene empty;
+    empty.lights.push_back(gpu::Light{0, 0, 9, 1, 1, 1, gpu::kLightDirectional, 0});
+    update_bounds(empty);  // directional lights have no position
+    expect_near(empty.bounds_min, glm::vec3(0.0f));
+    expect_near(empty.bounds_max, glm::vec3(0.0f));
+
+    scene.lights.push_back(gpu::Light{-10, 0, 0, 1, 1, 1, gpu::kLightPoint, 0});
+    update_bounds(scene);
+    EXPECT_FLOAT_EQ(scene.bounds_min.x, -10.0f);
+}
+
+// ---------------------------------------------------------------------------
+// Bad input: each case names the file, the field and the problem.
+// ---------------------------------------------------------------------------
+
+struct BadInput {
+    const char* scene;    // fixture under tests/data/scenes
+    const char* file;     // file the message must name
+    const char* field;    // JSON path, CSV line or OBJ location
+    const char* problem;  // part of the description
+};
+
+void PrintTo(const BadInput& c, std::ostream* os) { *os << c.scene; }
+
+class SceneLoaderBadInput : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(SceneLoaderBadInput, ThrowsInputErrorNamingFileAndField) {
+    const BadInput& c = GetParam();
+    const std::string message = input_error_of([&] { load_scene(kFixtures / c.scene); });
+    EXPECT_NE(message.find(c.file), std::string::npos) << message;
+    EXPECT_NE(message.find(c.field), std::string::npos) << message;
+    EXPECT_NE(message.find(c.problem), std::string::npos) << message;
+}
+
+const BadInput kBadInputs[] = {
+    // Malformed JSON: nlohmann's line/column.
+    {"bad_syntax.json", "bad_syntax.json", "line 4", "parse error"},
+    {"bad_not_object.json", "bad_not_object.json", "", "expected an object"},
+    {"bad_duplicate_key.json", "bad_duplicate_key.json", "camera.width: ", "duplicate key"},
+    {"bad_huge_number.json", "bad_huge_number.json", "lights[0].intensity[1]: ", "overflow"},
+    // Missing required keys.
+    {"bad_missing_camera_position.json", "bad_missing_camera_position.json", "camera.position: ",
+     "missing required key"},
+    {"bad_missing_lights.json", "bad_missing_lights.json", ": lights: ", "missing required key"},
+    {"bad_missing_light_intensity.json", "bad_missing_light_intensity.json", "lights[0].intensity: ",
+     "missing required key"},
+    // Unknown keys anywhere.
+    {"bad_unknown_top_key.json", "bad_unknown_top_key.json", ": rendr: ", "unknown key"},
+    {"bad_unknown_light_key.json", "bad_unknown_light_key.json", "lights[1].colour: ", "unknown key"},
+    {"bad_unknown_transform_key.json", "bad_unknown_transform_key.json", "meshes[0].transform.rotate: ",
+     "unknown key"},
+    {"bad_key_of_other_light_type.json", "bad_key_of_other_light_type.json", "lights[0].direction: ",
+     "unknown key"},
+    // Wrong types.
+    {"bad_type_width.json", "bad_type_width.json", "camera.width: ", "expected an integer"},
+    {"bad_type_width_float.json", "bad_type_width_float.json", "camera.width: ", "non-integer"},
+    {"bad_type_vec2.json", "bad_type_vec2.json", "camera.position: ", "3 numbers"},
+    {"bad_type_intensity_element.json", "bad_type_intensity_element.json", "lights[0].intensity[1]: ",
+     "expected a number"},
+    {"bad_type_lights.json", "bad_type_lights.json", ": lights: ", "expected an array"},
+    // Unknown light type.
+    {"bad_light_type.json", "bad_light_type.json", "lights[0].type: ", "unknown light type \"spot\""},
+    // Missing files.
+    {"bad_missing_obj.json", "nonexistent.obj", "meshes[1].obj: ", "file not found"},
+    {"bad_missing_csv.json", "nonexistent.csv", "lights[1].file: ", "file not found"},
+    // Non-finite and out-of-range values.
+    {"bad_csv_nan.json", "nan.csv", "line 4: ", "not finite"},
+    {"bad_csv_inf.json", "inf.csv", "line 3: ", "not finite"},
+    {"bad_csv_overflow.json", "overflow.csv", "line 2: ", "out of range"},
+    {"bad_negative_intensity.json", "bad_negative_intensity.json", "lights[0].intensity[2]: ", "negative"},
+    {"bad_negative_irradiance.json", "bad_negative_irradiance.json", "lights[1].irradiance[0]: ",
+     "negative"},
+    {"bad_zero_direction.json", "bad_zero_direction.json", "lights[1].direction: ", "zero-length"},
+    // Camera.
+    {"bad_zero_width.json", "bad_zero_width.json", "camera.width: ", "[1, 16384]"},
+    {"bad_negative_width.json", "bad_negative_width.json", "camera.width: ", "[1, 16384]"},
+    {"bad_huge_height.json", "bad_huge_height.json", "camera.height: ", "[1, 16384]"},
+    {"bad_fov.json", "bad_fov.json", "camera.fov_y_degrees: ", "(0, 180)"},
+    {"bad_up_parallel.json", "bad_up_parallel.json", "camera.up: ", "parallel"},
+    {"bad_camera_at_target.json", "bad_camera_at_target.json", "camera.look_at: ", "camera.position"},
+    // Empty light list, also when it is empty only after loading the CSVs.
+    {"bad_empty_lights.json", "bad_empty_lights.json", ": lights: ", "no lights"},
+    {"bad_only_empty_csv.json", "bad_only_empty_csv.json", ": lights: ", "no lights"},
+    // Meshes.
+    {"bad_meshes_empty.json", "bad_meshes_empty.json", ": meshes: ", "at least one mesh"},
+    {"bad_obj_garbage.json", "garbage.obj", "", "tinyobjloader"},
+    {"bad_obj_no_faces.json", "no_faces.obj", "", "no usable triangles"},
+    {"bad_obj_all_degenerate.json", "all_degenerate.obj", "", "no usable triangles"},
+    {"bad_obj_index.json", "bad_index.obj", "triangle 1: ", "vertex index 9 out of range"},
+    {"bad_obj_missing_mtl.json", "missing_mtl.obj", "mtllib: ", "'not_there.mtl' not found"},
+    {"bad_obj_unknown_usemtl.json", "unknown_usemtl.obj", "usemtl: ", "no_such_material"},
+    {"bad_mtl_kd.json", "bad_kd.obj", "material 'hot'.Kd: ", "[0, 1]"},
+    {"bad_scale_zero.json", "bad_scale_zero.json", "meshes[0].transform.scale[1]: ", "zero"},
+    {"bad_roughness.json", "bad_roughness.json", "meshes[0].material.roughness: ", "(0, 1]"},
+    {"bad_kd_override.json", "bad_kd_override.json", "meshes[0].material.kd[1]: ", "at most 1"},
+    // Render block.
+    {"bad_render_method.json", "bad_render_method.json", "render.method: ", "\"brute\" or \"lightcuts\""},
+    {"bad_render_spp.json", "bad_render_spp.json", "render.spp: ", "[1, "},
+    {"bad_render_relative_error.json", "bad_render_relative_error.json", "render.relative_error: ",
+     "[0, inf)"},
+    {"bad_render_max_cut.json", "bad_render_max_cut.json", "render.max_cut: ", "[1, "},
+    {"bad_render_seed.json", "bad_render_seed.json", "render.seed: ", "4294967295"},
+};
+
+INSTANTIATE_TEST_SUITE_P(Fixtures, SceneLoaderBadInput, ::testing::ValuesIn(kBadInputs),
+                         [](const ::testing::TestParamInfo<BadInput>& info) {
+                             std::string name = info.param.scene;
+                             name = name.substr(0, name.find('.'));
+                             for (char& ch : name) ch = std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
+                             return name;
+                         });
+
+TEST(SceneLoader, MissingSceneFileIsAnInputError) {
+    const std::string message = input_error_of([] { load_scene(kFixtures / "nonexistent.json"); });
+    EXPECT_NE(message.find("nonexistent.json"), std::string::npos) << message;
+    EXPECT_NE(message.find("file not found"), std::string::npos) << message;
+}
+
+TEST(SceneLoader, ErrorMessageReadsFileFieldProblem) {
+    const std::string message = input_error_of([] { load_scene(kFixtures / "bad_zero_width.json"); });
+    const std::string expected_start = (kFixtures / "bad_zero_width.json").lexically_normal().string() +
+                                       ": camera.width: must be";
+    EXPECT_EQ(message.rfind(expected_start, 0), 0u) << message;
+}
+
+// ---------------------------------------------------------------------------
+// points_csv
+// ---------------------------------------------------------------------------
+
+TEST(PointsCsv, SkipsHeaderCommentsAndBlankLines) {
+    const std::vector<gpu::Light> lights = load_points_csv(kFixtures / "lights_header.csv");
+    ASSERT_EQ(lights.size(), 3u);
+    expect_near({lights[0].x, lights[0].y, lights[0].z}, {1, 2, 3});
+    expect_near({lights[0].r, lights[0].g, lights[0].b}, {0.1f, 0.2f, 0.3f});
+    expect_near({lights[1].x, lights[1].y, lights[1].z}, {-1.5f, 0.25f, 0.2f});
+    expect_near({lights[2].r, lights[2].g, lights[2].b}, glm::vec3(0.0f));
+    for (const gpu::Light& l : lights) EXPECT_EQ(l.type, gpu::kLightPoint);
+}
+
+TEST(PointsCsv, AcceptsCrLfMissingFinalNewlineAndTinyNumbers) {
+    TempDir dir;
+    const fs::path file = dir.write("crlf.csv", "x,y,z,r,g,b\r\n1,2,3,4,5,6\r\n7,8,9,1e-60,0,1");
+    const std::vector<gpu::Light> lights = load_points_csv(file);
+    ASSERT_EQ(lights.size(), 2u);
+    expect_near({lights[0].r, lights[0].g, lights[0].b}, {4, 5, 6});
+    EXPECT_EQ(lights[1].r, 0.0f);  // underflow is zero, not an error
+    EXPECT_FLOAT_EQ(lights[1].b, 1.0f);
+}
+
+TEST(PointsCsv, EmptyFileGivesNoLights) {
+    TempDir dir;
+    EXPECT_TRUE(load_points_csv(dir.write("empty.csv", "")).empty());
+    EXPECT_TRUE(load_points_csv(kFixtures / "header_only.csv").empty());
+}
+
+struct CsvError {
+    const char* name;
+    const char* text;
+    const char* line;
+    const char* problem;
+};
+
+class PointsCsvError : public ::testing::TestWithParam<CsvError> {};
+
+TEST_P(PointsCsvError, NamesFileAndLine) {
+    const CsvError& c = GetParam();
+    TempDir dir;
+    const fs::path file = dir.write(std::string(c.name) + ".csv", c.text);
+    const std::string message = input_error_of([&] { load_points_csv(file); });
+    EXPECT_NE(message.find(file.filename().string()), std::string::npos) << message;
+    EXPECT_NE(message.find(c.line), std::string::npos) << message;
+    EXPECT_NE(message.find(c.problem), std::string::npos) << message;
+}
+
+const CsvError kCsvErrors[] = {
+    {"too_few_fields", "# c\n\n1,2,3,4,5\n", "line 3: ", "found 5 fields"},
+    {"too_many_fields", "1,2,3,4,5,6,7\n", "line 1: ", "found 7 fields"},
+    {"empty_field", "1,2,,4,5,6\n", "line 1: ", "column 3 (z): '' is not a number"},
+    {"not_a_number", "1,2,3,4,5,6\n1,2,3,4,five,6\n", "line 2: ", "'five' is not a number"},
+    {"trailing_junk", "1,2,3,4,5,6x\n", "line 1: ", "is not a number"},
+    {"typo_in_first_line_is_not_a_header", "1,2,3,4,5,x\n1,2,3,4,5,6\n", "line 1: ", "'x' is not a number"},
+    {"second_header", "x,y,z,r,g,b\n1,2,3,4,5,6\nx,y,z,r,g,b\n", "line 3: ", "is not a number"},
+    {"nan", "1,2,3,nan,5,6\n", "line 1: ", "column 4 (r): 'nan' is not finite"},
+    {"inf", "1,2,3,4,5,6\n-inf,2,3,4,5,6\n", "line 2: ", "is not finite"},
+    {"overflow", "1,2,3,4,5,1e999\n", "line 1: ", "out of range"},
+    {"negative", "1,2,3,4,-5,6\n", "line 1: ", "column 5 (g): intensity must not be negative"},
+};
+
+INSTANTIATE_TEST_SUITE_P(Cases, PointsCsvError, ::testing::ValuesIn(kCsvErrors),
+                         [](const ::testing::TestParamInfo<CsvError>& info) { return std::string(info.param.name); });
+
+TEST(PointsCsv, MissingFileIsAnInputError) {
+    const std::string message = input_error_of([] { load_points_csv(kFixtures / "nonexistent.csv"); });
+    EXPECT_NE(message.find("nonexistent.csv"), std::string::npos) << message;
+}
+
+TEST(PointsCsv, LoadsHundredThousandLines) {
+    TempDir dir;
+    constexpr std::size_t kCount = 100000;
+    std::string text = "# generated by the test\nx,y,z,r,g,b\n";
+    text.reserve(kCount * 40);
+    char line[128];
+    for (std::size_t i = 0; i < kCount; ++i) {
+        const double t = static_cast<double>(i);
+        std::snprintf(line, sizeof line, "%.6g,%.6g,%.6g,%.6g,0.5,1e-5\n", t * 0.001, -t, t * 1e-7, t);
+        text += line;
+    }
+    const fs::path file = dir.write("big.csv", text);
+    const std::vector<gpu::Light> lights = load_points_csv(file);
+    ASSERT_EQ(lights.size(), kCount);
+    const gpu::Light& last = lights.back();
+    EXPECT_NEAR(last.x, 99.999f, 1e-3f);
+    EXPECT_FLOAT_EQ(last.y, -99999.0f);
+    EXPECT_FLOAT_EQ(last.r, 99999.0f);
+    EXPECT_FLOAT_EQ(last.g, 0.5f);
+    EXPECT_FLOAT_EQ(last.b, 1e-5f);
+}
+
+}  // namespace
+}  // namespace lc
