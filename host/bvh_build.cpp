@@ -1,1 +1,265 @@
-// placeholder
+// Binned SAH BVH builder (Wald, "On fast Construction of SAH-based Bounding
+// Volume Hierarchies", 2007): top-down, depth first, children adjacent.
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+
+#include <glm/glm.hpp>
+
+#include "lightcuts/bvh.h"
+
+namespace lc {
+
+namespace {
+
+using gpu::BvhNode;
+
+constexpr int kBins = 16;
+constexpr std::uint32_t kMaxLeaf = gpu::kBvhMaxLeafTriangles;
+// Deepest leaf, root = depth 0. The any-hit traversal holds up to depth + 2
+// entries when it expands an interior node at `depth`, so leaves at depth
+// kBvhStackSize - 2 keep it within its stack (the closest-hit one needs less).
+constexpr std::uint32_t kMaxDepth = gpu::kBvhStackSize - 2;
+// SAH costs relative to one ray/triangle test. A box test pair costs about
+// one triangle test in the kernels, so a split pays off once it saves one.
+constexpr double kTraversalCost = 1.0;
+constexpr double kIntersectCost = 1.0;
+
+struct Aabb {
+    glm::vec3 lo{std::numeric_limits<float>::infinity()};
+    glm::vec3 hi{-std::numeric_limits<float>::infinity()};
+    void grow(const Aabb& b) {
+        lo = glm::min(lo, b.lo);
+        hi = glm::max(hi, b.hi);
+    }
+    void grow(glm::vec3 p) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    // Half the surface area, in double so huge scenes do not overflow.
+    double half_area() const {
+        const glm::dvec3 d = glm::dvec3(hi) - glm::dvec3(lo);
+        return d.x * d.y + d.y * d.z + d.z * d.x;
+    }
+};
+
+// Number of levels below a node of n triangles that a balanced (median)
+// split needs to reach leaves of at most kMaxLeaf.
+std::uint32_t levels_needed(std::size_t n) {
+    std::uint32_t levels = 0;
+    for (std::size_t capacity = kMaxLeaf; capacity < n; capacity *= 2) ++levels;
+    return levels;
+}
+
+class Builder {
+public:
+    Builder(const std::vector<Aabb>& bounds, const std::vector<glm::vec3>& centroids,
+            std::vector<std::uint32_t>& order, std::vector<BvhNode>& nodes)
+        : bounds_(bounds), centroids_(centroids), order_(order), nodes_(nodes) {}
+
+    void build(std::uint32_t node_index, std::uint32_t begin, std::uint32_t end, std::uint32_t depth) {
+        Aabb box, centroid_box;
+        for (std::uint32_t i = begin; i < end; ++i) {
+            box.grow(bounds_[order_[i]]);
+            centroid_box.grow(centroids_[order_[i]]);
+        }
+        BvhNode& node = nodes_[node_index];
+        node.min_x = box.lo.x; node.min_y = box.lo.y; node.min_z = box.lo.z;
+        node.max_x = box.hi.x; node.max_y = box.hi.y; node.max_z = box.hi.z;
+
+        const std::uint32_t n = end - begin;
+        // SAH only while there is depth to spare; once the remaining depth is
+        // just enough for a balanced tree, median splits take over for good.
+        Split split;
+        const bool sah = kMaxDepth - depth > levels_needed(n) + 1;
+        const double area = box.half_area();
+        const bool found = sah && find_sah_split(begin, end, centroid_box, area, split);
+        if (n <= kMaxLeaf) {
+            const double leaf_cost = kIntersectCost * n * area;
+            if (!found || !(split.cost < leaf_cost)) {
+                node.first_or_left = begin;
+                node.tri_count = n;
+                return;
+            }
+        }
+
+        std::uint32_t mid = found ? partition(begin, end, centroid_box, split) : begin;
+        if (mid == begin || mid == end) mid = median_split(begin, end, centroid_box);
+
+        const auto left = std::uint32_t(nodes_.size());
+        node.first_or_left = left;  // `node` is dead after the resize below
+        node.tri_count = 0;
+        nodes_.resize(nodes_.size() + 2);
+        build(left, begin, mid, depth + 1);
+        build(left + 1, mid, end, depth + 1);
+    }
+
+private:
+    struct Split {
+        int axis = 0;
+        int bin = 0;  // left side = bins [0, bin)
+        double cost = std::numeric_limits<double>::infinity();
+    };
+
+    static float bin_scale(const Aabb& centroid_box, int axis) {
+        const float extent = centroid_box.hi[axis] - centroid_box.lo[axis];
+        const float scale = float(kBins) / extent;
+        return extent > 0.0f && std::isfinite(scale) ? scale : 0.0f;
+    }
+    // NaN-safe: a non-finite offset lands in bin 0 instead of UB in the cast.
+    static int bin_of(float c, float lo, float scale) {
+        const float f = (c - lo) * scale;
+        return f > 0.0f ? std::min(int(std::min(f, float(kBins))), kBins - 1) : 0;
+    }
+
+    // Wald 2007 §3: bin centroids on all three axes in one pass, then sweep
+    // the kBins - 1 planes per axis. Costs are scaled by the parent's area
+    // (never divided by it, which may be zero for degenerate input).
+    bool find_sah_split(std::uint32_t begin, std::uint32_t end, const Aabb& centroid_box, double parent_area,
+                        Split& best) const {
+        struct Bin {
+            Aabb box;
+            std::uint32_t count = 0;
+        };
+        std::array<std::array<Bin, kBins>, 3> bins{};
+        float scale[3];
+        bool any_axis = false;
+        for (int a = 0; a < 3; ++a) {
+            scale[a] = bin_scale(centroid_box, a);
+            any_axis |= scale[a] > 0.0f;
+        }
+        if (!any_axis) return false;
+
+        for (std::uint32_t i = begin; i < end; ++i) {
+            const std::uint32_t tri = order_[i];
+            const glm::vec3 c = centroids_[tri];
+            for (int a = 0; a < 3; ++a) {
+                if (scale[a] == 0.0f) continue;
+                Bin& bin = bins[std::size_t(a)][std::size_t(bin_of(c[a], centroid_box.lo[a], scale[a]))];
+                bin.box.grow(bounds_[tri]);
+                ++bin.count;
+            }
+        }
+
+        for (int a = 0; a < 3; ++a) {
+            if (scale[a] == 0.0f) continue;
+            const auto& axis_bins = bins[std::size_t(a)];
+            // Right-to-left sweep: area and count of bins [k, kBins).
+            std::array<double, kBins> right_area{};
+            std::array<std::uint32_t, kBins> right_count{};
+            Aabb acc;
+            std::uint32_t count = 0;
+            for (int k = kBins - 1; k > 0; --k) {
+                acc.grow(axis_bins[std::size_t(k)].box);
+                count += axis_bins[std::size_t(k)].count;
+                right_area[std::size_t(k)] = count ? acc.half_area() : 0.0;
+                right_count[std::size_t(k)] = count;
+            }
+            acc = Aabb{};
+            count = 0;
+            for (int k = 1; k < kBins; ++k) {
+                acc.grow(axis_bins[std::size_t(k - 1)].box);
+                count += axis_bins[std::size_t(k - 1)].count;
+                if (count == 0 || right_count[std::size_t(k)] == 0) continue;
+                const double cost = kIntersectCost * (count * acc.half_area() +
+                                                      right_count[std::size_t(k)] * right_area[std::size_t(k)]);
+                if (cost < best.cost) best = {a, k, cost};
+            }
+        }
+        if (!std::isfinite(best.cost)) return false;
+        best.cost += kTraversalCost * parent_area;
+        return true;
+    }
+
+    std::uint32_t partition(std::uint32_t begin, std::uint32_t end, const Aabb& centroid_box, const Split& split) {
+        const int a = split.axis;
+        const float lo = centroid_box.lo[a], scale = bin_scale(centroid_box, a);
+        auto* first = order_.data() + begin;
+        auto* mid = std::partition(first, order_.data() + end, [&](std::uint32_t tri) {
+            return bin_of(centroids_[tri][a], lo, scale) < split.bin;
+        });
+        return begin + std::uint32_t(mid - first);
+    }
+
+    // Object median along the widest centroid axis; if all centroids
+    // coincide, the middle by index as they are.
+    std::uint32_t median_split(std::uint32_t begin, std::uint32_t end, const Aabb& centroid_box) {
+        const std::uint32_t mid = begin + (end - begin) / 2;
+        const glm::vec3 extent = centroid_box.hi - centroid_box.lo;
+        const int a = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+        if (extent[a] > 0.0f) {
+            std::nth_element(order_.begin() + begin, order_.begin() + mid, order_.begin() + end,
+                             [&](std::uint32_t x, std::uint32_t y) { return centroids_[x][a] < centroids_[y][a]; });
+        }
+        return mid;
+    }
+
+    const std::vector<Aabb>& bounds_;
+    const std::vector<glm::vec3>& centroids_;
+    std::vector<std::uint32_t>& order_;
+    std::vector<BvhNode>& nodes_;
+};
+
+}  // namespace
+
+Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNormals>& normals) {
+    const auto start = std::chrono::steady_clock::now();
+    if (normals.size() != triangles.size())
+        throw std::invalid_argument("build_bvh: triangles and normals differ in count");
+    // Node indices are 32-bit and a tree holds up to 2n - 1 nodes.
+    if (triangles.size() >= std::size_t(std::numeric_limits<std::uint32_t>::max() / 2))
+        throw std::invalid_argument("build_bvh: too many triangles for 32-bit node indices");
+
+    Bvh bvh;
+    const auto n = std::uint32_t(triangles.size());
+    if (n == 0) {
+        // No triangle: the root is an interior-looking node (tri_count 0), so
+        // traversal must never enter it. Its box is the single point at
+        // (FLT_MAX, FLT_MAX, FLT_MAX): a ray can only reach it at t around
+        // 3e38 / |dir|, beyond any t_max <= kRayInfinity (1e30). An inverted
+        // box (min > max) would not do: the slab test swaps the planes per
+        // axis and sees a box around the origin.
+        constexpr float far = std::numeric_limits<float>::max();
+        bvh.nodes.push_back(BvhNode{far, far, far, 0u, far, far, far, 0u});
+        bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return bvh;
+    }
+
+    std::vector<Aabb> bounds(n);
+    std::vector<glm::vec3> centroids(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+        const gpu::Triangle& t = triangles[i];
+        Aabb b;
+        b.grow(glm::vec3(t.v0_x, t.v0_y, t.v0_z));
+        b.grow(glm::vec3(t.v1_x, t.v1_y, t.v1_z));
+        b.grow(glm::vec3(t.v2_x, t.v2_y, t.v2_z));
+        bounds[i] = b;
+        centroids[i] = 0.5f * (b.lo + b.hi);  // box centre: binning only needs a stable point
+    }
+    std::vector<std::uint32_t> order(n);
+    for (std::uint32_t i = 0; i < n; ++i) order[i] = i;
+
+    bvh.nodes.reserve(2 * std::size_t(n));
+    bvh.nodes.resize(1);
+    Builder(bounds, centroids, order, bvh.nodes).build(0, 0, n, 0);
+    bvh.nodes.shrink_to_fit();
+
+    // Leaves reference contiguous ranges of the reordered arrays.
+    std::vector<gpu::Triangle> sorted_triangles(n);
+    std::vector<gpu::TriangleNormals> sorted_normals(n);
+    for (std::uint32_t i = 0; i < n; ++i) {
+        sorted_triangles[i] = triangles[order[i]];
+        sorted_normals[i] = normals[order[i]];
+    }
+    triangles.swap(sorted_triangles);
+    normals.swap(sorted_normals);
+
+    bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return bvh;
+}
+
+}  // namespace lc

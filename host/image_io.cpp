@@ -1,1 +1,247 @@
-// placeholder
+// OpenEXR and PNG writers/readers. tinyexr and stb are the compiled Debian
+// libraries (libtinyexr, libstb): no *_IMPLEMENTATION macro here.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+
+#include <unistd.h>
+
+#include <stb_image_write.h>
+#include <tinyexr.h>
+
+#include "lightcuts/error.h"
+#include "lightcuts/image.h"
+
+namespace lc {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// "<name>.tmp-<pid>-<n>" beside the target, so the final rename stays within
+// one file system and concurrent writers (threads or processes) never share it.
+fs::path temp_path_for(const fs::path& file) {
+    static std::atomic<unsigned> counter{0};
+    fs::path tmp = file;
+    tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+    return tmp;
+}
+
+// Runs `write(tmp)`, which returns an empty string on success or the reason
+// it failed, then renames the temporary over `file`. On any failure the
+// temporary is removed and std::runtime_error names `file`.
+template <class Write>
+void write_via_temp(const fs::path& file, Write&& write) {
+    const fs::path tmp = temp_path_for(file);
+    std::string problem;
+    try {
+        problem = write(tmp);
+    } catch (const std::exception& e) {
+        problem = e.what();
+    }
+    if (problem.empty()) {
+        std::error_code ec;
+        fs::rename(tmp, file, ec);
+        if (!ec) return;
+        problem = "cannot rename temporary file into place: " + ec.message();
+    }
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    throw std::runtime_error(file.string() + ": " + problem);
+}
+
+void check_image(const Image& image, const char* what) {
+    if (image.rgb.size() != std::size_t(image.width) * image.height * 3)
+        throw std::invalid_argument(std::string(what) + ": Image::rgb does not hold width * height * 3 floats");
+}
+
+// Takes ownership of a tinyexr error string.
+std::string exr_message(const char* err, const char* fallback) {
+    std::string message = err ? err : fallback;
+    if (err) FreeEXRErrorMessage(err);
+    return message;
+}
+
+struct ExrHeaderGuard {
+    EXRHeader* header;
+    ~ExrHeaderGuard() { FreeEXRHeader(header); }
+};
+struct ExrImageGuard {
+    EXRImage* image;
+    ~ExrImageGuard() { FreeEXRImage(image); }
+};
+
+float srgb_encode(float linear) {
+    return linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
+}
+
+// Exposure that maps the 99th percentile luminance of the lit (positive,
+// finite) pixels to 1; 1 for an image with no such pixel.
+float auto_exposure(const Image& image) {
+    std::vector<float> lum;
+    lum.reserve(std::size_t(image.width) * image.height);
+    for (std::size_t i = 0; i + 2 < image.rgb.size(); i += 3) {
+        const float y = luminance({image.rgb[i], image.rgb[i + 1], image.rgb[i + 2]});
+        if (y > 0.0f && std::isfinite(y)) lum.push_back(y);
+    }
+    if (lum.empty()) return 1.0f;
+    const std::size_t k = std::min(lum.size() - 1, std::size_t(0.99 * double(lum.size() - 1) + 0.5));
+    std::nth_element(lum.begin(), lum.begin() + std::ptrdiff_t(k), lum.end());
+    return 1.0f / lum[k];
+}
+
+}  // namespace
+
+void write_exr(const fs::path& file, const Image& image) {
+    check_image(image, "write_exr");
+    if (image.width == 0 || image.height == 0 ||
+        image.width > std::uint32_t(std::numeric_limits<int>::max()) ||
+        image.height > std::uint32_t(std::numeric_limits<int>::max()))
+        throw std::runtime_error(file.string() + ": cannot write an image of size " +
+                                 std::to_string(image.width) + "x" + std::to_string(image.height));
+
+    // OpenEXR readers expect channels sorted by name, so the planes go B, G, R.
+    const std::size_t pixels = std::size_t(image.width) * image.height;
+    std::vector<float> planes[3];
+    for (int c = 0; c < 3; ++c) {
+        planes[c].resize(pixels);
+        const int src = 2 - c;
+        for (std::size_t i = 0; i < pixels; ++i) planes[c][i] = image.rgb[i * 3 + std::size_t(src)];
+    }
+    unsigned char* plane_ptrs[3] = {reinterpret_cast<unsigned char*>(planes[0].data()),
+                                    reinterpret_cast<unsigned char*>(planes[1].data()),
+                                    reinterpret_cast<unsigned char*>(planes[2].data())};
+
+    EXRChannelInfo channels[3];
+    std::memset(channels, 0, sizeof(channels));
+    channels[0].name[0] = 'B';
+    channels[1].name[0] = 'G';
+    channels[2].name[0] = 'R';
+    int pixel_types[3] = {TINYEXR_PIXELTYPE_FLOAT, TINYEXR_PIXELTYPE_FLOAT, TINYEXR_PIXELTYPE_FLOAT};
+    int requested_types[3] = {TINYEXR_PIXELTYPE_FLOAT, TINYEXR_PIXELTYPE_FLOAT, TINYEXR_PIXELTYPE_FLOAT};
+
+    // The header points at the arrays above; it is not FreeEXRHeader'd.
+    EXRHeader header;
+    InitEXRHeader(&header);
+    header.num_channels = 3;
+    header.channels = channels;
+    header.pixel_types = pixel_types;
+    header.requested_pixel_types = requested_types;
+    header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;  // lossless
+
+    EXRImage exr;
+    InitEXRImage(&exr);
+    exr.num_channels = 3;
+    exr.images = plane_ptrs;
+    exr.width = int(image.width);
+    exr.height = int(image.height);
+
+    write_via_temp(file, [&](const fs::path& tmp) -> std::string {
+        const char* err = nullptr;
+        if (SaveEXRImageToFile(&exr, &header, tmp.c_str(), &err) != TINYEXR_SUCCESS)
+            return exr_message(err, "cannot write OpenEXR file");
+        return {};
+    });
+}
+
+Image read_exr(const fs::path& file) {
+    const std::string name = file.string();
+    EXRVersion version;
+    if (ParseEXRVersionFromFile(&version, name.c_str()) != TINYEXR_SUCCESS)
+        throw InputError(name, "", "cannot be read or is not an OpenEXR file");
+    if (version.multipart || version.non_image)
+        throw InputError(name, "", "multi-part and deep OpenEXR files are not supported");
+
+    EXRHeader header;
+    InitEXRHeader(&header);
+    const char* err = nullptr;
+    if (ParseEXRHeaderFromFile(&header, &version, name.c_str(), &err) != TINYEXR_SUCCESS)
+        throw InputError(name, "", exr_message(err, "cannot parse the OpenEXR header"));
+    ExrHeaderGuard header_guard{&header};
+
+    int rgb_channel[3] = {-1, -1, -1};
+    for (int c = 0; c < header.num_channels; ++c) {
+        const std::string channel = header.channels[c].name;
+        const int slot = channel == "R" ? 0 : channel == "G" ? 1 : channel == "B" ? 2 : -1;
+        if (slot < 0) continue;  // A and anything else is ignored
+        if (header.pixel_types[c] == TINYEXR_PIXELTYPE_UINT)
+            throw InputError(name, "", "channel " + channel + " holds integers, expected HALF or FLOAT");
+        rgb_channel[slot] = c;
+    }
+    for (int slot = 0; slot < 3; ++slot)
+        if (rgb_channel[slot] < 0)
+            throw InputError(name, "", std::string("has no ") + "RGB"[slot] + " channel");
+    for (int c = 0; c < header.num_channels; ++c)
+        if (header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF) header.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
+
+    EXRImage exr;
+    InitEXRImage(&exr);
+    if (LoadEXRImageFromFile(&exr, &header, name.c_str(), &err) != TINYEXR_SUCCESS)
+        throw InputError(name, "", exr_message(err, "cannot decode the OpenEXR pixels"));
+    ExrImageGuard image_guard{&exr};
+    if (exr.width <= 0 || exr.height <= 0) throw InputError(name, "", "image is empty");
+
+    Image image(std::uint32_t(exr.width), std::uint32_t(exr.height));
+    if (exr.images) {
+        const std::size_t pixels = std::size_t(exr.width) * std::size_t(exr.height);
+        for (int slot = 0; slot < 3; ++slot) {
+            const float* src = reinterpret_cast<const float*>(exr.images[rgb_channel[slot]]);
+            for (std::size_t i = 0; i < pixels; ++i) image.rgb[i * 3 + std::size_t(slot)] = src[i];
+        }
+    } else if (exr.tiles) {
+        // Level 0 of a tiled file: tiles are placed on a tile_size grid.
+        for (int t = 0; t < exr.num_tiles; ++t) {
+            const EXRTile& tile = exr.tiles[t];
+            const long x0 = long(tile.offset_x) * header.tile_size_x;
+            const long y0 = long(tile.offset_y) * header.tile_size_y;
+            for (int slot = 0; slot < 3; ++slot) {
+                const float* src = reinterpret_cast<const float*>(tile.images[rgb_channel[slot]]);
+                for (int y = 0; y < tile.height; ++y) {
+                    for (int x = 0; x < tile.width; ++x) {
+                        const long px = x0 + x, py = y0 + y;
+                        if (px >= exr.width || py >= exr.height) continue;
+                        image.rgb[(std::size_t(py) * image.width + std::size_t(px)) * 3 + std::size_t(slot)] =
+                            src[std::size_t(y) * std::size_t(header.tile_size_x) + std::size_t(x)];
+                    }
+                }
+            }
+        }
+    } else {
+        throw InputError(name, "", "OpenEXR file holds no pixel data");
+    }
+    return image;
+}
+
+void write_png_rgb8(const fs::path& file, std::uint32_t width, std::uint32_t height,
+                    const std::vector<std::uint8_t>& rgb8) {
+    if (rgb8.size() != std::size_t(width) * height * 3)
+        throw std::invalid_argument("write_png_rgb8: " + file.string() + ": expected width * height * 3 bytes");
+    if (width == 0 || height == 0 || width > std::uint32_t(std::numeric_limits<int>::max() / 3) ||
+        height > std::uint32_t(std::numeric_limits<int>::max()))
+        throw std::runtime_error(file.string() + ": cannot write a PNG of size " + std::to_string(width) +
+                                 "x" + std::to_string(height));
+    write_via_temp(file, [&](const fs::path& tmp) -> std::string {
+        if (stbi_write_png(tmp.c_str(), int(width), int(height), 3, rgb8.data(), int(width * 3)) == 0)
+            return "cannot write PNG file";
+        return {};
+    });
+}
+
+void write_png_tonemapped(const fs::path& file, const Image& image, float exposure) {
+    check_image(image, "write_png_tonemapped");
+    if (!(exposure > 0.0f)) exposure = auto_exposure(image);
+    std::vector<std::uint8_t> rgb8(image.rgb.size());
+    for (std::size_t i = 0; i < image.rgb.size(); ++i) {
+        float v = exposure * image.rgb[i];
+        v = std::isnan(v) ? 0.0f : std::clamp(v, 0.0f, 1.0f);
+        rgb8[i] = std::uint8_t(srgb_encode(v) * 255.0f + 0.5f);
+    }
+    write_png_rgb8(file, image.width, image.height, rgb8);
+}
+
+}  // namespace lc

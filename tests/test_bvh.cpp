@@ -1,1 +1,485 @@
+// BVH build and the shared traversal (shaders/shared/trace.h, run on the CPU
+// through lc::cpu::TraceKernel), checked against brute force over every
+// triangle with the same intersection routine.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
 #include <gtest/gtest.h>
+
+#include "cpu_kernel.h"
+#include "lightcuts/bvh.h"
+
+namespace {
+
+using glm::vec3;
+using lc::gpu::BvhNode;
+using lc::gpu::kInvalidIndex;
+using lc::gpu::Triangle;
+using lc::gpu::TriangleNormals;
+constexpr float kRayInfinity = lc::cpu::TraceKernel::kRayInfinity;
+
+Triangle make_triangle(vec3 a, vec3 b, vec3 c) {
+    Triangle t{};
+    t.v0_x = a.x; t.v0_y = a.y; t.v0_z = a.z;
+    t.v1_x = b.x; t.v1_y = b.y; t.v1_z = b.z;
+    t.v2_x = c.x; t.v2_y = c.y; t.v2_z = c.z;
+    return t;
+}
+vec3 v0(const Triangle& t) { return {t.v0_x, t.v0_y, t.v0_z}; }
+vec3 v1(const Triangle& t) { return {t.v1_x, t.v1_y, t.v1_z}; }
+vec3 v2(const Triangle& t) { return {t.v2_x, t.v2_y, t.v2_z}; }
+vec3 geometric_normal(const Triangle& t) { return glm::normalize(glm::cross(v1(t) - v0(t), v2(t) - v0(t))); }
+
+// Triangles tagged with their input index (material, normals.pad0) so the
+// permutation applied by the build can be checked.
+struct Scene {
+    std::vector<Triangle> triangles;
+    std::vector<TriangleNormals> normals;
+    lc::Bvh bvh;
+
+    explicit Scene(std::vector<Triangle> input) : triangles(std::move(input)) {
+        normals.resize(triangles.size());
+        for (std::size_t i = 0; i < triangles.size(); ++i) {
+            triangles[i].material = std::uint32_t(i);
+            normals[i] = TriangleNormals{};
+            normals[i].pad0 = std::uint32_t(i);
+        }
+        bvh = lc::build_bvh(triangles, normals);
+    }
+    lc::cpu::TraceKernel kernel() const { return {bvh.nodes.data(), triangles.data()}; }
+};
+
+struct Hit {
+    std::uint32_t index = kInvalidIndex;
+    float t = 0.0f;
+};
+
+Hit brute_closest(const Scene& s, vec3 org, vec3 dir, float t_max) {
+    lc::cpu::TraceKernel k = s.kernel();
+    Hit hit;
+    float best = t_max;
+    for (std::uint32_t i = 0; i < s.triangles.size(); ++i) {
+        float b1, b2;
+        const float t = k.lc_intersect_triangle(org, dir, s.triangles[i], best, b1, b2);
+        if (t > 0.0f) {
+            best = t;
+            hit = {i, t};
+        }
+    }
+    return hit;
+}
+
+bool brute_any(const Scene& s, vec3 org, vec3 dir, float t_max) {
+    lc::cpu::TraceKernel k = s.kernel();
+    for (const Triangle& tri : s.triangles) {
+        float b1, b2;
+        if (k.lc_intersect_triangle(org, dir, tri, t_max, b1, b2) > 0.0f) return true;
+    }
+    return false;
+}
+
+std::string describe(vec3 org, vec3 dir, float t_max) {
+    std::ostringstream os;
+    os.precision(9);
+    os << "org (" << org.x << ", " << org.y << ", " << org.z << ") dir (" << dir.x << ", " << dir.y << ", " << dir.z
+       << ") t_max " << t_max;
+    return os.str();
+}
+
+// Compares the BVH traversal with brute force for one ray. Returns an empty
+// string when they agree. Ties at shared edges may pick either triangle, but
+// the distance must agree.
+std::string check_ray(const Scene& s, vec3 org, vec3 dir, float t_max) {
+    lc::cpu::TraceKernel k = s.kernel();
+    float t, b1, b2;
+    const std::uint32_t index = k.lc_trace_closest(org, dir, t_max, t, b1, b2);
+    const Hit expected = brute_closest(s, org, dir, t_max);
+    if (index == kInvalidIndex || expected.index == kInvalidIndex) {
+        if (index != expected.index)
+            return "closest: bvh " + std::to_string(index) + " vs brute " + std::to_string(expected.index) + " for " +
+                   describe(org, dir, t_max);
+    } else {
+        if (std::abs(t - expected.t) > 1e-6f * expected.t)
+            return "closest t " + std::to_string(t) + " vs " + std::to_string(expected.t) + " for " +
+                   describe(org, dir, t_max);
+        if (index != expected.index) {
+            const float t_own = k.lc_intersect_triangle(org, dir, s.triangles[index], kRayInfinity, b1, b2);
+            if (!(std::abs(t_own - expected.t) <= 1e-6f * expected.t))
+                return "closest picked a triangle that is not a tie for " + describe(org, dir, t_max);
+        }
+    }
+    if (k.lc_trace_any(org, dir, t_max) != brute_any(s, org, dir, t_max))
+        return "any-hit disagrees with brute force for " + describe(org, dir, t_max);
+    return {};
+}
+
+int max_leaf_depth(const std::vector<BvhNode>& nodes, std::uint32_t index, int depth) {
+    const BvhNode& n = nodes[index];
+    if (n.tri_count > 0) return depth;
+    return std::max(max_leaf_depth(nodes, n.first_or_left, depth + 1),
+                    max_leaf_depth(nodes, n.first_or_left + 1, depth + 1));
+}
+
+bool contains(const BvhNode& outer, const BvhNode& inner) {
+    return outer.min_x <= inner.min_x && outer.min_y <= inner.min_y && outer.min_z <= inner.min_z &&
+           outer.max_x >= inner.max_x && outer.max_y >= inner.max_y && outer.max_z >= inner.max_z;
+}
+bool contains(const BvhNode& box, vec3 p) {
+    return box.min_x <= p.x && box.min_y <= p.y && box.min_z <= p.z && box.max_x >= p.x && box.max_y >= p.y &&
+           box.max_z >= p.z;
+}
+
+// Structural invariants: every node reached once, children inside parents,
+// every triangle in exactly one leaf and inside its box, leaf sizes, depth,
+// and triangles and normals permuted together.
+void check_invariants(const Scene& s) {
+    const auto& nodes = s.bvh.nodes;
+    const std::size_t n = s.triangles.size();
+    ASSERT_FALSE(nodes.empty());
+    ASSERT_EQ(s.normals.size(), n);
+    std::vector<int> node_seen(nodes.size(), 0), tri_seen(n, 0);
+    std::vector<std::pair<std::uint32_t, int>> stack = {{0u, 0}};
+    int max_depth = 0;
+    while (!stack.empty()) {
+        const auto [index, depth] = stack.back();
+        stack.pop_back();
+        ASSERT_LT(index, nodes.size());
+        ++node_seen[index];
+        max_depth = std::max(max_depth, depth);
+        const BvhNode& node = nodes[index];
+        if (node.tri_count > 0) {
+            ASSERT_LE(node.tri_count, lc::gpu::kBvhMaxLeafTriangles);
+            ASSERT_LE(std::size_t(node.first_or_left) + node.tri_count, n);
+            for (std::uint32_t i = node.first_or_left; i < node.first_or_left + node.tri_count; ++i) {
+                ++tri_seen[i];
+                const Triangle& t = s.triangles[i];
+                ASSERT_TRUE(contains(node, v0(t)) && contains(node, v1(t)) && contains(node, v2(t)));
+            }
+        } else {
+            ASSERT_LT(std::size_t(node.first_or_left) + 1, nodes.size());
+            EXPECT_TRUE(contains(node, nodes[node.first_or_left]));
+            EXPECT_TRUE(contains(node, nodes[node.first_or_left + 1]));
+            stack.push_back({node.first_or_left, depth + 1});
+            stack.push_back({node.first_or_left + 1, depth + 1});
+        }
+    }
+    EXPECT_LT(max_depth, int(lc::gpu::kBvhStackSize) - 1);
+    EXPECT_TRUE(std::all_of(node_seen.begin(), node_seen.end(), [](int c) { return c == 1; }));
+    EXPECT_TRUE(std::all_of(tri_seen.begin(), tri_seen.end(), [](int c) { return c == 1; }));
+    std::vector<int> input_seen(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        ASSERT_LT(s.triangles[i].material, n);
+        ++input_seen[s.triangles[i].material];
+        ASSERT_EQ(s.normals[i].pad0, s.triangles[i].material) << "normals not permuted with triangles";
+    }
+    EXPECT_TRUE(std::all_of(input_seen.begin(), input_seen.end(), [](int c) { return c == 1; }));
+}
+
+vec3 random_unit(std::mt19937& rng) {
+    std::normal_distribution<float> g(0.0f, 1.0f);
+    vec3 d;
+    do d = {g(rng), g(rng), g(rng)};
+    while (glm::dot(d, d) < 1e-6f);
+    return glm::normalize(d);
+}
+
+// Direction in the hemisphere around n, at least `min_cos` away from grazing.
+vec3 random_in_hemisphere(std::mt19937& rng, vec3 n, float min_cos) {
+    while (true) {
+        const vec3 d = random_unit(rng);
+        const float c = glm::dot(d, n);
+        if (std::abs(c) >= min_cos) return c > 0.0f ? d : -d;
+    }
+}
+
+std::vector<Triangle> random_triangles(std::mt19937& rng, std::size_t count, float extent, float size) {
+    std::uniform_real_distribution<float> pos(-extent, extent), off(-size, size);
+    std::vector<Triangle> tris;
+    tris.reserve(count);
+    for (std::size_t i = 0; i < count; ++i) {
+        const vec3 c(pos(rng), pos(rng), pos(rng));
+        tris.push_back(make_triangle(c + vec3(off(rng), off(rng), off(rng)), c + vec3(off(rng), off(rng), off(rng)),
+                                     c + vec3(off(rng), off(rng), off(rng))));
+    }
+    return tris;
+}
+
+// The surface of a rotated cube as an n x n grid of quads per face. Every
+// lattice vertex is computed once, so neighbouring triangles share exactly
+// the same corner values and the mesh is closed.
+struct GridCube {
+    int n;
+    vec3 center;
+    float size;
+    glm::mat3 rotation;
+    std::map<std::array<int, 3>, vec3> vertices;
+
+    GridCube(int n_, vec3 center_, float size_, vec3 axis, float angle)
+        : n(n_), center(center_), size(size_) {
+        const vec3 a = glm::normalize(axis);
+        const float c = std::cos(angle), s = std::sin(angle);
+        const glm::mat3 k(0, a.z, -a.y, -a.z, 0, a.x, a.y, -a.x, 0);  // cross-product matrix, column major
+        rotation = glm::mat3(1.0f) * c + (1.0f - c) * glm::outerProduct(a, a) + s * k;
+    }
+    vec3 vertex(std::array<int, 3> ijk) {
+        auto it = vertices.find(ijk);
+        if (it != vertices.end()) return it->second;
+        const vec3 lattice_point{static_cast<float>(ijk[0]), static_cast<float>(ijk[1]), static_cast<float>(ijk[2])};
+        const vec3 local = (lattice_point / float(n) - 0.5f) * size;
+        return vertices[ijk] = center + rotation * local;
+    }
+    // Corner of face (axis, side) at grid coordinates (u, v).
+    static std::array<int, 3> lattice(int axis, int side, int u, int v) {
+        std::array<int, 3> ijk{};
+        ijk[std::size_t(axis)] = side;
+        ijk[std::size_t((axis + 1) % 3)] = u;
+        ijk[std::size_t((axis + 2) % 3)] = v;
+        return ijk;
+    }
+    std::vector<Triangle> triangles() {
+        std::vector<Triangle> tris;
+        for (int axis = 0; axis < 3; ++axis)
+            for (int side : {0, n})
+                for (int u = 0; u < n; ++u)
+                    for (int v = 0; v < n; ++v) {
+                        const vec3 p00 = vertex(lattice(axis, side, u, v)), p10 = vertex(lattice(axis, side, u + 1, v));
+                        const vec3 p11 = vertex(lattice(axis, side, u + 1, v + 1));
+                        const vec3 p01 = vertex(lattice(axis, side, u, v + 1));
+                        if ((u + v) % 2 == 0) {  // alternate diagonals
+                            tris.push_back(make_triangle(p00, p10, p11));
+                            tris.push_back(make_triangle(p00, p11, p01));
+                        } else {
+                            tris.push_back(make_triangle(p00, p10, p01));
+                            tris.push_back(make_triangle(p10, p11, p01));
+                        }
+                    }
+        return tris;
+    }
+    // A point on a shared vertex or edge of the grid (quad sides and
+    // diagonals), and the outward normal of its face.
+    std::pair<vec3, vec3> random_edge_point(std::mt19937& rng) {
+        std::uniform_int_distribution<int> face(0, 5), cell(0, n - 1), kind(0, 4);
+        std::uniform_real_distribution<float> f(0.0f, 1.0f);
+        const int f_index = face(rng);
+        const int axis = f_index / 2, side = f_index % 2 ? n : 0;
+        const int u = cell(rng), v = cell(rng);
+        const vec3 a = vertex(lattice(axis, side, u, v));
+        const vec3 b = vertex(lattice(axis, side, u + 1, v));
+        const vec3 c = vertex(lattice(axis, side, u + 1, v + 1));
+        const vec3 d = vertex(lattice(axis, side, u, v + 1));
+        vec3 local_normal(0.0f);
+        local_normal[axis] = side ? 1.0f : -1.0f;
+        const vec3 normal = rotation * local_normal;
+        switch (kind(rng)) {
+            case 0: return {a, normal};                               // shared vertex
+            case 1: return {0.5f * (a + b), normal};                  // quad side midpoint
+            case 2: return {0.5f * (a + c), normal};                  // diagonal midpoint
+            case 3: return {0.5f * (b + d), normal};                  // other diagonal
+            default: return {a + f(rng) * (d - a), normal};           // anywhere on a side
+        }
+    }
+};
+
+}  // namespace
+
+TEST(Bvh, TraversalMatchesBruteForceIncludingSharedEdges) {
+    std::mt19937 rng(20240611u);
+    GridCube cube(6, vec3(25.0f, 3.0f, -4.0f), 8.0f, vec3(0.3f, 1.0f, 0.2f), 0.7f);
+    std::vector<Triangle> tris = random_triangles(rng, 2000, 10.0f, 1.5f);
+    const std::vector<Triangle> grid = cube.triangles();
+    tris.insert(tris.end(), grid.begin(), grid.end());
+    const Scene scene(std::move(tris));
+    check_invariants(scene);
+    lc::cpu::TraceKernel k = scene.kernel();
+
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f), box(-15.0f, 15.0f), inner(-0.35f, 0.35f);
+    int failures = 0, misses_inside = 0, total = 0;
+    std::string first_failure;
+    auto check = [&](vec3 org, vec3 dir, float t_max) {
+        ++total;
+        const std::string problem = check_ray(scene, org, dir, t_max);
+        if (!problem.empty() && failures++ == 0) first_failure = problem;
+    };
+
+    // Random rays, unbounded and short segments.
+    for (int i = 0; i < 4000; ++i) {
+        const vec3 org(box(rng) + 10.0f, box(rng), box(rng));
+        check(org, random_unit(rng), i % 2 ? kRayInfinity : 30.0f * u01(rng));
+    }
+    // From inside the closed cube at its shared vertices and edges: the
+    // watertight test must never let such a ray escape.
+    for (int i = 0; i < 3000; ++i) {
+        const vec3 org = cube.center + cube.rotation * (vec3(inner(rng), inner(rng), inner(rng)) * cube.size);
+        const vec3 target = cube.random_edge_point(rng).first;
+        const vec3 dir = target - org;
+        check(org, dir, kRayInfinity);
+        float t, b1, b2;
+        if (k.lc_trace_closest(org, dir, kRayInfinity, t, b1, b2) == kInvalidIndex ||
+            !k.lc_trace_any(org, dir, kRayInfinity))
+            ++misses_inside;
+    }
+    // From outside, grazing the faces towards shared vertices and edges.
+    for (int i = 0; i < 3000; ++i) {
+        const auto [target, normal] = cube.random_edge_point(rng);
+        vec3 tangent = glm::cross(normal, random_unit(rng));
+        tangent = glm::normalize(tangent);
+        const float lift = std::pow(10.0f, -4.0f * u01(rng));  // 1 .. 1e-4 rad above the face
+        const vec3 org = target + 20.0f * (tangent + lift * normal);
+        check(org, target - org, kRayInfinity);
+    }
+    EXPECT_EQ(total, 10000);
+    EXPECT_EQ(failures, 0) << "first: " << first_failure;
+    EXPECT_EQ(misses_inside, 0) << "rays leaked through shared edges or vertices of the closed grid";
+}
+
+TEST(Bvh, EmptySceneMissesEverything) {
+    std::vector<Triangle> tris;
+    std::vector<TriangleNormals> normals;
+    const lc::Bvh bvh = lc::build_bvh(tris, normals);
+    ASSERT_EQ(bvh.nodes.size(), 1u);
+    EXPECT_EQ(bvh.nodes[0].tri_count, 0u);
+    lc::cpu::TraceKernel k{bvh.nodes.data(), nullptr};
+    std::mt19937 rng(7u);
+    std::uniform_real_distribution<float> pos(-1e3f, 1e3f);
+    std::vector<std::pair<vec3, vec3>> rays = {{vec3(0.0f), vec3(1.0f)},   // towards the sentinel box
+                                               {vec3(0.0f), vec3(-1.0f)},
+                                               {vec3(0.0f), vec3(0.0f, 0.0f, 1.0f)}};
+    for (int i = 0; i < 1000; ++i) rays.push_back({vec3(pos(rng), pos(rng), pos(rng)), random_unit(rng)});
+    for (const auto& [org, dir] : rays) {
+        float t, b1, b2;
+        EXPECT_EQ(k.lc_trace_closest(org, dir, kRayInfinity, t, b1, b2), kInvalidIndex);
+        EXPECT_FALSE(k.lc_trace_any(org, dir, kRayInfinity));
+    }
+}
+
+TEST(Bvh, DegenerateInputsKeepInvariants) {
+    // All centroids coincide: split by index.
+    std::vector<Triangle> same(37, make_triangle(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0)));
+    const Scene stacked(same);
+    check_invariants(stacked);
+    float t, b1, b2;
+    EXPECT_NE(stacked.kernel().lc_trace_closest(vec3(0.2f, 0.2f, 1.0f), vec3(0, 0, -1), kRayInfinity, t, b1, b2),
+              kInvalidIndex);
+    EXPECT_FLOAT_EQ(t, 1.0f);
+
+    // Geometrically spaced triangles make SAH peel off one at a time; the
+    // depth cap must switch to median splits.
+    std::vector<Triangle> spread;
+    for (int i = 0; i < 400; ++i) {
+        const float x = std::pow(1.2f, float(i));
+        spread.push_back(make_triangle(vec3(x, 0, 0), vec3(x * 1.01f, 1, 0), vec3(x, 0, 1)));
+    }
+    const Scene deep(spread);
+    check_invariants(deep);
+    std::mt19937 rng(99u);
+    std::uniform_int_distribution<std::size_t> pick(0, deep.triangles.size() - 1);
+    int failures = 0;
+    std::string first_failure;
+    for (int i = 0; i < 2000; ++i) {
+        const Triangle& tri = deep.triangles[pick(rng)];
+        const vec3 target = (v0(tri) + v1(tri) + v2(tri)) / 3.0f;
+        const vec3 org = target + vec3(0.0f, 2.0f, 3.0f) + random_unit(rng);
+        const std::string problem = check_ray(deep, org, target - org, kRayInfinity);
+        if (!problem.empty() && failures++ == 0) first_failure = problem;
+    }
+    EXPECT_EQ(failures, 0) << first_failure;
+
+    std::vector<Triangle> one = {make_triangle(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0))};
+    const Scene single(one);
+    check_invariants(single);
+    EXPECT_EQ(single.bvh.nodes.size(), 1u);
+}
+
+TEST(Bvh, BuildsLargeRandomSceneWithValidTree) {
+    std::mt19937 rng(5u);
+    const Scene scene(random_triangles(rng, 50000, 100.0f, 1.0f));
+    check_invariants(scene);
+    EXPECT_GT(scene.bvh.build_seconds, 0.0);
+    EXPECT_LE(scene.bvh.nodes.size(), 2 * scene.triangles.size());
+}
+
+// Waechter-Binder offsets: a shadow ray leaving the surface from the offset
+// hit point never hits the surface it starts on.
+TEST(Bvh, OffsetOriginsAvoidSelfIntersectionFarFromOrigin) {
+    const vec3 n = glm::normalize(vec3(1.0f, 2.0f, 3.0f));
+    const vec3 p0(1e5f, -1e5f, 1e5f);
+    const vec3 t1 = glm::normalize(glm::cross(n, vec3(0, 0, 1))), t2 = glm::cross(n, t1);
+    const float half = 100.0f;
+    const vec3 a = p0 - half * t1 - half * t2, b = p0 + half * t1 - half * t2;
+    const vec3 c = p0 + half * t1 + half * t2, d = p0 - half * t1 + half * t2;
+    const Scene plane({make_triangle(a, b, c), make_triangle(a, c, d)});
+    lc::cpu::TraceKernel k = plane.kernel();
+
+    std::mt19937 rng(3u);
+    std::uniform_real_distribution<float> on(-60.0f, 60.0f), height(0.01f, 100.0f);
+    int hits = 0, self_hits = 0, raw_self_hits = 0;
+    for (int i = 0; i < 4000; ++i) {
+        const float side = i % 2 ? 1.0f : -1.0f;
+        const vec3 q = p0 + on(rng) * t1 + on(rng) * t2;
+        const vec3 org = q + side * height(rng) * n + on(rng) * t1;
+        const vec3 dir = glm::normalize(q - org);
+        float t, b1, b2;
+        const std::uint32_t tri = k.lc_trace_closest(org, dir, kRayInfinity, t, b1, b2);
+        if (tri == kInvalidIndex) continue;
+        ++hits;
+        const vec3 p = org + t * dir;
+        vec3 ng = geometric_normal(plane.triangles[tri]);
+        if (glm::dot(ng, dir) > 0.0f) ng = -ng;  // face the incoming ray
+        const vec3 shadow = random_in_hemisphere(rng, ng, 1e-3f);
+        self_hits += k.lc_trace_any(k.lc_offset_ray_origin(p, ng), shadow, kRayInfinity);
+        raw_self_hits += k.lc_trace_any(p, shadow, kRayInfinity);
+    }
+    EXPECT_GT(hits, 3900);
+    EXPECT_EQ(self_hits, 0);
+    EXPECT_GT(raw_self_hits, 0) << "the test should be sensitive: without the offset some rays self-intersect";
+}
+
+TEST(Bvh, OffsetOriginsAvoidSelfIntersectionOnCurvedSurface) {
+    // UV sphere away from the origin; a convex mesh, so any ray leaving the
+    // outside of a face within that face's hemisphere must escape.
+    const vec3 center(1e3f, -2e3f, 5e2f);
+    const float radius = 10.0f;
+    const int rings = 32, segments = 64;
+    auto point = [&](int r, int s) {
+        const float theta = std::numbers::pi_v<float> * float(r) / float(rings);
+        const float phi = 2.0f * std::numbers::pi_v<float> * float(s % segments) / float(segments);
+        return center + radius * vec3(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+    };
+    std::vector<Triangle> tris;
+    for (int r = 0; r < rings; ++r)
+        for (int s = 0; s < segments; ++s) {
+            const vec3 p00 = point(r, s), p01 = point(r, s + 1), p10 = point(r + 1, s), p11 = point(r + 1, s + 1);
+            if (r > 0) tris.push_back(make_triangle(p00, p10, p01));
+            if (r < rings - 1) tris.push_back(make_triangle(p01, p10, p11));
+        }
+    const Scene sphere(std::move(tris));
+    check_invariants(sphere);
+    lc::cpu::TraceKernel k = sphere.kernel();
+
+    std::mt19937 rng(11u);
+    int hits = 0, self_hits = 0;
+    for (int i = 0; i < 4000; ++i) {
+        const vec3 org = center + 3.0f * radius * random_unit(rng);
+        const vec3 aim = center + 0.8f * radius * random_unit(rng);
+        const vec3 dir = glm::normalize(aim - org);
+        float t, b1, b2;
+        const std::uint32_t tri = k.lc_trace_closest(org, dir, kRayInfinity, t, b1, b2);
+        if (tri == kInvalidIndex) continue;
+        ++hits;
+        const vec3 p = org + t * dir;
+        vec3 ng = geometric_normal(sphere.triangles[tri]);
+        if (glm::dot(ng, dir) > 0.0f) ng = -ng;
+        const vec3 shadow = random_in_hemisphere(rng, ng, 0.02f);
+        self_hits += k.lc_trace_any(k.lc_offset_ray_origin(p, ng), shadow, kRayInfinity);
+    }
+    EXPECT_GT(hits, 3900);
+    EXPECT_EQ(self_hits, 0);
+}

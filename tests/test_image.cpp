@@ -1,1 +1,281 @@
+// Image files (EXR, PNG, heat map) and the comparison metrics.
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <string>
+
+#include <unistd.h>
+
 #include <gtest/gtest.h>
+#include <stb/stb_image.h>
+#include <tinyexr.h>
+
+#include "lightcuts/error.h"
+#include "lightcuts/image.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A fresh folder per test, removed afterwards.
+class ImageFiles : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = fs::temp_directory_path() /
+               ("lc_test_image_" + std::to_string(::getpid()) + "_" + info->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    std::set<std::string> entries() const {
+        std::set<std::string> names;
+        for (const auto& e : fs::directory_iterator(dir_)) names.insert(e.path().filename().string());
+        return names;
+    }
+
+    fs::path dir_;
+};
+
+struct Png {
+    int width = 0, height = 0, channels = 0;
+    std::vector<std::uint8_t> rgb;
+    std::array<std::uint8_t, 3> at(int x, int y) const {
+        const std::size_t i = (std::size_t(y) * std::size_t(width) + std::size_t(x)) * 3;
+        return {rgb[i], rgb[i + 1], rgb[i + 2]};
+    }
+};
+
+Png read_png(const fs::path& file) {
+    Png png;
+    unsigned char* data = stbi_load(file.c_str(), &png.width, &png.height, &png.channels, 3);
+    if (!data) return png;
+    png.rgb.assign(data, data + std::size_t(png.width) * std::size_t(png.height) * 3);
+    stbi_image_free(data);
+    return png;
+}
+
+lc::Image gray(std::uint32_t w, std::uint32_t h, float v) {
+    lc::Image image(w, h);
+    std::fill(image.rgb.begin(), image.rgb.end(), v);
+    return image;
+}
+
+}  // namespace
+
+TEST_F(ImageFiles, ExrRoundTripIsBitExact) {
+    lc::Image image(7, 5);
+    const float specials[] = {0.0f, -0.0f, 1.0f, -3.5f, 1e-40f /* denormal */, 3.0e38f,
+                              std::numeric_limits<float>::infinity(), 0.1f, 1234.5678f};
+    for (std::size_t i = 0; i < image.rgb.size(); ++i)
+        image.rgb[i] = i < std::size(specials) ? specials[i] : std::sin(float(i)) * float(i);
+    const fs::path file = dir_ / "round.exr";
+    lc::write_exr(file, image);
+    const lc::Image back = lc::read_exr(file);
+    ASSERT_EQ(back.width, image.width);
+    ASSERT_EQ(back.height, image.height);
+    ASSERT_EQ(back.rgb.size(), image.rgb.size());
+    EXPECT_EQ(std::memcmp(back.rgb.data(), image.rgb.data(), image.rgb.size() * sizeof(float)), 0);
+    EXPECT_EQ(entries(), std::set<std::string>{"round.exr"});
+}
+
+TEST_F(ImageFiles, ExrStoresFloatChannelsSortedByName) {
+    lc::Image image(2, 1);
+    image.set(0, 0, {1.0f, 2.0f, 3.0f});
+    const fs::path file = dir_ / "channels.exr";
+    lc::write_exr(file, image);
+
+    EXRVersion version;
+    ASSERT_EQ(ParseEXRVersionFromFile(&version, file.c_str()), TINYEXR_SUCCESS);
+    EXRHeader header;
+    InitEXRHeader(&header);
+    const char* err = nullptr;
+    ASSERT_EQ(ParseEXRHeaderFromFile(&header, &version, file.c_str(), &err), TINYEXR_SUCCESS);
+    ASSERT_EQ(header.num_channels, 3);
+    EXPECT_STREQ(header.channels[0].name, "B");
+    EXPECT_STREQ(header.channels[1].name, "G");
+    EXPECT_STREQ(header.channels[2].name, "R");
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(header.pixel_types[c], TINYEXR_PIXELTYPE_FLOAT);
+    FreeEXRHeader(&header);
+
+    // And an independent reader sees R, G, B where they belong.
+    float* rgba = nullptr;
+    int w = 0, h = 0;
+    ASSERT_EQ(LoadEXR(&rgba, &w, &h, file.c_str(), &err), TINYEXR_SUCCESS);
+    EXPECT_EQ(rgba[0], 1.0f);
+    EXPECT_EQ(rgba[1], 2.0f);
+    EXPECT_EQ(rgba[2], 3.0f);
+    std::free(rgba);
+}
+
+TEST_F(ImageFiles, ReadExrReportsBadInputAsInputError) {
+    const fs::path missing = dir_ / "missing.exr";
+    try {
+        lc::read_exr(missing);
+        FAIL() << "expected InputError";
+    } catch (const lc::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find(missing.string()), std::string::npos) << e.what();
+    }
+    const fs::path text = dir_ / "text.exr";
+    std::ofstream(text) << "this is not an OpenEXR file\n";
+    EXPECT_THROW(lc::read_exr(text), lc::InputError);
+}
+
+TEST_F(ImageFiles, PngHasTheRightSizeAndPixels) {
+    const std::uint32_t w = 7, h = 3;
+    std::vector<std::uint8_t> rgb(w * h * 3);
+    for (std::size_t i = 0; i < rgb.size(); ++i) rgb[i] = std::uint8_t(i * 11);
+    const fs::path file = dir_ / "bytes.png";
+    lc::write_png_rgb8(file, w, h, rgb);
+    const Png png = read_png(file);
+    ASSERT_EQ(png.width, int(w));
+    ASSERT_EQ(png.height, int(h));
+    EXPECT_EQ(png.channels, 3);
+    EXPECT_EQ(png.rgb, rgb);
+    EXPECT_EQ(entries(), std::set<std::string>{"bytes.png"});
+    EXPECT_THROW(lc::write_png_rgb8(dir_ / "short.png", w, h, std::vector<std::uint8_t>(5)), std::invalid_argument);
+}
+
+TEST_F(ImageFiles, TonemappedPngAppliesExposureAndSrgb) {
+    lc::Image image = gray(4, 2, 0.25f);
+    image.set(1, 0, {std::numeric_limits<float>::quiet_NaN(), -1.0f, 100.0f});
+    const fs::path file = dir_ / "tone.png";
+    lc::write_png_tonemapped(file, image, 2.0f);  // 0.25 * 2 = 0.5 linear
+    const Png png = read_png(file);
+    ASSERT_EQ(png.width, 4);
+    ASSERT_EQ(png.height, 2);
+    EXPECT_EQ(png.at(0, 0)[0], 188);  // sRGB(0.5) = 0.7354 -> 187.5 -> 188
+    EXPECT_EQ(png.at(1, 0)[0], 0);    // NaN -> black
+    EXPECT_EQ(png.at(1, 0)[1], 0);    // negative clamps
+    EXPECT_EQ(png.at(1, 0)[2], 255);  // over-exposed clamps
+
+    // Auto exposure maps the 99th percentile luminance to white.
+    lc::write_png_tonemapped(file, gray(10, 10, 40.0f));
+    EXPECT_EQ(read_png(file).at(3, 3)[1], 255);
+    lc::write_png_tonemapped(file, gray(3, 3, 0.0f));  // all black: exposure 1, no crash
+    EXPECT_EQ(read_png(file).at(1, 1)[0], 0);
+    EXPECT_EQ(entries(), std::set<std::string>{"tone.png"});
+}
+
+TEST_F(ImageFiles, WritingIntoAMissingFolderThrowsAndLeavesNothing) {
+    const fs::path missing = dir_ / "no_such_folder";
+    const lc::Image image = gray(2, 2, 1.0f);
+    for (const char* name : {"a.exr", "a.png"}) {
+        const fs::path file = missing / name;
+        try {
+            if (fs::path(name).extension() == ".exr")
+                lc::write_exr(file, image);
+            else
+                lc::write_png_tonemapped(file, image, 1.0f);
+            FAIL() << "expected std::runtime_error for " << file;
+        } catch (const std::runtime_error& e) {
+            EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_FALSE(fs::exists(missing));
+    EXPECT_TRUE(entries().empty());
+}
+
+TEST_F(ImageFiles, FailedRenameRemovesTheTemporary) {
+    // The target is a non-empty folder, so the final rename fails.
+    fs::create_directories(dir_ / "taken.exr" / "inside");
+    EXPECT_THROW(lc::write_exr(dir_ / "taken.exr", gray(2, 2, 1.0f)), std::runtime_error);
+    EXPECT_EQ(entries(), std::set<std::string>{"taken.exr"});
+}
+
+TEST(CompareImages, IdenticalImagesHaveZeroError) {
+    lc::Image a(5, 4);
+    for (std::size_t i = 0; i < a.rgb.size(); ++i) a.rgb[i] = float(i % 7) * 0.3f;
+    const lc::CompareResult r = lc::compare_images(a, a);
+    EXPECT_EQ(r.relative_rmse, 0.0);
+    EXPECT_EQ(r.fraction_above_1pct, 0.0);
+    EXPECT_EQ(r.fraction_above_2pct, 0.0);
+    EXPECT_EQ(r.fraction_above_5pct, 0.0);
+    EXPECT_EQ(r.max_relative_error, 0.0);
+    ASSERT_EQ(r.per_pixel.size(), 20u);
+    for (float e : r.per_pixel) EXPECT_EQ(e, 0.0f);
+}
+
+TEST(CompareImages, KnownErrorsGiveKnownMetrics) {
+    // 20 grey pixels of 2.0; three are off by 25%, 3.125% and 1.5625%
+    // (all exact in binary).
+    const lc::Image reference = gray(5, 4, 2.0f);
+    lc::Image image = reference;
+    image.set(1, 1, glm::vec3(2.5f));
+    image.set(4, 2, glm::vec3(2.0625f));
+    image.set(0, 3, glm::vec3(2.03125f));
+    const lc::CompareResult r = lc::compare_images(image, reference);
+    EXPECT_DOUBLE_EQ(r.fraction_above_1pct, 3.0 / 20.0);
+    EXPECT_DOUBLE_EQ(r.fraction_above_2pct, 2.0 / 20.0);
+    EXPECT_DOUBLE_EQ(r.fraction_above_5pct, 1.0 / 20.0);
+    EXPECT_NEAR(r.max_relative_error, 0.25, 1e-12);
+    EXPECT_NEAR(r.per_pixel[1 * 5 + 1], 0.25f, 1e-6f);
+    EXPECT_NEAR(r.per_pixel[2 * 5 + 4], 0.03125f, 1e-7f);
+    const double sum_d2 = 3.0 * (0.5 * 0.5 + 0.0625 * 0.0625 + 0.03125 * 0.03125);
+    const double sum_r2 = 60.0 * 4.0;
+    EXPECT_NEAR(r.relative_rmse, std::sqrt(sum_d2 / sum_r2), 1e-15);
+}
+
+TEST(CompareImages, DarkReferencePixelsUseTheMeanFloor) {
+    // Reference: 3 pixels of luminance 1 and one black; mean Y = 0.75.
+    lc::Image reference = gray(2, 2, 1.0f);
+    reference.set(1, 1, glm::vec3(0.0f));
+    lc::Image image = reference;
+    image.set(1, 1, glm::vec3(0.0015f));
+    const lc::CompareResult r = lc::compare_images(image, reference);
+    EXPECT_NEAR(r.per_pixel[3], 0.0015 / (1e-3 * 0.75), 1e-5);
+    EXPECT_DOUBLE_EQ(r.fraction_above_5pct, 0.25);
+}
+
+TEST(CompareImages, ZeroAndNonFiniteImagesDoNotCrash) {
+    const lc::Image black = gray(3, 2, 0.0f);
+    EXPECT_EQ(lc::compare_images(black, black).relative_rmse, 0.0);
+    const lc::CompareResult lit = lc::compare_images(gray(3, 2, 1.0f), black);
+    EXPECT_TRUE(std::isinf(lit.relative_rmse));
+    EXPECT_DOUBLE_EQ(lit.fraction_above_5pct, 1.0);
+    EXPECT_FALSE(std::isnan(lit.max_relative_error));
+
+    lc::Image with_nan = gray(3, 2, 1.0f);
+    with_nan.set(2, 1, {std::numeric_limits<float>::quiet_NaN(), 1.0f, 1.0f});
+    const lc::CompareResult r = lc::compare_images(with_nan, gray(3, 2, 1.0f));
+    EXPECT_TRUE(std::isnan(r.relative_rmse));
+    EXPECT_TRUE(std::isnan(r.max_relative_error));
+    EXPECT_DOUBLE_EQ(r.fraction_above_1pct, 1.0 / 6.0);  // the NaN pixel counts as wrong
+
+    lc::Image with_inf = gray(3, 2, 1.0f);
+    with_inf.set(0, 0, glm::vec3(std::numeric_limits<float>::infinity()));
+    EXPECT_TRUE(std::isinf(lc::compare_images(with_inf, gray(3, 2, 1.0f)).relative_rmse));
+}
+
+TEST(CompareImages, SizeMismatchThrows) {
+    EXPECT_THROW(lc::compare_images(gray(3, 2, 1.0f), gray(2, 3, 1.0f)), std::invalid_argument);
+}
+
+TEST_F(ImageFiles, HeatmapOnSmallAndWideImages) {
+    for (std::uint32_t w : {1u, 16u, 400u}) {
+        const std::uint32_t h = 4;
+        std::vector<float> values(std::size_t(w) * h);
+        for (std::size_t i = 0; i < values.size(); ++i) values[i] = 0.1f * float(i % w) / float(w);
+        values[0] = 0.0f;
+        values.back() = 7.0f;  // above max: clamped
+        const fs::path file = dir_ / ("heat" + std::to_string(w) + ".png");
+        lc::write_heatmap_png(file, w, h, values, 0.1f);
+        const Png png = read_png(file);
+        ASSERT_EQ(png.width, int(w));
+        ASSERT_GT(png.height, int(h));  // legend below
+        EXPECT_EQ(png.at(0, 0), (std::array<std::uint8_t, 3>{68, 1, 84}));                    // ramp(0)
+        EXPECT_EQ(png.at(int(w) - 1, int(h) - 1), (std::array<std::uint8_t, 3>{253, 231, 37}));  // ramp(1)
+    }
+    // The wide legend has room for its labels: some light ink below the bar.
+    const Png wide = read_png(dir_ / "heat400.png");
+    int ink = 0;
+    for (int y = 4; y < wide.height; ++y)
+        for (int x = 0; x < wide.width; ++x) ink += wide.at(x, y) == std::array<std::uint8_t, 3>{235, 235, 235};
+    EXPECT_GT(ink, 20);
+    EXPECT_EQ(entries().size(), 3u);
+    EXPECT_THROW(lc::write_heatmap_png(dir_ / "bad.png", 4, 4, std::vector<float>(3), 1.0f), std::invalid_argument);
+}
