@@ -133,12 +133,20 @@ std::uint32_t cluster_fast(std::vector<Cluster>& all, std::vector<std::uint32_t>
                 for (std::size_t j = jb; j < je; ++j) {
                     if (j == i) continue;
                     float cost = merge_cost(all[active[i]], all[active[j]]);
-                    // Ties go to the nearer index, then the lower one, so the
-                    // globally cheapest pair is always mutual and rounds progress.
+                    // Ties go to the nearer index; between i - d and i + d to
+                    // the right when i / d is even, else the left. Any choice
+                    // at equal distance keeps the globally cheapest pair at the
+                    // smallest distance mutual, so rounds progress; alternating
+                    // sides makes a run of equal costs pair up as (0,1), (2,3),
+                    // ... Always taking the lower index merged one pair per round
+                    // when every cost is equal, which they are for coincident or
+                    // black lights (cost 0): O(n^2) rounds' work and a tree as
+                    // deep as n (8000 coincident lights took 5 s).
                     std::size_t dist = j > i ? j - i : i - j;
                     std::size_t best_dist = best_j > i ? best_j - i : i - best_j;
+                    const bool prefer_right = (i / dist) % 2 == 0;
                     if (cost < best_cost || (cost == best_cost && (dist < best_dist ||
-                                                                  (dist == best_dist && j < best_j)))) {
+                                                                  (dist == best_dist && (j > i) == prefer_right)))) {
                         best_cost = cost;
                         best_j = j;
                     }

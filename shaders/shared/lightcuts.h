@@ -133,11 +133,15 @@ void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, uint light_typ
 // cluster with the largest error bound by its children while that bound
 // exceeds relative_error times the current estimate (both as luminance) and
 // the cut is smaller than max_cut.
-vec3 lc_shade_lightcuts(SurfacePoint sp, FrameParams f, LC_INOUT(ShadeStats) stats) {
-    Material m = LC_MATERIAL(sp.material);
-    uint heap_size = 0u;
-    vec3 leaf_sum = vec3(0.0f);
-    vec3 heap_sum = vec3(0.0f);
+//
+// In three steps (start, one refinement, result) so that the GPU can spread
+// a long refinement over several dispatches; lc_shade_lightcuts runs them
+// back to back.
+void lc_cut_start(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_size,
+                  LC_OUT(vec3) leaf_sum, LC_OUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
+    heap_size = 0u;
+    leaf_sum = vec3(0.0f);
+    heap_sum = vec3(0.0f);
     stats.cut_size = 0u;
     uint root_count = 0u;
     if (f.root_point != kInvalidIndex) {
@@ -151,32 +155,52 @@ vec3 lc_shade_lightcuts(SurfacePoint sp, FrameParams f, LC_INOUT(ShadeStats) sta
         root_count += 1u;
     }
     stats.cut_size = root_count;
-    while (heap_size > 0u) {
-        CutEntry top = LC_HEAP_LOAD(0u);
-        float estimate = lc_luminance(leaf_sum + heap_sum);
-        if (!(top.error > f.relative_error * estimate)) break;
-        if (stats.cut_size >= f.max_cut) {
-            stats.hit_max_cut = 1u;
-            break;
-        }
-        lc_heap_pop(heap_size);
-        LightNode node = LC_LIGHT_NODE(top.node);
-        vec3 unit = vec3(top.unit_r, top.unit_g, top.unit_b);
-        heap_sum -= unit * lc_node_intensity(node);
-        uint light_type = top.node >= f.root_directional ? kLightDirectional : kLightPoint;
-        bool right_shares = (node.flags & kNodeRepFromRight) != 0u;
-        lc_add_cluster(sp, m, node.left, light_type, !right_shares, unit, f.min_distance2,
-                       heap_size, leaf_sum, heap_sum, stats);
-        lc_add_cluster(sp, m, node.left + 1u, light_type, right_shares, unit, f.min_distance2,
-                       heap_size, leaf_sum, heap_sum, stats);
-        stats.cut_size += 1u;
+}
+
+// Refines the cluster with the largest bound; false (cut unchanged) once the
+// cut is final.
+bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) heap_size,
+                   LC_INOUT(vec3) leaf_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
+    if (heap_size == 0u) return false;
+    CutEntry top = LC_HEAP_LOAD(0u);
+    float estimate = lc_luminance(leaf_sum + heap_sum);
+    if (!(top.error > f.relative_error * estimate)) return false;
+    if (stats.cut_size >= f.max_cut) {
+        stats.hit_max_cut = 1u;
+        return false;
     }
-    // The running heap_sum drifts by the additions and subtractions above;
-    // the result is summed afresh from the final cut.
+    lc_heap_pop(heap_size);
+    LightNode node = LC_LIGHT_NODE(top.node);
+    vec3 unit = vec3(top.unit_r, top.unit_g, top.unit_b);
+    heap_sum -= unit * lc_node_intensity(node);
+    uint light_type = top.node >= f.root_directional ? kLightDirectional : kLightPoint;
+    bool right_shares = (node.flags & kNodeRepFromRight) != 0u;
+    lc_add_cluster(sp, m, node.left, light_type, !right_shares, unit, f.min_distance2,
+                   heap_size, leaf_sum, heap_sum, stats);
+    lc_add_cluster(sp, m, node.left + 1u, light_type, right_shares, unit, f.min_distance2,
+                   heap_size, leaf_sum, heap_sum, stats);
+    stats.cut_size += 1u;
+    return true;
+}
+
+// The running heap_sum drifts by the additions and subtractions of the
+// refinements; the result is summed afresh from the final cut.
+vec3 lc_cut_result(uint heap_size, vec3 leaf_sum) {
     vec3 result = leaf_sum;
     for (uint i = 0u; i < heap_size; ++i) {
         CutEntry e = LC_HEAP_LOAD(i);
         result += vec3(e.unit_r, e.unit_g, e.unit_b) * lc_node_intensity(LC_LIGHT_NODE(e.node));
     }
     return result;
+}
+
+vec3 lc_shade_lightcuts(SurfacePoint sp, FrameParams f, LC_INOUT(ShadeStats) stats) {
+    Material m = LC_MATERIAL(sp.material);
+    uint heap_size = 0u;
+    vec3 leaf_sum = vec3(0.0f);
+    vec3 heap_sum = vec3(0.0f);
+    lc_cut_start(sp, m, f, heap_size, leaf_sum, heap_sum, stats);
+    while (lc_cut_refine(sp, m, f, heap_size, leaf_sum, heap_sum, stats)) {
+    }
+    return lc_cut_result(heap_size, leaf_sum);
 }

@@ -17,6 +17,8 @@ LC_KCONST float kPi = 3.14159265358979f;
 // bound is never below the value it bounds by an ulp.
 LC_KCONST float kBoundSlack = 1.0f + 1e-5f;
 LC_KCONST float kCosineAbsSlack = 1e-6f;
+// Shaded points leave their triangle by this times its largest coordinate.
+LC_KCONST float kHitOffsetRelative = 1.0f / 1048576.0f;
 
 // --- Random numbers for pixel jitter: PCG hash, identical on CPU and GPU.
 uint lc_hash(uint v) {
@@ -76,8 +78,17 @@ SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) 
     // Two-sided surfaces: both normals turn to the side the ray came from.
     if (dot(ng, ray_dir) > 0.0f) ng = -ng;
     if (dot(ns, ng) < 0.0f) ns = -ns;
+    // Off the surface along ng by 2^-20 of the triangle's largest coordinate
+    // (8 to 16 of its ulps). The barycentric point is off the plane by a few
+    // ulps of that coordinate, and the shadow ray's triangle test errs by as
+    // much, so this clears the surface at any scale and any distance from
+    // the origin. lc_offset_ray_origin's 256 ulps of p, or 1.5e-5 absolute
+    // near the origin, assume p = org + t * dir and unit-sized scenes: they
+    // moved points by 2 units at 1e5 and by 7% of a room scaled to 1e-4
+    // (tests/stress, Transformed.*).
+    vec3 m = max(max(abs(v0), abs(v1)), abs(v2));
     SurfacePoint sp;
-    sp.p = lc_offset_ray_origin(p, ng);
+    sp.p = p + ng * (kHitOffsetRelative * max(max(m.x, m.y), m.z));
     sp.n = ns;
     sp.wo = -ray_dir;
     sp.material = tri.material;
@@ -177,8 +188,14 @@ float lc_min_abs_on_interval(float centre, float half_width) {
 // surface. (The seed report rotated a world-space box by a single angle,
 // which is not conservative.)
 float lc_cosine_bound(vec3 box_min, vec3 box_max, vec3 x, vec3 n) {
-    vec3 c = 0.5f * (box_min + box_max) - x;
-    vec3 e = 0.5f * (box_max - box_min);
+    // The box relative to x first: the centre 0.5 * (box_min + box_max)
+    // rounds at the box's magnitude (0.008 at 1e5), which shifted the box by
+    // far more than the slack below and broke the bound by 0.3% far from
+    // the origin (tests/stress, Transformed.*); box - x is exact there.
+    vec3 lo = box_min - x;
+    vec3 hi = box_max - x;
+    vec3 c = 0.5f * (lo + hi);
+    vec3 e = 0.5f * (hi - lo);
     // Near the tangent plane cos is tiny and the rounding of the exact term
     // is absolute, not relative: widen z_max by a few ulps of the magnitudes
     // it was computed from.
@@ -208,7 +225,7 @@ float lc_box_distance2(vec3 box_min, vec3 box_max, vec3 x) {
 float lc_ggx_bound(Material m, vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec3 wo) {
     float cos_o = dot(n, wo);
     if (cos_o <= 0.0f) return 0.0f;
-    vec3 c = 0.5f * (box_min + box_max) - x;
+    vec3 c = 0.5f * ((box_min - x) + (box_max - x));  // see lc_cosine_bound
     float radius = 0.5f * length(box_max - box_min);
     float dist = length(c);
     float cos_h_max = 1.0f;

@@ -1,0 +1,314 @@
+#include "vk_context.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <cstring>
+#include <stdexcept>
+
+#include "vk_check.h"
+#include "vulkan_renderer.h"
+
+namespace lc::vk {
+
+namespace {
+
+std::atomic<std::uint64_t> g_message_total{0};
+
+constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
+
+VKAPI_ATTR VkBool32 VKAPI_CALL on_debug_message(
+    VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT /*types*/,
+    const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+    std::string text = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error: "
+                                                                                 : "warning: ";
+    if (data->pMessageIdName) text += std::string(data->pMessageIdName) + ": ";
+    text += data->pMessage ? data->pMessage : "(no text)";
+    static_cast<MessageLog*>(user)->add(std::move(text));
+    g_message_total.fetch_add(1, std::memory_order_relaxed);
+    return VK_FALSE;  // never abort the call that triggered it
+}
+
+VkDebugUtilsMessengerCreateInfoEXT messenger_info(MessageLog* log) {
+    auto info = vk_struct<VkDebugUtilsMessengerCreateInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT);
+    info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                           VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    info.pfnUserCallback = on_debug_message;
+    info.pUserData = log;
+    return info;
+}
+
+bool has_layer(const char* name) {
+    std::uint32_t count = 0;
+    VK_CHECK(vkEnumerateInstanceLayerProperties(&count, nullptr));
+    std::vector<VkLayerProperties> layers(count);
+    VK_CHECK(vkEnumerateInstanceLayerProperties(&count, layers.data()));
+    return std::any_of(layers.begin(), layers.end(),
+                       [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, name) == 0; });
+}
+
+bool has_instance_extension(const char* name, const char* layer = nullptr) {
+    std::uint32_t count = 0;
+    VK_CHECK(vkEnumerateInstanceExtensionProperties(layer, &count, nullptr));
+    std::vector<VkExtensionProperties> extensions(count);
+    VK_CHECK(vkEnumerateInstanceExtensionProperties(layer, &count, extensions.data()));
+    return std::any_of(extensions.begin(), extensions.end(), [&](const VkExtensionProperties& e) {
+        return std::strcmp(e.extensionName, name) == 0;
+    });
+}
+
+// The instance, with validation and the messenger's create-info chained so
+// that messages from vkCreateInstance/vkDestroyInstance are caught too.
+Instance create_instance(bool validation, MessageLog* log, bool& debug_utils) {
+    load_vulkan_loader();
+    auto app = vk_struct<VkApplicationInfo>(VK_STRUCTURE_TYPE_APPLICATION_INFO);
+    app.pApplicationName = "lightcuts";
+    app.pEngineName = "lightcuts";
+    app.apiVersion = VK_API_VERSION_1_2;
+
+    std::vector<const char*> extensions;
+    std::vector<const char*> layers;
+    auto info = vk_struct<VkInstanceCreateInfo>(VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO);
+    debug_utils = has_instance_extension(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    if (debug_utils) extensions.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+    // Lets the loader report devices that are not fully conformant (MoltenVK).
+    if (has_instance_extension(VK_KHR_PORTABILITY_ENUMERATION_EXTENSION_NAME)) {
+        extensions.push_back(VK_KHR_PORTABILITY_ENUMERATION_EXTENSION_NAME);
+        info.flags |= VK_INSTANCE_CREATE_ENUMERATE_PORTABILITY_BIT_KHR;
+    }
+
+    VkDebugUtilsMessengerCreateInfoEXT messenger = messenger_info(log);
+    VkValidationFeatureEnableEXT enables[] = {
+        VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+    auto features = vk_struct<VkValidationFeaturesEXT>(VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT);
+    features.enabledValidationFeatureCount = 1;
+    features.pEnabledValidationFeatures = enables;
+    if (validation) {
+        if (!has_layer(kValidationLayer))
+            throw std::runtime_error(std::string("Vulkan validation requested but ") +
+                                     kValidationLayer + " is not installed");
+        if (!debug_utils)
+            throw std::runtime_error("Vulkan validation requested but " +
+                                     std::string(VK_EXT_DEBUG_UTILS_EXTENSION_NAME) +
+                                     " is missing, so its messages cannot be collected");
+        layers.push_back(kValidationLayer);
+        info.pNext = &messenger;
+        if (has_instance_extension(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME, kValidationLayer)) {
+            extensions.push_back(VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME);
+            messenger.pNext = &features;
+        }
+    }
+    info.pApplicationInfo = &app;
+    info.enabledExtensionCount = static_cast<std::uint32_t>(extensions.size());
+    info.ppEnabledExtensionNames = extensions.data();
+    info.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
+    info.ppEnabledLayerNames = layers.data();
+
+    VkInstance instance = VK_NULL_HANDLE;
+    VkResult result = vkCreateInstance(&info, nullptr, &instance);
+    if (result == VK_ERROR_INCOMPATIBLE_DRIVER)
+        throw std::runtime_error(
+            "no Vulkan device: the Vulkan loader found no driver (vkCreateInstance returned "
+            "VK_ERROR_INCOMPATIBLE_DRIVER)");
+    VK_CHECK(result);
+    volkLoadInstanceOnly(instance);
+    return Instance(instance, {});
+}
+
+std::vector<PhysicalDeviceInfo> physical_devices(VkInstance instance) {
+    std::uint32_t count = 0;
+    VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
+    std::vector<VkPhysicalDevice> handles(count);
+    VkResult result = vkEnumeratePhysicalDevices(instance, &count, handles.data());
+    if (result != VK_INCOMPLETE) VK_CHECK(result);
+    handles.resize(count);
+
+    std::vector<PhysicalDeviceInfo> devices;
+    for (VkPhysicalDevice handle : handles) {
+        PhysicalDeviceInfo d;
+        d.handle = handle;
+        vkGetPhysicalDeviceProperties(handle, &d.properties);
+        std::uint32_t family_count = 0;
+        vkGetPhysicalDeviceQueueFamilyProperties(handle, &family_count, nullptr);
+        std::vector<VkQueueFamilyProperties> families(family_count);
+        vkGetPhysicalDeviceQueueFamilyProperties(handle, &family_count, families.data());
+        // Prefer a compute family with timestamps, so stage timings exist.
+        for (std::uint32_t f = 0; f < family_count; ++f) {
+            if ((families[f].queueFlags & VK_QUEUE_COMPUTE_BIT) == 0) continue;
+            if (d.compute_family == UINT32_MAX ||
+                (families[d.compute_family].timestampValidBits == 0 &&
+                 families[f].timestampValidBits > 0))
+                d.compute_family = f;
+        }
+        std::uint32_t api = d.properties.apiVersion;
+        if (VK_API_VERSION_MAJOR(api) == 1 && VK_API_VERSION_MINOR(api) < 2)
+            d.refusal = "supports Vulkan 1." + std::to_string(VK_API_VERSION_MINOR(api)) +
+                        ", needs 1.2";
+        else if (d.compute_family == UINT32_MAX)
+            d.refusal = "has no compute queue";
+        devices.push_back(std::move(d));
+    }
+    return devices;
+}
+
+// Lower is preferred: discrete, integrated, virtual, CPU, other.
+int type_rank(VkPhysicalDeviceType type) {
+    switch (type) {
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+        case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
+        default: return 4;
+    }
+}
+
+std::string lower(std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+bool is_index(const std::string& s) {
+    return !s.empty() && s.size() < 9 &&
+           std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+// Applies the user's choice (index or name substring) on top of the
+// capability refusals, then takes the best-ranked device left.
+PhysicalDeviceInfo choose_device(std::vector<PhysicalDeviceInfo> devices, const std::string& gpu) {
+    if (devices.empty())
+        throw std::runtime_error(
+            "no Vulkan device: the Vulkan loader reports no physical device (is a Vulkan driver "
+            "installed? VK_DRIVER_FILES / VK_ICD_FILENAMES select driver manifests)");
+    const bool by_index = is_index(gpu);
+    const std::string wanted = lower(gpu);
+    int best = -1;
+    for (std::size_t i = 0; i < devices.size(); ++i) {
+        PhysicalDeviceInfo& d = devices[i];
+        if (d.refusal.empty() && by_index && std::stoul(gpu) != i)
+            d.refusal = "is not device " + gpu;
+        else if (d.refusal.empty() && !by_index && !gpu.empty() &&
+                 lower(d.properties.deviceName).find(wanted) == std::string::npos)
+            d.refusal = "name does not contain '" + gpu + "'";
+        if (!d.refusal.empty()) continue;
+        if (best < 0 || type_rank(d.properties.deviceType) <
+                            type_rank(devices[static_cast<std::size_t>(best)].properties.deviceType))
+            best = static_cast<int>(i);
+    }
+    if (best >= 0) return devices[static_cast<std::size_t>(best)];
+
+    std::string message = gpu.empty() ? "no Vulkan device: none of the devices present is usable:"
+                                      : "no Vulkan device matches '" + gpu + "':";
+    for (std::size_t i = 0; i < devices.size(); ++i) {
+        const VkPhysicalDeviceProperties& p = devices[i].properties;
+        message += "\n  " + std::to_string(i) + ": " + p.deviceName + " (" +
+                   device_type_name(p.deviceType) + ", Vulkan " +
+                   std::to_string(VK_API_VERSION_MAJOR(p.apiVersion)) + "." +
+                   std::to_string(VK_API_VERSION_MINOR(p.apiVersion)) + "): " + devices[i].refusal;
+    }
+    throw std::runtime_error(message);
+}
+
+}  // namespace
+
+void MessageLog::add(std::string message) {
+    std::lock_guard lock(mutex_);
+    messages_.push_back(std::move(message));
+}
+
+std::vector<std::string> MessageLog::messages() const {
+    std::lock_guard lock(mutex_);
+    return messages_;
+}
+
+std::size_t MessageLog::count() const {
+    std::lock_guard lock(mutex_);
+    return messages_.size();
+}
+
+std::uint64_t validation_message_total() { return g_message_total.load(); }
+
+void load_vulkan_loader() {
+    // volk keeps the loader's entry points in globals; load them once.
+    static const VkResult result = volkInitialize();
+    if (result != VK_SUCCESS)
+        throw std::runtime_error(
+            "no Vulkan device: the Vulkan loader (libvulkan.so.1) could not be loaded");
+}
+
+const char* device_type_name(VkPhysicalDeviceType type) {
+    switch (type) {
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
+        case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU";
+        default: return "other";
+    }
+}
+
+Context::Context(const VulkanOptions& options, MessageLog* log) {
+    bool debug_utils = false;
+    instance_ = create_instance(options.validation, log, debug_utils);
+    if (options.validation) {
+        VkDebugUtilsMessengerCreateInfoEXT info = messenger_info(log);
+        VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+        VK_CHECK(vkCreateDebugUtilsMessengerEXT(instance_.get(), &info, nullptr, &messenger));
+        messenger_ = DebugMessenger(messenger, {instance_.get()});
+    }
+
+    physical_ = choose_device(physical_devices(instance_.get()), options.gpu);
+
+    auto maintenance3 = vk_struct<VkPhysicalDeviceMaintenance3Properties>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES);
+    auto properties2 =
+        vk_struct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
+    properties2.pNext = &maintenance3;
+    vkGetPhysicalDeviceProperties2(physical_.handle, &properties2);
+    max_allocation_size_ = maintenance3.maxMemoryAllocationSize;
+    vkGetPhysicalDeviceMemoryProperties(physical_.handle, &memory_);
+
+    std::uint32_t family_count = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(physical_.handle, &family_count, nullptr);
+    std::vector<VkQueueFamilyProperties> families(family_count);
+    vkGetPhysicalDeviceQueueFamilyProperties(physical_.handle, &family_count, families.data());
+    timestamp_valid_bits_ = families[physical_.compute_family].timestampValidBits;
+
+    // One compute queue; the kernels need no optional feature or extension.
+    const float priority = 1.0f;
+    auto queue_info = vk_struct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
+    queue_info.queueFamilyIndex = physical_.compute_family;
+    queue_info.queueCount = 1;
+    queue_info.pQueuePriorities = &priority;
+    auto device_info = vk_struct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
+    device_info.queueCreateInfoCount = 1;
+    device_info.pQueueCreateInfos = &queue_info;
+    VkDevice device = VK_NULL_HANDLE;
+    VK_CHECK(vkCreateDevice(physical_.handle, &device_info, nullptr, &device));
+    device_ = Device(device, debug_utils);
+    device_.set_name(device, std::string("lightcuts device: ") + physical_.properties.deviceName);
+
+    device_.fn().vkGetDeviceQueue(device, physical_.compute_family, 0, &queue_);
+    device_.set_name(queue_, "compute queue");
+}
+
+}  // namespace lc::vk
+
+namespace lc {
+
+std::vector<std::string> list_vulkan_devices() {
+    std::vector<std::string> names;
+    try {
+        vk::MessageLog log;
+        bool debug_utils = false;
+        vk::Instance instance = vk::create_instance(false, &log, debug_utils);
+        for (const vk::PhysicalDeviceInfo& d : vk::physical_devices(instance.get()))
+            names.emplace_back(d.properties.deviceName);
+    } catch (const std::runtime_error&) {
+        // No loader or no driver: no devices.
+    }
+    return names;
+}
+
+}  // namespace lc

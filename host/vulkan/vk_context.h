@@ -1,0 +1,75 @@
+// Headless Vulkan 1.2 setup: loader, instance, validation messages, choice
+// of the physical device, logical device with one compute queue.
+#pragma once
+
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "lightcuts/render.h"
+#include "vk_objects.h"
+
+namespace lc::vk {
+
+// Validation and loader messages of warning or error severity, collected by
+// the debug messenger (called from any driver thread).
+class MessageLog {
+public:
+    void add(std::string message);
+    std::vector<std::string> messages() const;
+    std::size_t count() const;
+
+private:
+    mutable std::mutex mutex_;
+    std::vector<std::string> messages_;
+};
+
+// One physical device as the loader reports it.
+struct PhysicalDeviceInfo {
+    VkPhysicalDevice handle = VK_NULL_HANDLE;
+    VkPhysicalDeviceProperties properties{};
+    std::uint32_t compute_family = UINT32_MAX;  // a queue family with compute
+    std::string refusal;                        // why it cannot run the kernels ("" if it can)
+};
+
+// Loads the loader once per process. Throws "no Vulkan device: ..." if
+// libvulkan cannot be loaded.
+void load_vulkan_loader();
+
+class Context {
+public:
+    // Picks the device per options.gpu (see VulkanOptions) and creates it.
+    // Throws std::runtime_error starting "no Vulkan device" when there is no
+    // loader, no device, or none that fits; the message lists the devices
+    // present and why each was refused.
+    Context(const VulkanOptions& options, MessageLog* log);
+
+    const Device& device() const { return device_; }
+    const VolkDeviceTable& fn() const { return device_.fn(); }
+    VkPhysicalDevice physical() const { return physical_.handle; }
+    const VkPhysicalDeviceProperties& properties() const { return physical_.properties; }
+    const VkPhysicalDeviceMemoryProperties& memory() const { return memory_; }
+    VkDeviceSize max_allocation_size() const { return max_allocation_size_; }
+    VkQueue queue() const { return queue_; }
+    std::uint32_t queue_family() const { return physical_.compute_family; }
+    // Nanoseconds per timestamp tick, and the valid bits (0: no timestamps).
+    double timestamp_period() const { return physical_.properties.limits.timestampPeriod; }
+    std::uint32_t timestamp_valid_bits() const { return timestamp_valid_bits_; }
+    std::string device_name() const { return physical_.properties.deviceName; }
+
+private:
+    // Member order is destruction order, reversed: device, messenger, instance.
+    Instance instance_;
+    DebugMessenger messenger_;
+    Device device_;
+    PhysicalDeviceInfo physical_;
+    VkPhysicalDeviceMemoryProperties memory_{};
+    VkDeviceSize max_allocation_size_ = 0;
+    VkQueue queue_ = VK_NULL_HANDLE;
+    std::uint32_t timestamp_valid_bits_ = 0;
+};
+
+const char* device_type_name(VkPhysicalDeviceType type);
+
+}  // namespace lc::vk

@@ -1,0 +1,108 @@
+#include "vk_objects.h"
+
+#include <stdexcept>
+
+#include "vk_check.h"
+
+namespace lc::vk {
+
+Device::Device(VkDevice device, bool debug_utils)
+    : device_(device), table_(std::make_unique<VolkDeviceTable>()), debug_utils_(debug_utils) {
+    volkLoadDeviceTable(table_.get(), device_);
+}
+
+Device::Device(Device&& other) noexcept
+    : device_(std::exchange(other.device_, VK_NULL_HANDLE)),
+      table_(std::move(other.table_)),
+      debug_utils_(other.debug_utils_) {}
+
+Device& Device::operator=(Device&& other) noexcept {
+    if (this != &other) {
+        reset();
+        device_ = std::exchange(other.device_, VK_NULL_HANDLE);
+        table_ = std::move(other.table_);
+        debug_utils_ = other.debug_utils_;
+    }
+    return *this;
+}
+
+void Device::reset() {
+    if (device_ != VK_NULL_HANDLE) table_->vkDestroyDevice(device_, nullptr);
+    device_ = VK_NULL_HANDLE;
+}
+
+void Device::set_name(VkObjectType type, std::uint64_t handle, const std::string& name) const {
+    if (!debug_utils_ || vkSetDebugUtilsObjectNameEXT == nullptr) return;
+    auto info = vk_struct<VkDebugUtilsObjectNameInfoEXT>(VK_STRUCTURE_TYPE_DEBUG_UTILS_OBJECT_NAME_INFO_EXT);
+    info.objectType = type;
+    info.objectHandle = handle;
+    info.pObjectName = name.c_str();
+    VK_CHECK(vkSetDebugUtilsObjectNameEXT(device_, &info));
+}
+
+namespace {
+
+// First memory type allowed by `type_bits` with all `required` flags,
+// preferring one that also has all `preferred` flags.
+std::uint32_t find_memory_type(const VkPhysicalDeviceMemoryProperties& memory,
+                               std::uint32_t type_bits, VkMemoryPropertyFlags required,
+                               VkMemoryPropertyFlags preferred) {
+    std::uint32_t fallback = UINT32_MAX;
+    for (std::uint32_t i = 0; i < memory.memoryTypeCount; ++i) {
+        if ((type_bits & (1u << i)) == 0) continue;
+        VkMemoryPropertyFlags flags = memory.memoryTypes[i].propertyFlags;
+        if ((flags & required) != required) continue;
+        if ((flags & preferred) == preferred) return i;
+        if (fallback == UINT32_MAX) fallback = i;
+    }
+    return fallback;
+}
+
+}  // namespace
+
+Buffer::Buffer(const Device& device, const VkPhysicalDeviceMemoryProperties& memory,
+               VkDeviceSize size, VkBufferUsageFlags usage, MemoryUse use, const std::string& name)
+    : size_(size), name_(name) {
+    const VolkDeviceTable& vkd = device.fn();
+    auto buffer_info = vk_struct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
+    buffer_info.size = size;
+    buffer_info.usage = usage;
+    buffer_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VK_CHECK(vkd.vkCreateBuffer(device.get(), &buffer_info, nullptr, &buffer));
+    buffer_ = own<VkBufferHandle>(device, buffer, name);
+
+    VkMemoryRequirements requirements;
+    vkd.vkGetBufferMemoryRequirements(device.get(), buffer, &requirements);
+    VkMemoryPropertyFlags required = 0, preferred = 0;
+    switch (use) {
+        case MemoryUse::kDevice:
+            preferred = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT;
+            break;
+        case MemoryUse::kUpload:
+            required = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+            break;
+        case MemoryUse::kReadback:
+            required = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+            preferred = VK_MEMORY_PROPERTY_HOST_CACHED_BIT;
+            break;
+    }
+    std::uint32_t type = find_memory_type(memory, requirements.memoryTypeBits, required, preferred);
+    if (type == UINT32_MAX)
+        throw std::runtime_error("no Vulkan memory type fits buffer '" + name + "'");
+
+    auto alloc_info = vk_struct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
+    alloc_info.allocationSize = requirements.size;
+    alloc_info.memoryTypeIndex = type;
+    VkDeviceMemory allocation = VK_NULL_HANDLE;
+    VK_CHECK(vkd.vkAllocateMemory(device.get(), &alloc_info, nullptr, &allocation));
+    memory_ = own<DeviceMemory>(device, allocation, name + " memory");
+    VK_CHECK(vkd.vkBindBufferMemory(device.get(), buffer, allocation, 0));
+
+    constexpr VkMemoryPropertyFlags kMappable =
+        VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+    if ((memory.memoryTypes[type].propertyFlags & kMappable) == kMappable)
+        VK_CHECK(vkd.vkMapMemory(device.get(), allocation, 0, VK_WHOLE_SIZE, 0, &mapped_));
+}
+
+}  // namespace lc::vk

@@ -1,0 +1,39 @@
+// Knobs of the Vulkan renderer that the public VulkanOptions do not expose:
+// used by the tests and benchmarks, and settable from the environment.
+#pragma once
+
+#include <cstdint>
+
+#include "lightcuts/render.h"
+
+namespace lc::vk {
+
+struct Tuning {
+    // Compile every kernel feature in (GGX, shadow rays) whatever the scene
+    // needs, to measure what the specialization constants save.
+    bool all_features = false;
+    // Largest tile, in pixels (0: limited only by the buffer limits).
+    std::uint32_t max_tile_pixels = 0;
+    // Tiles are resized so one dispatch takes about this long.
+    double target_dispatch_ms = 30.0;
+    // Split the work of each pixel from the start, as is otherwise done only
+    // where the driver cuts long loops short (0: no split): brute force over
+    // at most this many lights per dispatch, Lightcuts with at most this many
+    // refinements per dispatch.
+    std::uint32_t lights_per_dispatch = 0;
+    std::uint32_t refinements_per_dispatch = 0;
+
+    // LC_VK_ALL_FEATURES=1, LC_VK_MAX_TILE_PIXELS=N, LC_VK_TARGET_MS=X,
+    // LC_VK_LIGHTS_PER_DISPATCH=N, LC_VK_REFINEMENTS_PER_DISPATCH=N.
+    static Tuning from_environment();
+};
+
+// render_vulkan(prepared, options, vulkan) is this with Tuning::from_environment().
+RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& options,
+                           const VulkanOptions& vulkan, const Tuning& tuning);
+
+// Warning/error messages the validation layer (or loader) has reported to
+// any render of this process so far; tests check it stays unchanged.
+std::uint64_t validation_message_total();
+
+}  // namespace lc::vk

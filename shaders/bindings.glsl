@@ -1,0 +1,91 @@
+// The Vulkan kernels' interface: descriptor bindings, specialization
+// constant ids, workgroup size and the per-pixel statistics record.
+//
+// Compiles as GLSL (included by the kernels) and as C++ (included by
+// host/vulkan), in the same way as shared/types.h, so the host sizes its
+// dispatches and buffers from these constants.
+#ifndef LC_BINDINGS_GLSL
+#define LC_BINDINGS_GLSL
+
+#include "shared/types.h"
+
+#ifdef __cplusplus
+namespace lc::gpu {
+#endif
+
+// Invocations per workgroup (1D; one invocation per pixel of the tile).
+LC_CONST uint kWorkgroupSize = 64u;
+
+// Descriptor set 0, one storage buffer per binding.
+LC_CONST uint kBindingBvhNodes = 0u;
+LC_CONST uint kBindingTriangles = 1u;
+LC_CONST uint kBindingNormals = 2u;
+LC_CONST uint kBindingMaterials = 3u;
+LC_CONST uint kBindingLights = 4u;        // leaf order of the light tree
+LC_CONST uint kBindingLightNodes = 5u;
+LC_CONST uint kBindingGBuffer = 6u;       // GBufferTexel per tile pixel
+LC_CONST uint kBindingRadiance = 7u;      // 3 floats per tile pixel, summed over samples
+LC_CONST uint kBindingPixelStats = 8u;    // PixelStats per tile pixel, summed over samples
+LC_CONST uint kBindingHeapSpill = 9u;     // CutEntry slots of every invocation (see heap.glsl)
+LC_CONST uint kBindingCutState = 10u;     // CutState per tile pixel, between Lightcuts dispatches
+LC_CONST uint kBindingCount = 11u;
+
+// Specialization constant ids.
+LC_CONST uint kSpecWorkgroupSize = 0u;    // local_size_x
+LC_CONST uint kSpecEnableGgx = 1u;        // any material has a GGX lobe
+LC_CONST uint kSpecEnableShadows = 2u;    // any triangle can block a light
+LC_CONST uint kSpecHeapShared = 3u;       // K: cut-heap slots per invocation in shared memory
+LC_CONST uint kSpecHeapCapacity = 4u;     // all cut-heap slots per invocation, max(max_cut, 2)
+LC_CONST uint kSpecSpillStride = 5u;      // invocations the spill buffer is laid out for
+
+// PixelStats.flags
+LC_CONST uint kPixelHeapOverflow = 1u;  // a heap outgrew its capacity (a bug: cannot happen
+                                        // while cuts stay within max(max_cut, 2) clusters)
+LC_CONST uint kPixelLoopLimit = 2u;     // the driver cut the invocation's loops short
+LC_CONST uint kPixelCutUnfinished = 4u; // refinement went on past the pass's last dispatch (a bug)
+
+// Per tile pixel, summed over the samples of the pixel (32 bytes).
+struct PixelStats {
+    uint cut_size_sum;      // lightcuts: clusters in the final cuts
+    uint shadow_rays;
+    uint max_cut_samples;   // samples whose refinement stopped at max_cut
+    uint spill_samples;     // samples whose heap grew past kHeapShared slots
+    uint flags;             // kPixel* bits, or-ed over samples
+    uint pad0, pad1, pad2;
+};
+
+// A Lightcuts cut in the making, kept in global memory between the
+// dispatches of one sample when the refinement is spread over several
+// (48 bytes). The heap slots themselves stay in the spill buffer.
+LC_CONST uint kCutDone = 1u;       // result added to the pixel; later dispatches skip it
+LC_CONST uint kCutSpilled = 2u;    // the heap went past kHeapShared slots
+struct CutState {
+    uint heap_size;
+    uint cut_size;
+    uint shadow_rays;
+    uint flags;                    // kCut* bits
+    float leaf_r, leaf_g, leaf_b;
+    float heap_r, heap_g, heap_b;
+    uint pad0, pad1;
+};
+
+// PushConstants.cut_flags
+LC_CONST uint kCutFirstDispatch = 1u;  // start the cut from the roots
+LC_CONST uint kCutLastDispatch = 2u;   // every cut must be final by the end of this one
+LC_CONST uint kUnlimitedRefinements = 0xFFFFFFFFu;
+
+// Push constants of every kernel (124 bytes, within the 128 every device offers).
+LC_CONST uint kPushLightFirstOffset = 112u;
+LC_CONST uint kPushCutFlagsOffset = 116u;
+LC_CONST uint kPushRefineBudgetOffset = 120u;
+struct PushConstants {
+    FrameParams frame;
+    uint light_first;       // brute force: first light of this dispatch's range
+    uint cut_flags;         // lightcuts: kCut*Dispatch bits
+    uint refine_budget;     // lightcuts: refinements per pixel in this dispatch
+};
+
+#ifdef __cplusplus
+}  // namespace lc::gpu
+#endif
+#endif

@@ -1,0 +1,79 @@
+// Common part of the compute kernels: buffers, frame constants, feature
+// switches, and the shared kernel headers compiled as GLSL over them.
+// Included once at the top of every *.comp file.
+#ifndef LC_KERNEL_GLSL
+#define LC_KERNEL_GLSL
+
+#include "bindings.glsl"
+
+layout(local_size_x_id = kSpecWorkgroupSize) in;
+
+// Switched off for scenes that do not need them, so the compiler drops the
+// GGX lobe and the shadow-ray traversal (shared/shading.h reads these).
+layout(constant_id = kSpecEnableGgx) const bool kEnableGgx = true;
+layout(constant_id = kSpecEnableShadows) const bool kEnableShadows = true;
+
+// PushConstants of bindings.glsl.
+layout(push_constant) uniform Push {
+    FrameParams frame;
+    layout(offset = kPushLightFirstOffset) uint light_first;
+    layout(offset = kPushCutFlagsOffset) uint cut_flags;
+    layout(offset = kPushRefineBudgetOffset) uint refine_budget;
+};
+
+layout(std430, binding = kBindingBvhNodes) readonly buffer BvhNodes { BvhNode bvh_nodes[]; };
+layout(std430, binding = kBindingTriangles) readonly buffer Triangles { Triangle triangles[]; };
+layout(std430, binding = kBindingNormals) readonly buffer Normals { TriangleNormals normals[]; };
+layout(std430, binding = kBindingMaterials) readonly buffer Materials { Material materials[]; };
+layout(std430, binding = kBindingLights) readonly buffer Lights { Light lights[]; };
+layout(std430, binding = kBindingLightNodes) readonly buffer LightNodes { LightNode light_nodes[]; };
+layout(std430, binding = kBindingGBuffer) buffer GBuffer { GBufferTexel gbuffer[]; };
+layout(std430, binding = kBindingRadiance) buffer Radiance { float radiance[]; };
+layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_stats[]; };
+
+#define LC_BVH_NODE(i) bvh_nodes[i]
+#define LC_TRIANGLE(i) triangles[i]
+#define LC_MATERIAL(i) materials[i]
+#define LC_NORMALS(i) normals[i]
+#define LC_LIGHT_NODE(i) light_nodes[i]
+// LC_LIGHT is defined by each kernel (brute force offsets it by light_first).
+
+#include "shared/glsl_compat.h"
+#include "shared/trace.h"
+#include "shared/shading.h"
+
+// Index of this invocation's pixel inside the tile, or kInvalidIndex for the
+// invocations of the last workgroup that lie past the tile.
+uint lc_tile_pixel() {
+    uint i = gl_GlobalInvocationID.x;
+    return i < frame.tile_width * frame.tile_height ? i : kInvalidIndex;
+}
+
+SurfacePoint lc_texel_surface(GBufferTexel g) {
+    SurfacePoint sp;
+    sp.p = vec3(g.px, g.py, g.pz);
+    sp.n = vec3(g.nx, g.ny, g.nz);
+    sp.wo = vec3(g.wo_x, g.wo_y, g.wo_z);
+    sp.material = g.material;
+    return sp;
+}
+
+// llvmpipe (lavapipe) ends every loop of a shader invocation for good once
+// the invocation has run 65535 loop iterations in all (gallivm's loop
+// limiter), silently truncating long brute-force sums and deep cuts. A loop
+// that must run spp + 1 >= 2 rounds, and does not, shows it happened.
+bool lc_loops_were_cut_short() {
+    uint rounds = 0u;
+    for (uint k = 0u; k <= frame.spp; ++k) rounds += 1u;
+    return rounds != frame.spp + 1u;
+}
+
+// Samples are summed in sample order, the way the CPU reference sums them;
+// the host divides by spp.
+void lc_accumulate(uint pixel, vec3 c) {
+    radiance[3u * pixel + 0u] += c.x;
+    radiance[3u * pixel + 1u] += c.y;
+    radiance[3u * pixel + 2u] += c.z;
+}
+
+#endif

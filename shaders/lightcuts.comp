@@ -1,0 +1,83 @@
+// Lightcuts (Walter et al. 2005, section 4): cut selection and shading at the
+// G-buffer point of every tile pixel; the result is added to the pixel's sum.
+//
+// One dispatch normally runs each cut from the roots to the end. Where the
+// driver limits how long an invocation may loop (lavapipe), the host gives
+// each dispatch a budget of refinements instead and dispatches until every
+// cut is final; a cut that is not final yet waits in CutState and the heap
+// buffer.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+
+#include "kernel.glsl"
+#include "heap.glsl"
+#define LC_LIGHT(i) lights[i]
+#include "shared/lightcuts.h"
+
+layout(std430, binding = kBindingCutState) buffer CutStates { CutState cut_states[]; };
+
+void main() {
+    uint i = lc_tile_pixel();
+    if (i == kInvalidIndex) return;
+    GBufferTexel g = gbuffer[i];
+    if (g.material == kInvalidIndex) return;  // the camera ray left the scene: black
+    SurfacePoint sp = lc_texel_surface(g);
+    Material m = LC_MATERIAL(sp.material);
+
+    ShadeStats stats;
+    stats.cut_size = 0u;
+    stats.shadow_rays = 0u;
+    stats.hit_max_cut = 0u;
+    uint heap_size = 0u;
+    vec3 leaf_sum = vec3(0.0f);
+    vec3 heap_sum = vec3(0.0f);
+    if ((cut_flags & kCutFirstDispatch) != 0u) {
+        lc_cut_start(sp, m, frame, heap_size, leaf_sum, heap_sum, stats);
+    } else {
+        CutState s = cut_states[i];
+        if ((s.flags & kCutDone) != 0u) return;
+        heap_size = s.heap_size;
+        stats.cut_size = s.cut_size;
+        stats.shadow_rays = s.shadow_rays;
+        g_heap_spilled = (s.flags & kCutSpilled) != 0u;
+        leaf_sum = vec3(s.leaf_r, s.leaf_g, s.leaf_b);
+        heap_sum = vec3(s.heap_r, s.heap_g, s.heap_b);
+        lc_heap_restore(heap_size);
+    }
+
+    bool final_cut = false;
+    for (uint r = 0u; r < refine_budget && !final_cut; ++r)
+        final_cut = !lc_cut_refine(sp, m, frame, heap_size, leaf_sum, heap_sum, stats);
+    bool cut_short = lc_loops_were_cut_short();
+
+    if (!final_cut) {
+        PixelStats ps = pixel_stats[i];
+        if ((cut_flags & kCutLastDispatch) != 0u) ps.flags |= kPixelCutUnfinished;
+        if (cut_short) ps.flags |= kPixelLoopLimit;
+        if (g_heap_overflow) ps.flags |= kPixelHeapOverflow;
+        pixel_stats[i] = ps;
+        lc_heap_save(heap_size);
+        CutState s;
+        s.heap_size = heap_size;
+        s.cut_size = stats.cut_size;
+        s.shadow_rays = stats.shadow_rays;
+        s.flags = g_heap_spilled ? kCutSpilled : 0u;
+        s.leaf_r = leaf_sum.x; s.leaf_g = leaf_sum.y; s.leaf_b = leaf_sum.z;
+        s.heap_r = heap_sum.x; s.heap_g = heap_sum.y; s.heap_b = heap_sum.z;
+        s.pad0 = 0u;
+        s.pad1 = 0u;
+        cut_states[i] = s;
+        return;
+    }
+
+    lc_accumulate(i, lc_cut_result(heap_size, leaf_sum));
+    PixelStats ps = pixel_stats[i];
+    ps.cut_size_sum += stats.cut_size;
+    ps.shadow_rays += stats.shadow_rays;
+    ps.max_cut_samples += stats.hit_max_cut;
+    ps.spill_samples += g_heap_spilled ? 1u : 0u;
+    if (g_heap_overflow) ps.flags |= kPixelHeapOverflow;
+    if (cut_short || lc_loops_were_cut_short()) ps.flags |= kPixelLoopLimit;
+    pixel_stats[i] = ps;
+    if ((cut_flags & kCutLastDispatch) == 0u) cut_states[i].flags = kCutDone;
+}

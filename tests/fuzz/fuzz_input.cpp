@@ -1,0 +1,73 @@
+#include "fuzz_input.h"
+
+#include <cmath>
+#include <fstream>
+
+#include <glm/glm.hpp>
+
+namespace lc::fuzz {
+namespace {
+
+bool finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+bool unit(glm::vec3 v) { return finite(v) && std::abs(glm::length(v) - 1.0f) < 1e-3f; }
+
+bool in_unit_interval(float r, float g, float b) {
+    return r >= 0.0f && r <= 1.0f && g >= 0.0f && g <= 1.0f && b >= 0.0f && b <= 1.0f;
+}
+
+}  // namespace
+
+std::filesystem::path write_scene_files(std::string_view data, const std::filesystem::path& dir) {
+    std::filesystem::create_directories(dir);
+    const char* names[] = {kSceneFile, kLightsFile, kObjFile, kMtlFile};
+    for (const char* name : names) {
+        const std::size_t end = std::min(data.find('\0'), data.size());
+        std::ofstream out(dir / name, std::ios::binary | std::ios::trunc);
+        out.write(data.data(), std::streamsize(end));
+        data.remove_prefix(std::min(end + 1, data.size()));
+    }
+    return dir / kSceneFile;
+}
+
+std::string check_scene_contract(const Scene& s) {
+    const Camera& c = s.camera;
+    if (!finite(c.position) || !finite(c.look_at) || !finite(c.up)) return "camera not finite";
+    if (c.position == c.look_at) return "camera looks at its own position";
+    if (!(c.fov_y_degrees > 0.0f && c.fov_y_degrees < 180.0f)) return "fov out of (0, 180)";
+    if (c.width < 1 || c.height < 1 || c.width > 16384 || c.height > 16384) return "image size out of range";
+    if (s.triangles.empty()) return "no triangles";
+    if (s.normals.size() != s.triangles.size()) return "normals not parallel to triangles";
+    if (s.lights.empty()) return "no lights";
+    for (const auto& m : s.materials) {
+        if (!in_unit_interval(m.kd_r, m.kd_g, m.kd_b) || !in_unit_interval(m.ks_r, m.ks_g, m.ks_b))
+            return "material colour out of [0, 1]";
+        if (!(m.alpha >= 1e-3f && m.alpha <= 1.0f)) return "GGX alpha out of [1e-3, 1]";
+        const bool specular = m.ks_r > 0.0f || m.ks_g > 0.0f || m.ks_b > 0.0f;
+        if (specular != ((m.flags & gpu::kMaterialHasSpecular) != 0u)) return "specular flag disagrees with ks";
+    }
+    for (std::size_t i = 0; i < s.triangles.size(); ++i) {
+        const gpu::Triangle& t = s.triangles[i];
+        const gpu::TriangleNormals& n = s.normals[i];
+        if (t.material >= s.materials.size()) return "triangle material out of range";
+        const glm::vec3 v0(t.v0_x, t.v0_y, t.v0_z), v1(t.v1_x, t.v1_y, t.v1_z), v2(t.v2_x, t.v2_y, t.v2_z);
+        if (!finite(v0) || !finite(v1) || !finite(v2)) return "vertex not finite";
+        if (!(glm::length(glm::cross(v1 - v0, v2 - v0)) > 0.0f)) return "degenerate triangle kept";
+        if (!unit({n.n0_x, n.n0_y, n.n0_z}) || !unit({n.n1_x, n.n1_y, n.n1_z}) || !unit({n.n2_x, n.n2_y, n.n2_z}))
+            return "normal not unit length";
+    }
+    for (const auto& l : s.lights) {
+        if (l.type != gpu::kLightPoint && l.type != gpu::kLightDirectional) return "unknown light type";
+        if (!finite({l.x, l.y, l.z})) return "light position not finite";
+        if (!finite({l.r, l.g, l.b}) || l.r < 0.0f || l.g < 0.0f || l.b < 0.0f) return "light intensity invalid";
+        if (l.type == gpu::kLightDirectional && !unit({l.x, l.y, l.z})) return "light direction not unit";
+    }
+    if (!finite(s.bounds_min) || !finite(s.bounds_max)) return "bounds not finite";
+    const RenderSettings& r = s.render;
+    if (r.method != "brute" && r.method != "lightcuts") return "unknown method";
+    if (r.spp < 1 || r.max_cut < 1) return "spp or max_cut below 1";
+    if (!(r.relative_error >= 0.0f) || !std::isfinite(r.relative_error)) return "relative_error invalid";
+    return {};
+}
+
+}  // namespace lc::fuzz
