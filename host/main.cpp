@@ -109,12 +109,19 @@ int run_render(const RenderArgs& a) {
     lc::PreparedScene prepared = lc::prepare_scene(std::move(scene), o.seed);
 
     lc::RenderResult result;
+    // auto: a GPU if there is one (or the one --gpu names); with only a
+    // software Vulkan device (lavapipe) the CPU path is the faster of the two.
     bool use_vulkan = a.device == "vulkan";
-    if (a.device == "auto") {
+    if (a.device == "auto" && a.gpu.empty() && !lc::vulkan_hardware_device_present()) {
+        if (!lc::list_vulkan_devices().empty())
+            std::fprintf(stderr, "note: only a software Vulkan device is present; rendering on the CPU "
+                                 "(--device vulkan uses it anyway)\n");
+        else
+            std::fprintf(stderr, "warning: no Vulkan device; rendering on the CPU\n");
+        result = lc::render_cpu(prepared, o);
+    } else if (a.device == "auto") {
         try {
-            lc::VulkanOptions vo{a.gpu, a.validation};
-            result = lc::render_vulkan(prepared, o, vo);
-            use_vulkan = true;
+            result = lc::render_vulkan(prepared, o, lc::VulkanOptions{a.gpu, a.validation});
         } catch (const lc::NoVulkanDevice& e) {
             std::fprintf(stderr, "warning: %s; rendering on the CPU\n", e.what());
             result = lc::render_cpu(prepared, o);
@@ -195,7 +202,6 @@ int run_render(const RenderArgs& a) {
         throw std::invalid_argument("--cut-heatmap needs --method lightcuts");
     }
     if (!a.stats_file.empty()) write_json_atomically(a.stats_file, stats);
-    (void)use_vulkan;
     return 0;
 }
 

@@ -406,8 +406,14 @@ TEST(Bvh, BuildsLargeRandomSceneWithValidTree) {
     EXPECT_LE(scene.bvh.nodes.size(), 2 * scene.triangles.size());
 }
 
-// Waechter-Binder offsets: a shadow ray leaving the surface from the offset
-// hit point never hits the surface it starts on.
+// lc_offset_hit_point: a shadow ray leaving the surface from the offset
+// (barycentric) hit point never hits the surface it starts on.
+// The hit point as the renderer computes it (lc_surface_point).
+vec3 barycentric_point(const Triangle& t, float b1, float b2) {
+    return (1.0f - b1 - b2) * vec3(t.v0_x, t.v0_y, t.v0_z) + b1 * vec3(t.v1_x, t.v1_y, t.v1_z) +
+           b2 * vec3(t.v2_x, t.v2_y, t.v2_z);
+}
+
 TEST(Bvh, OffsetOriginsAvoidSelfIntersectionFarFromOrigin) {
     const vec3 n = glm::normalize(vec3(1.0f, 2.0f, 3.0f));
     const vec3 p0(1e5f, -1e5f, 1e5f);
@@ -430,11 +436,11 @@ TEST(Bvh, OffsetOriginsAvoidSelfIntersectionFarFromOrigin) {
         const std::uint32_t tri = k.lc_trace_closest(org, dir, kRayInfinity, t, b1, b2);
         if (tri == kInvalidIndex) continue;
         ++hits;
-        const vec3 p = org + t * dir;
+        const vec3 p = barycentric_point(plane.triangles[tri], b1, b2);
         vec3 ng = geometric_normal(plane.triangles[tri]);
         if (glm::dot(ng, dir) > 0.0f) ng = -ng;  // face the incoming ray
         const vec3 shadow = random_in_hemisphere(rng, ng, 1e-3f);
-        self_hits += k.lc_trace_any(k.lc_offset_ray_origin(p, ng), shadow, kRayInfinity);
+        self_hits += k.lc_trace_any(k.lc_offset_hit_point(p, ng, plane.triangles[tri]), shadow, kRayInfinity);
         raw_self_hits += k.lc_trace_any(p, shadow, kRayInfinity);
     }
     EXPECT_GT(hits, 3900);
@@ -474,11 +480,11 @@ TEST(Bvh, OffsetOriginsAvoidSelfIntersectionOnCurvedSurface) {
         const std::uint32_t tri = k.lc_trace_closest(org, dir, kRayInfinity, t, b1, b2);
         if (tri == kInvalidIndex) continue;
         ++hits;
-        const vec3 p = org + t * dir;
+        const vec3 p = barycentric_point(sphere.triangles[tri], b1, b2);
         vec3 ng = geometric_normal(sphere.triangles[tri]);
         if (glm::dot(ng, dir) > 0.0f) ng = -ng;
         const vec3 shadow = random_in_hemisphere(rng, ng, 0.02f);
-        self_hits += k.lc_trace_any(k.lc_offset_ray_origin(p, ng), shadow, kRayInfinity);
+        self_hits += k.lc_trace_any(k.lc_offset_hit_point(p, ng, sphere.triangles[tri]), shadow, kRayInfinity);
     }
     EXPECT_GT(hits, 3900);
     EXPECT_EQ(self_hits, 0);

@@ -110,7 +110,7 @@ Instance create_instance(bool validation, MessageLog* log, bool& debug_utils) {
     VkInstance instance = VK_NULL_HANDLE;
     VkResult result = vkCreateInstance(&info, nullptr, &instance);
     if (result == VK_ERROR_INCOMPATIBLE_DRIVER)
-        throw std::runtime_error(
+        throw NoVulkanDevice(
             "no Vulkan device: the Vulkan loader found no driver (vkCreateInstance returned "
             "VK_ERROR_INCOMPATIBLE_DRIVER)");
     VK_CHECK(result);
@@ -179,7 +179,7 @@ bool is_index(const std::string& s) {
 // capability refusals, then takes the best-ranked device left.
 PhysicalDeviceInfo choose_device(std::vector<PhysicalDeviceInfo> devices, const std::string& gpu) {
     if (devices.empty())
-        throw std::runtime_error(
+        throw NoVulkanDevice(
             "no Vulkan device: the Vulkan loader reports no physical device (is a Vulkan driver "
             "installed? VK_DRIVER_FILES / VK_ICD_FILENAMES select driver manifests)");
     const bool by_index = is_index(gpu);
@@ -208,6 +208,9 @@ PhysicalDeviceInfo choose_device(std::vector<PhysicalDeviceInfo> devices, const 
                    std::to_string(VK_API_VERSION_MAJOR(p.apiVersion)) + "." +
                    std::to_string(VK_API_VERSION_MINOR(p.apiVersion)) + "): " + devices[i].refusal;
     }
+    // Nothing usable at all is "no device"; a --gpu that matches nothing is
+    // the user's mistake and must not silently fall back to the CPU.
+    if (gpu.empty()) throw NoVulkanDevice(message);
     throw std::runtime_error(message);
 }
 
@@ -234,7 +237,7 @@ void load_vulkan_loader() {
     // volk keeps the loader's entry points in globals; load them once.
     static const VkResult result = volkInitialize();
     if (result != VK_SUCCESS)
-        throw std::runtime_error(
+        throw NoVulkanDevice(
             "no Vulkan device: the Vulkan loader (libvulkan.so.1) could not be loaded");
 }
 
@@ -309,6 +312,19 @@ std::vector<std::string> list_vulkan_devices() {
         // No loader or no driver: no devices.
     }
     return names;
+}
+
+bool vulkan_hardware_device_present() {
+    try {
+        vk::MessageLog log;
+        bool debug_utils = false;
+        vk::Instance instance = vk::create_instance(false, &log, debug_utils);
+        for (const vk::PhysicalDeviceInfo& d : vk::physical_devices(instance.get()))
+            if (d.refusal.empty() && d.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) return true;
+    } catch (const std::runtime_error&) {
+        // No loader or no driver: no devices.
+    }
+    return false;
 }
 
 }  // namespace lc

@@ -21,6 +21,7 @@
 #include "spirv/lightcuts.h"
 #include "spirv/primary.h"
 #include "vk_check.h"
+#include "progress.h"
 #include "vk_context.h"
 
 namespace lc::vk {
@@ -144,7 +145,7 @@ private:
 
     // Progress and timing.
     Clock::time_point start_ = Clock::now();
-    Clock::time_point last_progress_ = start_;
+    Progress progress_{options_.progress};
     std::uint64_t samples_done_ = 0, samples_total_ = 0;
     double seconds_primary_ = 0.0, seconds_shading_ = 0.0;
 };
@@ -673,19 +674,11 @@ double Renderer::render_tile(std::uint32_t x0, std::uint32_t y0, std::uint32_t w
 }
 
 void Renderer::report_progress(bool done) {
-    if (!options_.progress) return;
-    const Clock::time_point now = Clock::now();
-    if (!done && now - last_progress_ < std::chrono::milliseconds(250)) return;
-    last_progress_ = now;
-    const double fraction = samples_total_ ? double(samples_done_) / double(samples_total_) : 1.0;
-    const double elapsed = seconds_since(start_);
     if (done) {
-        std::fprintf(stderr, "\rvulkan: 100.0%%, %.1f s          \n", elapsed);
-    } else {
-        const double eta = fraction > 0.0 ? elapsed / fraction - elapsed : 0.0;
-        std::fprintf(stderr, "\rvulkan: %5.1f%%, ETA %.1f s   ", 100.0 * fraction, eta);
+        progress_.finish();
+        return;
     }
-    std::fflush(stderr);
+    progress_.update(samples_total_ ? double(samples_done_) / double(samples_total_) : 1.0);
 }
 
 RenderResult Renderer::run() {

@@ -83,4 +83,9 @@ RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& o
 // Names of the Vulkan devices present, in index order ("" list if none / no loader).
 std::vector<std::string> list_vulkan_devices();
 
+// True when a usable Vulkan device runs on real GPU hardware (discrete,
+// integrated or virtual GPU), as opposed to a software rasterizer such as
+// lavapipe, which is slower than the CPU path.
+bool vulkan_hardware_device_present();
+
 }  // namespace lc

@@ -17,8 +17,6 @@ LC_KCONST float kPi = 3.14159265358979f;
 // bound is never below the value it bounds by an ulp.
 LC_KCONST float kBoundSlack = 1.0f + 1e-5f;
 LC_KCONST float kCosineAbsSlack = 1e-6f;
-// Shaded points leave their triangle by this times its largest coordinate.
-LC_KCONST float kHitOffsetRelative = 1.0f / 1048576.0f;
 
 // --- Random numbers for pixel jitter: PCG hash, identical on CPU and GPU.
 uint lc_hash(uint v) {
@@ -78,17 +76,8 @@ SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) 
     // Two-sided surfaces: both normals turn to the side the ray came from.
     if (dot(ng, ray_dir) > 0.0f) ng = -ng;
     if (dot(ns, ng) < 0.0f) ns = -ns;
-    // Off the surface along ng by 2^-20 of the triangle's largest coordinate
-    // (8 to 16 of its ulps). The barycentric point is off the plane by a few
-    // ulps of that coordinate, and the shadow ray's triangle test errs by as
-    // much, so this clears the surface at any scale and any distance from
-    // the origin. lc_offset_ray_origin's 256 ulps of p, or 1.5e-5 absolute
-    // near the origin, assume p = org + t * dir and unit-sized scenes: they
-    // moved points by 2 units at 1e5 and by 7% of a room scaled to 1e-4
-    // (tests/stress, Transformed.*).
-    vec3 m = max(max(abs(v0), abs(v1)), abs(v2));
     SurfacePoint sp;
-    sp.p = p + ng * (kHitOffsetRelative * max(max(m.x, m.y), m.z));
+    sp.p = lc_offset_hit_point(p, ng, tri);
     sp.n = ns;
     sp.wo = -ray_dir;
     sp.material = tri.material;

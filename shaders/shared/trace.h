@@ -163,21 +163,19 @@ bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
     return false;
 }
 
-// Moves a surface point off the surface along the (geometric) normal n by a
-// few ulps of its coordinates (Waechter and Binder, "A Fast and Robust Method
-// for Avoiding Self-Intersection", Ray Tracing Gems, 2019). The offset scales
-// with the magnitude of p, so it works far from the origin too, and stays far
-// smaller than any wall thickness a scene would model.
-float lc_offset_component(float p, float n) {
-    LC_KCONST float kOrigin = 1.0f / 32.0f;
-    LC_KCONST float kFloatScale = 1.0f / 65536.0f;
-    LC_KCONST float kIntScale = 256.0f;
-    int of = int(kIntScale * n);
-    float p_i = intBitsToFloat(floatBitsToInt(p) + (p < 0.0f ? -of : of));
-    return abs(p) < kOrigin ? p + kFloatScale * n : p_i;
-}
+// Moves a hit point off its triangle along the geometric normal ng (turned
+// to the side the ray came from) by 2^-20 of the triangle's largest
+// coordinate (8 to 16 of its ulps). The barycentric point is off the plane by
+// a few ulps of that coordinate, and a shadow ray's triangle test errs by as
+// much, so this clears the surface at any scale and any distance from the
+// origin, while staying far below any wall thickness a scene would model.
+// (Offsets of a fixed number of ulps of p, as in Waechter and Binder, Ray
+// Tracing Gems 2019, assume p = org + t * dir and unit-sized scenes: they
+// moved points by 2 units at 1e5 and by 7% of a room scaled to 1e-4;
+// tests/stress, Transformed.*.)
+LC_KCONST float kHitOffsetRelative = 1.0f / 1048576.0f;
 
-vec3 lc_offset_ray_origin(vec3 p, vec3 n) {
-    return vec3(lc_offset_component(p.x, n.x), lc_offset_component(p.y, n.y),
-                lc_offset_component(p.z, n.z));
+vec3 lc_offset_hit_point(vec3 p, vec3 ng, Triangle tri) {
+    vec3 m = max(max(abs(lc_tri_v0(tri)), abs(lc_tri_v1(tri))), abs(lc_tri_v2(tri)));
+    return p + ng * (kHitOffsetRelative * max(max(m.x, m.y), m.z));
 }
