@@ -448,8 +448,8 @@ void Renderer::create_descriptors() {
 void Renderer::create_pipelines() {
     SpecData spec{};
     spec.workgroup_size = kWorkgroupSize;
-    spec.enable_ggx = tuning_.all_features || prepared_.has_specular;
-    spec.enable_shadows = tuning_.all_features || prepared_.has_occluders;
+    spec.enable_ggx = tuning_.force_ggx || prepared_.has_specular;
+    spec.enable_shadows = tuning_.force_shadows || prepared_.has_occluders;
     spec.heap_shared = heap_shared_;
     spec.heap_capacity = heap_capacity_;
     spec.spill_stride = tiles_.invocations;
@@ -753,7 +753,12 @@ RenderResult Renderer::run() {
 
 Tuning Tuning::from_environment() {
     Tuning tuning;
-    if (const char* v = std::getenv("LC_VK_ALL_FEATURES")) tuning.all_features = std::atoi(v) != 0;
+    if (const char* v = std::getenv("LC_VK_FORCE_FEATURES")) {
+        const std::string features = v;
+        const bool all = features.find("all") != std::string::npos;
+        tuning.force_ggx = all || features.find("ggx") != std::string::npos;
+        tuning.force_shadows = all || features.find("shadows") != std::string::npos;
+    }
     if (const char* v = std::getenv("LC_VK_MAX_TILE_PIXELS"))
         tuning.max_tile_pixels = std::uint32_t(std::strtoul(v, nullptr, 10));
     if (const char* v = std::getenv("LC_VK_LIGHTS_PER_DISPATCH"))

@@ -9,9 +9,10 @@
 namespace lc::vk {
 
 struct Tuning {
-    // Compile every kernel feature in (GGX, shadow rays) whatever the scene
-    // needs, to measure what the specialization constants save.
-    bool all_features = false;
+    // Compile a kernel feature in whatever the scene needs, to measure what
+    // its specialization constant saves.
+    bool force_ggx = false;
+    bool force_shadows = false;
     // Largest tile, in pixels (0: limited only by the buffer limits).
     std::uint32_t max_tile_pixels = 0;
     // Tiles are resized so one dispatch takes about this long.
@@ -23,7 +24,7 @@ struct Tuning {
     std::uint32_t lights_per_dispatch = 0;
     std::uint32_t refinements_per_dispatch = 0;
 
-    // LC_VK_ALL_FEATURES=1, LC_VK_MAX_TILE_PIXELS=N, LC_VK_TARGET_MS=X,
+    // LC_VK_FORCE_FEATURES=ggx,shadows (or all), LC_VK_MAX_TILE_PIXELS=N, LC_VK_TARGET_MS=X,
     // LC_VK_LIGHTS_PER_DISPATCH=N, LC_VK_REFINEMENTS_PER_DISPATCH=N.
     static Tuning from_environment();
 };
