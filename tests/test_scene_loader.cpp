@@ -93,7 +93,7 @@ TEST(SceneLoader, LoadsDefaultRoomScene) {
     const Scene scene = load_scene(kScenes / "room" / "room.json");
     EXPECT_EQ(scene.camera.width, 256u);
     EXPECT_EQ(scene.camera.height, 256u);
-    EXPECT_EQ(scene.render.method, "brute");
+    EXPECT_EQ(scene.render.method, "lightcuts");
     EXPECT_EQ(scene.render.spp, 1u);
     EXPECT_EQ(scene.lights.size(), 1000u);
     EXPECT_EQ(scene.count_lights(gpu::kLightPoint), 1000u);
