@@ -25,6 +25,31 @@ void BM_TreeBuild(benchmark::State& state) {
 }
 BENCHMARK(BM_TreeBuild)->RangeMultiplier(10)->Range(1000, 1000000)->Unit(benchmark::kMillisecond);
 
+// BVH build over random triangles; reports bytes per triangle (nodes +
+// positions + normals) as a counter.
+void BM_BvhBuild(benchmark::State& state) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-100.0f, 100.0f), e(-0.5f, 0.5f);
+    std::vector<lc::gpu::Triangle> tris;
+    std::vector<lc::gpu::TriangleNormals> normals(std::size_t(state.range(0)));
+    for (std::int64_t i = 0; i < state.range(0); ++i) {
+        glm::vec3 c(u(rng), u(rng), u(rng));
+        tris.push_back({c.x + e(rng), c.y + e(rng), c.z + e(rng), c.x + e(rng), c.y + e(rng), c.z + e(rng),
+                        c.x + e(rng), c.y + e(rng), c.z + e(rng), 0u, 0u, 0u});
+    }
+    std::size_t nodes = 0;
+    for (auto _ : state) {
+        auto t = tris;
+        auto n = normals;
+        nodes = lc::build_bvh(t, n).nodes.size();
+    }
+    state.SetItemsProcessed(state.iterations() * state.range(0));
+    state.counters["bytes_per_triangle"] =
+        double(nodes * sizeof(lc::gpu::BvhNode)) / double(state.range(0)) + double(sizeof(lc::gpu::Triangle)) +
+        double(sizeof(lc::gpu::TriangleNormals));
+}
+BENCHMARK(BM_BvhBuild)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond);
+
 // A prepared room scene with a kernel bound to it, and shading points taken
 // from camera rays.
 struct Fixture {
@@ -39,13 +64,7 @@ struct Fixture {
         lc::RenderOptions o = lc::test::options("lightcuts", 64);
         frame = lc::make_frame_params(prepared, o);
         heap.resize(frame.max_cut + 2);
-        k.bvh_nodes = prepared.bvh.nodes.data();
-        k.triangles = prepared.scene.triangles.data();
-        k.normals = prepared.scene.normals.data();
-        k.materials = prepared.scene.materials.data();
-        k.lights = prepared.tree.lights.data();
-        k.light_nodes = prepared.tree.nodes.data();
-        k.heap = heap.data();
+        k = lc::cpu::make_shade_kernel(prepared, heap.data());
         glm::vec3 origin(frame.cam_pos_x, frame.cam_pos_y, frame.cam_pos_z);
         for (std::uint32_t y = 0; y < 64; y += 4)
             for (std::uint32_t x = 0; x < 64; x += 4) {

@@ -5,6 +5,7 @@
 
 #include <glm/glm.hpp>
 
+#include "lightcuts/render.h"
 #include "shared/types.h"
 #include "shared/glsl_compat.h"
 
@@ -26,7 +27,7 @@ struct TraceKernel {
 };
 
 // Everything a pixel needs. `heap` must hold max(max_cut, 2) entries; one
-// kernel object per thread.
+// kernel object per thread (make_shade_kernel binds one to a scene).
 struct ShadeKernel {
     const BvhNode* bvh_nodes = nullptr;
     const Triangle* triangles = nullptr;
@@ -35,6 +36,9 @@ struct ShadeKernel {
     const Light* lights = nullptr;
     const LightNode* light_nodes = nullptr;
     CutEntry* heap = nullptr;
+    // Highest heap slot written + 1 since the caller last reset it: tells how
+    // many slots a cut needed (the GPU keeps only the first K in shared memory).
+    uint heap_high_water = 0u;
 
     // The CPU reference always runs the full kernel; the GPU switches parts
     // off only where the scene cannot use them.
@@ -48,7 +52,7 @@ struct ShadeKernel {
 #define LC_LIGHT(i) lights[i]
 #define LC_LIGHT_NODE(i) light_nodes[i]
 #define LC_HEAP_LOAD(i) heap[i]
-#define LC_HEAP_STORE(i, e) (heap[i] = (e))
+#define LC_HEAP_STORE(i, e) (heap_high_water = max(heap_high_water, (i) + 1u), heap[i] = (e))
 #include "shared/trace.h"
 #include "shared/shading.h"
 #include "shared/lightcuts.h"
@@ -61,5 +65,18 @@ struct ShadeKernel {
 #undef LC_HEAP_LOAD
 #undef LC_HEAP_STORE
 };
+
+// A kernel reading the prepared scene's arrays, with `heap` as its cut heap.
+inline ShadeKernel make_shade_kernel(const PreparedScene& p, CutEntry* heap) {
+    ShadeKernel k;
+    k.bvh_nodes = p.bvh.nodes.data();
+    k.triangles = p.scene.triangles.data();
+    k.normals = p.scene.normals.data();
+    k.materials = p.scene.materials.data();
+    k.lights = p.tree.lights.data();
+    k.light_nodes = p.tree.nodes.data();
+    k.heap = heap;
+    return k;
+}
 
 }  // namespace lc::cpu

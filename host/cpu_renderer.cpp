@@ -1,5 +1,5 @@
 // CPU reference renderer: the shared kernels (host/cpu_kernel.h) run per
-// pixel over 16x16 tiles handed out to worker threads. Every pixel is
+// pixel over 8x8 tiles handed out to worker threads. Every pixel is
 // computed independently in a fixed order, so the image is bit-identical
 // whatever the thread count.
 #include <algorithm>
@@ -15,7 +15,7 @@
 namespace lc {
 namespace {
 
-constexpr std::uint32_t kTile = 16;
+constexpr std::uint32_t kTile = 8;  // small, so small images still use every core
 
 struct ThreadTotals {
     std::uint64_t shadow_rays = 0;
@@ -50,14 +50,7 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
 
     auto worker = [&](unsigned thread_index) {
         std::vector<gpu::CutEntry> heap(std::max<std::uint32_t>(frame.max_cut, 2u));
-        cpu::ShadeKernel k;
-        k.bvh_nodes = prepared.bvh.nodes.data();
-        k.triangles = prepared.scene.triangles.data();
-        k.normals = prepared.scene.normals.data();
-        k.materials = prepared.scene.materials.data();
-        k.lights = prepared.tree.lights.data();
-        k.light_nodes = prepared.tree.nodes.data();
-        k.heap = heap.data();
+        cpu::ShadeKernel k = cpu::make_shade_kernel(prepared, heap.data());
         ThreadTotals& t = totals[thread_index];
         const glm::vec3 origin(frame.cam_pos_x, frame.cam_pos_y, frame.cam_pos_z);
         for (std::uint32_t tile; (tile = next_tile.fetch_add(1)) < tile_count;) {

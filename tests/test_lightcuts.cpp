@@ -180,14 +180,7 @@ TEST(Lightcuts, MaxCutOneUsesTheRootRepresentative) {
     RenderResult r = render_cpu(p, o);
     gpu::FrameParams f = make_frame_params(p, o);
     std::vector<gpu::CutEntry> heap(2);
-    Kernel k;
-    k.bvh_nodes = p.bvh.nodes.data();
-    k.triangles = p.scene.triangles.data();
-    k.normals = p.scene.normals.data();
-    k.materials = p.scene.materials.data();
-    k.lights = p.tree.lights.data();
-    k.light_nodes = p.tree.nodes.data();
-    k.heap = heap.data();
+    Kernel k = cpu::make_shade_kernel(p, heap.data());
     const gpu::LightNode& root = p.tree.nodes[p.tree.root_point];
     glm::vec3 root_intensity(root.intensity_r, root.intensity_g, root.intensity_b);
     int lit = 0;

@@ -28,6 +28,7 @@
 
 #include "lightcuts/image.h"
 #include "lightcuts/render.h"
+#include "cpu_kernel.h"
 #include "test_util.h"
 #include "vulkan_renderer.h"
 
@@ -39,61 +40,13 @@ using test::add_quad;
 
 constexpr float kPi = 3.14159265358979f;
 
-// --- The CPU kernel once more, this time recording how far each heap grows,
-// to count the samples whose heap spills past the GPU's shared slots.
-namespace heap_probe {
-using namespace glm;
-using namespace lc::gpu;
-
-struct Kernel {
-    const BvhNode* bvh_nodes = nullptr;
-    const Triangle* triangles = nullptr;
-    const TriangleNormals* normals = nullptr;
-    const Material* materials = nullptr;
-    const Light* lights = nullptr;
-    const LightNode* light_nodes = nullptr;
-    CutEntry* heap = nullptr;
-    uint heap_used = 0;  // highest slot written + 1
-
-    static constexpr bool kEnableGgx = true;
-    static constexpr bool kEnableShadows = true;
-
-#define LC_BVH_NODE(i) bvh_nodes[i]
-#define LC_TRIANGLE(i) triangles[i]
-#define LC_NORMALS(i) normals[i]
-#define LC_MATERIAL(i) materials[i]
-#define LC_LIGHT(i) lights[i]
-#define LC_LIGHT_NODE(i) light_nodes[i]
-#define LC_HEAP_LOAD(i) heap[i]
-#define LC_HEAP_STORE(i, e) (heap_used = std::max(heap_used, (i) + 1u), heap[i] = (e))
-#include "shared/glsl_compat.h"
-#include "shared/trace.h"
-#include "shared/shading.h"
-#include "shared/lightcuts.h"
-#undef LC_BVH_NODE
-#undef LC_TRIANGLE
-#undef LC_NORMALS
-#undef LC_MATERIAL
-#undef LC_LIGHT
-#undef LC_LIGHT_NODE
-#undef LC_HEAP_LOAD
-#undef LC_HEAP_STORE
-};
-}  // namespace heap_probe
 
 // Samples whose Lightcuts heap needs more than `shared_slots` slots.
 std::uint64_t count_spilling_samples(const PreparedScene& p, const RenderOptions& o,
                                      std::uint32_t shared_slots) {
     const gpu::FrameParams f = make_frame_params(p, o);
     std::vector<gpu::CutEntry> heap(std::max(f.max_cut, 2u));
-    heap_probe::Kernel k;
-    k.bvh_nodes = p.bvh.nodes.data();
-    k.triangles = p.scene.triangles.data();
-    k.normals = p.scene.normals.data();
-    k.materials = p.scene.materials.data();
-    k.lights = p.tree.lights.data();
-    k.light_nodes = p.tree.nodes.data();
-    k.heap = heap.data();
+    lc::cpu::ShadeKernel k = lc::cpu::make_shade_kernel(p, heap.data());
     const glm::vec3 origin(f.cam_pos_x, f.cam_pos_y, f.cam_pos_z);
     std::uint64_t spilled = 0;
     for (std::uint32_t y = 0; y < f.height; ++y)
@@ -103,10 +56,10 @@ std::uint64_t count_spilling_samples(const PreparedScene& p, const RenderOptions
                 float t, b1, b2;
                 std::uint32_t tri = k.lc_trace_closest(origin, dir, k.kRayInfinity, t, b1, b2);
                 if (tri == gpu::kInvalidIndex) continue;
-                heap_probe::Kernel::ShadeStats stats{0u, 0u, 0u};
-                k.heap_used = 0;
+                lc::cpu::ShadeKernel::ShadeStats stats{0u, 0u, 0u};
+                k.heap_high_water = 0;
                 k.lc_shade_lightcuts(k.lc_surface_point(tri, b1, b2, dir), f, stats);
-                spilled += k.heap_used > shared_slots ? 1 : 0;
+                spilled += k.heap_high_water > shared_slots ? 1 : 0;
             }
     return spilled;
 }
