@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# What each Vulkan specialization-constant switch saves: renders a scene that
+# needs neither shadow rays nor the GGX lobe (scenes/plane) with the switches
+# as the scene allows them, and with each one forced on
+# (LC_VK_FORCE_FEATURES), and prints the median GPU shading time of 5 runs
+# after a warm-up.
+#
+#   bench/spec_switches.sh [SCENE] [SIZE]
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+scene="${1:-$root/scenes/plane/plane.json}"
+size="${2:-128}"
+exe="$root/build/host/lightcuts"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+
+printf '%-10s %-14s %s\n' method forced "median shading [s] (5 runs)"
+for method in lightcuts brute; do
+  for force in none ggx shadows all; do
+    times=()
+    for run in 0 1 2 3 4 5; do
+      LC_VK_FORCE_FEATURES="$force" "$exe" render "$scene" -o "$tmp/x.exr" --device vulkan --method "$method" \
+        --width "$size" --height "$size" --no-png --stats "$tmp/s.json" >/dev/null 2>&1
+      [ "$run" -eq 0 ] && continue  # warm-up
+      times+=("$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['seconds']['shading'])" "$tmp/s.json")")
+    done
+    median="$(printf '%s\n' "${times[@]}" | sort -g | sed -n 3p)"
+    printf '%-10s %-14s %.3f\n' "$method" "$force" "$median"
+  done
+done
