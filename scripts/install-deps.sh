@@ -13,6 +13,7 @@ packages=(
   nlohmann-json3-dev libcli11-dev
   libstb-dev libtinyexr-dev
   python3 python3-numpy python3-matplotlib
+  clang libclang-rt-14-dev
 )
 
 missing=()
