@@ -183,6 +183,9 @@ int run_render(const RenderArgs& a) {
                     prepared.tree.build_seconds);
         std::printf("  cut size mean %.1f, p50 %.0f, p99 %.0f, max %.0f; %llu samples hit max_cut %u\n", mean, p50,
                     p99, max, static_cast<unsigned long long>(s.max_cut_pixels), o.max_cut);
+        if (s.device != "cpu")
+            std::printf("  cut heap: %u slots per pixel in shared memory; %llu samples spilled to global memory\n",
+                        s.heap_capacity_shared, static_cast<unsigned long long>(s.heap_spill_pixels));
         stats["lightcuts"] = {{"relative_error", o.relative_error},
                               {"max_cut", o.max_cut},
                               {"tree_nodes", prepared.tree.nodes.size()},
@@ -274,7 +277,7 @@ int main(int argc, char** argv) {
     render->add_option("--max-cut", r.max_cut, "Lightcuts largest cut (default 1000)")->check(CLI::Range(1u, 1u << 20));
     render->add_option("--seed", r.seed, "Seed for pixel jitter and light-tree representatives");
     render->add_option("--threads", r.threads, "CPU threads (0 = all cores)");
-    render->add_option("--device", r.device, "auto (Vulkan, else CPU), cpu or vulkan")
+    render->add_option("--device", r.device, "auto (a hardware GPU through Vulkan, else the CPU path), cpu or vulkan")
         ->check(CLI::IsMember({"auto", "cpu", "vulkan"}));
     render->add_option("--gpu", r.gpu, "Vulkan device index or name substring");
     render->add_flag("--validation", r.validation, "Enable the Vulkan validation layer");
