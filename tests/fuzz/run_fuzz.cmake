@@ -22,11 +22,13 @@ if(rc)
 endif()
 
 # New inputs go to the build tree's corpus (the first folder); the seeds
-# and regressions in the source tree are only read.
+# and regressions in the source tree are only read. A fixed seed makes a CI
+# run repeat the same mutations (up to how many fit in the time); fuzz
+# longer with another seed by hand (docs/testing.md).
 file(MAKE_DIRECTORY ${BUILD_DIR}/corpus ${BUILD_DIR}/artifacts)
 execute_process(
   COMMAND ${BUILD_DIR}/lc_fuzz_scene_loader
-          -max_total_time=${SECONDS} -rss_limit_mb=2048 -timeout=10 -print_final_stats=1
+          -seed=1 -max_total_time=${SECONDS} -rss_limit_mb=2048 -timeout=10 -print_final_stats=1
           -dict=${SOURCE_DIR}/scene.dict -artifact_prefix=${BUILD_DIR}/artifacts/
           ${BUILD_DIR}/corpus ${SOURCE_DIR}/corpus ${SOURCE_DIR}/regressions
   RESULT_VARIABLE rc)
