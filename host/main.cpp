@@ -111,7 +111,6 @@ int run_render(const RenderArgs& a) {
     lc::RenderResult result;
     // auto: a GPU if there is one (or the one --gpu names); with only a
     // software Vulkan device (lavapipe) the CPU path is the faster of the two.
-    bool use_vulkan = a.device == "vulkan";
     if (a.device == "auto" && a.gpu.empty() && !lc::vulkan_hardware_device_present()) {
         if (!lc::list_vulkan_devices().empty())
             std::fprintf(stderr, "note: only a software Vulkan device is present; rendering on the CPU "
@@ -126,7 +125,7 @@ int run_render(const RenderArgs& a) {
             std::fprintf(stderr, "warning: %s; rendering on the CPU\n", e.what());
             result = lc::render_cpu(prepared, o);
         }
-    } else if (use_vulkan) {
+    } else if (a.device == "vulkan") {
         result = lc::render_vulkan(prepared, o, lc::VulkanOptions{a.gpu, a.validation});
     } else {
         result = lc::render_cpu(prepared, o);
