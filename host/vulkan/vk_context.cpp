@@ -300,30 +300,33 @@ Context::Context(const VulkanOptions& options, MessageLog* log) {
 
 namespace lc {
 
-std::vector<std::string> list_vulkan_devices() {
-    std::vector<std::string> names;
+namespace {
+
+// The devices the loader reports, with why each is refused (handles are
+// not valid after return: the instance is gone). Empty without a loader or
+// a driver.
+std::vector<vk::PhysicalDeviceInfo> present_devices() {
     try {
         vk::MessageLog log;
         bool debug_utils = false;
         vk::Instance instance = vk::create_instance(false, &log, debug_utils);
-        for (const vk::PhysicalDeviceInfo& d : vk::physical_devices(instance.get()))
-            names.emplace_back(d.properties.deviceName);
+        return vk::physical_devices(instance.get());
     } catch (const std::runtime_error&) {
-        // No loader or no driver: no devices.
+        return {};
     }
+}
+
+}  // namespace
+
+std::vector<std::string> list_vulkan_devices() {
+    std::vector<std::string> names;
+    for (const vk::PhysicalDeviceInfo& d : present_devices()) names.emplace_back(d.properties.deviceName);
     return names;
 }
 
 bool vulkan_hardware_device_present() {
-    try {
-        vk::MessageLog log;
-        bool debug_utils = false;
-        vk::Instance instance = vk::create_instance(false, &log, debug_utils);
-        for (const vk::PhysicalDeviceInfo& d : vk::physical_devices(instance.get()))
-            if (d.refusal.empty() && d.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) return true;
-    } catch (const std::runtime_error&) {
-        // No loader or no driver: no devices.
-    }
+    for (const vk::PhysicalDeviceInfo& d : present_devices())
+        if (d.refusal.empty() && d.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) return true;
     return false;
 }
 
