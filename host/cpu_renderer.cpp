@@ -25,8 +25,7 @@ struct ThreadTotals {
 }  // namespace
 
 RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& options) {
-    if (options.method != "brute" && options.method != "lightcuts")
-        throw std::invalid_argument("unknown method '" + options.method + "' (brute or lightcuts)");
+    validate_render_options(options);
     const bool lightcuts = options.method == "lightcuts";
     const gpu::FrameParams frame = make_frame_params(prepared, options);
     auto start = std::chrono::steady_clock::now();

@@ -158,10 +158,7 @@ Renderer::Renderer(const Context& ctx, const PreparedScene& prepared, const Rend
       options_(options),
       tuning_(tuning),
       lightcuts_(options.method == "lightcuts") {
-    if (options.method != "brute" && options.method != "lightcuts")
-        throw std::invalid_argument("unknown render method '" + options.method +
-                                    "' (expected brute or lightcuts)");
-    if (options.spp == 0) throw std::invalid_argument("spp must be at least 1");
+    validate_render_options(options);
     frame_ = make_frame_params(prepared, options);
     light_chunk_ = std::max(frame_.light_count, 1u);
     if (tuning.lights_per_dispatch > 0) light_chunk_ = std::min(light_chunk_, tuning.lights_per_dispatch);

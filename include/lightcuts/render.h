@@ -11,6 +11,7 @@
 #include "image.h"
 #include "light_tree.h"
 #include "scene.h"
+#include "settings.h"
 
 namespace lc {
 
@@ -57,6 +58,10 @@ struct RenderResult {
     Image image;
     RenderStats stats;
 };
+
+// Throws std::invalid_argument naming the first option out of the ranges of
+// lightcuts/settings.h; both renderers call it on what they are given.
+void validate_render_options(const RenderOptions& options);
 
 // Frame constants for a tile of the image; shared by CPU and GPU paths.
 gpu::FrameParams make_frame_params(const PreparedScene& prepared, const RenderOptions& options);

@@ -1,0 +1,62 @@
+// One definition of the valid render settings (include/lightcuts/settings.h).
+#include "lightcuts/settings.h"
+
+#include "lightcuts/render.h"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace lc {
+namespace {
+
+std::string integer_problem(double value, double lo, double hi) {
+    auto text = [](double v) { return std::to_string(static_cast<long long>(v)); };
+    if (!std::isfinite(value) || value != std::floor(value) || value < lo || value > hi)
+        return "must be an integer from " + text(lo) + " to " + text(hi);
+    return "";
+}
+
+}  // namespace
+
+std::string setting_problem(std::string_view key, double value) {
+    constexpr double kMaxU32 = double(std::numeric_limits<std::uint32_t>::max());
+    if (key == kSettingSpp) return integer_problem(value, 1, kMaxSpp);
+    if (key == kSettingMaxCut) return integer_problem(value, 1, kMaxU32);
+    if (key == kSettingSeed) return integer_problem(value, 0, kMaxU32);
+    if (key == kSettingWidth || key == kSettingHeight) return integer_problem(value, 1, kMaxImageSide);
+    if (key == kSettingRelativeError) {
+        if (!(value >= 0.0 && value <= double(kMaxRelativeError)))
+            return "must be a number from 0 to " + std::to_string(kMaxRelativeError).substr(0, 3);
+        return "";
+    }
+    throw std::logic_error("setting_problem: unknown setting '" + std::string(key) + "'");
+}
+
+std::string method_problem(std::string_view method) {
+    if (method == "brute" || method == "lightcuts") return "";
+    return "must be \"brute\" or \"lightcuts\", got \"" + std::string(method) + "\"";
+}
+
+void validate_render_options(const RenderOptions& o) {
+    std::string problem = method_problem(o.method);
+    if (!problem.empty()) throw std::invalid_argument("method " + problem);
+    const std::pair<std::string_view, double> values[] = {
+        {kSettingSpp, o.spp},
+        {kSettingRelativeError, o.relative_error},
+        {kSettingMaxCut, o.max_cut},
+        {kSettingSeed, o.seed},
+    };
+    for (const auto& [key, value] : values) {
+        problem = setting_problem(key, value);
+        if (!problem.empty()) throw std::invalid_argument(std::string(key) + " " + problem);
+    }
+    // 0 means the camera's size.
+    for (const auto& [key, value] : {std::pair{kSettingWidth, o.width}, std::pair{kSettingHeight, o.height}}) {
+        if (value == 0) continue;
+        problem = setting_problem(key, value);
+        if (!problem.empty()) throw std::invalid_argument(std::string(key) + " " + problem);
+    }
+}
+
+}  // namespace lc

@@ -1,0 +1,37 @@
+// Render settings and their valid ranges, checked in one place: the scene
+// loader (a scene's "render" block), the command line and the renderers all
+// ask these functions, so a value is accepted or refused with the same
+// message wherever it comes from (docs/scene-format.md lists the ranges).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace lc {
+
+inline constexpr std::uint32_t kMaxSpp = 65536;        // camera rays per pixel
+inline constexpr std::uint32_t kMaxImageSide = 16384;  // width and height
+inline constexpr float kMaxRelativeError = 1.0f;       // lightcuts threshold, as a fraction
+// max_cut may be any positive 32-bit value: the cut heap is sized by the
+// light tree, never by max_cut (a cut cannot outgrow the tree).
+
+// Names of the settings as the scene file's render block spells them (the
+// command line uses the same words, with "--" and '-' for '_').
+inline constexpr std::string_view kSettingMethod = "method";
+inline constexpr std::string_view kSettingSpp = "spp";
+inline constexpr std::string_view kSettingRelativeError = "relative_error";
+inline constexpr std::string_view kSettingMaxCut = "max_cut";
+inline constexpr std::string_view kSettingSeed = "seed";
+inline constexpr std::string_view kSettingWidth = "width";
+inline constexpr std::string_view kSettingHeight = "height";
+
+// What is wrong with `value` for the numeric setting `key` (one of the
+// kSetting* names above, not method), or "" when it is valid. Integer
+// settings refuse fractions; NaN and infinities are refused everywhere.
+std::string setting_problem(std::string_view key, double value);
+
+// What is wrong with a method name, or "" for "brute" and "lightcuts".
+std::string method_problem(std::string_view method);
+
+}  // namespace lc
