@@ -65,13 +65,10 @@ struct Fixture {
         frame = lc::make_frame_params(prepared, o);
         heap.resize(frame.max_cut + 2);
         k = lc::cpu::make_shade_kernel(prepared, heap.data());
-        glm::vec3 origin(frame.cam_pos_x, frame.cam_pos_y, frame.cam_pos_z);
         for (std::uint32_t y = 0; y < 64; y += 4)
             for (std::uint32_t x = 0; x < 64; x += 4) {
-                glm::vec3 dir = k.lc_camera_ray_dir(frame, k.lc_pixel_sample(x, y, 0, 1, 1));
-                float t, b1, b2;
-                std::uint32_t tri = k.lc_trace_closest(origin, dir, k.kRayInfinity, t, b1, b2);
-                if (tri != lc::gpu::kInvalidIndex) points.push_back(k.lc_surface_point(tri, b1, b2, dir));
+                ShadeKernel::SurfacePoint sp;
+                if (k.lc_camera_hit(frame, x, y, 0, sp)) points.push_back(sp);
             }
     }
 };
@@ -83,10 +80,8 @@ void BM_ClusterBound(benchmark::State& state) {
     for (auto _ : state) {
         const auto& sp = f.points[i % f.points.size()];
         const auto& n = nodes[i % nodes.size()];
-        benchmark::DoNotOptimize(f.k.lc_cluster_bound(sp, f.prepared.scene.materials[sp.material],
-                                                      glm::vec3(n.min_x, n.min_y, n.min_z),
-                                                      glm::vec3(n.max_x, n.max_y, n.max_z), lc::gpu::kLightPoint,
-                                                      f.frame.min_distance2));
+        benchmark::DoNotOptimize(
+            f.k.lc_cluster_bound(sp, f.prepared.scene.materials[sp.material], n, f.frame.min_distance2));
         ++i;
     }
 }

@@ -7,6 +7,7 @@
 
 #include "lightcuts/render.h"
 #include "shared/types.h"
+#include "shared/color.h"
 #include "shared/glsl_compat.h"
 
 namespace lc::cpu {
@@ -26,8 +27,9 @@ struct TraceKernel {
 #undef LC_TRIANGLE
 };
 
-// Everything a pixel needs. `heap` must hold max(max_cut, 2) entries; one
-// kernel object per thread (make_shade_kernel binds one to a scene).
+// Everything a pixel needs. `heap` must hold tree.cut_heap_capacity(max_cut)
+// entries; one kernel object per thread (make_shade_kernel binds one to a
+// scene).
 struct ShadeKernel {
     const BvhNode* bvh_nodes = nullptr;
     const Triangle* triangles = nullptr;
@@ -55,6 +57,7 @@ struct ShadeKernel {
 #define LC_HEAP_STORE(i, e) (heap_high_water = max(heap_high_water, (i) + 1u), heap[i] = (e))
 #include "shared/trace.h"
 #include "shared/shading.h"
+#include "shared/brute.h"
 #include "shared/lightcuts.h"
 #undef LC_BVH_NODE
 #undef LC_TRIANGLE

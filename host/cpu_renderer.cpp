@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <exception>
 #include <stdexcept>
 #include <thread>
 
@@ -46,25 +47,20 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     std::atomic<std::uint32_t> tiles_done{0};
     std::vector<ThreadTotals> totals(threads);
     Progress progress(options.progress);
+    const std::uint32_t heap_capacity = prepared.tree.cut_heap_capacity(frame.max_cut);
 
-    auto worker = [&](unsigned thread_index) {
-        std::vector<gpu::CutEntry> heap(std::max<std::uint32_t>(frame.max_cut, 2u));
+    auto render_tiles = [&](ThreadTotals& t) {
+        std::vector<gpu::CutEntry> heap(lightcuts ? heap_capacity : 0);
         cpu::ShadeKernel k = cpu::make_shade_kernel(prepared, heap.data());
-        ThreadTotals& t = totals[thread_index];
-        const glm::vec3 origin(frame.cam_pos_x, frame.cam_pos_y, frame.cam_pos_z);
         for (std::uint32_t tile; (tile = next_tile.fetch_add(1)) < tile_count;) {
             std::uint32_t x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
             for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); ++y) {
                 for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); ++x) {
                     glm::vec3 sum(0.0f);
-                    std::uint32_t cut_sum = 0;
+                    std::uint64_t cut_sum = 0;
                     for (std::uint32_t s = 0; s < frame.spp; ++s) {
-                        glm::vec2 pixel = k.lc_pixel_sample(x, y, s, frame.spp, frame.seed);
-                        glm::vec3 dir = k.lc_camera_ray_dir(frame, pixel);
-                        float t_hit, b1, b2;
-                        std::uint32_t tri = k.lc_trace_closest(origin, dir, k.kRayInfinity, t_hit, b1, b2);
-                        if (tri == gpu::kInvalidIndex) continue;
-                        cpu::ShadeKernel::SurfacePoint sp = k.lc_surface_point(tri, b1, b2, dir);
+                        cpu::ShadeKernel::SurfacePoint sp;
+                        if (!k.lc_camera_hit(frame, x, y, s, sp)) continue;
                         cpu::ShadeKernel::ShadeStats ss{0u, 0u, 0u};
                         if (lightcuts) {
                             sum += k.lc_shade_lightcuts(sp, frame, ss);
@@ -77,10 +73,21 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
                     }
                     result.image.set(x, y, sum / float(frame.spp));
                     if (lightcuts)
-                        stats.cut_size[std::size_t(y) * frame.width + x] = float(cut_sum) / float(frame.spp);
+                        stats.cut_size[std::size_t(y) * frame.width + x] = float(double(cut_sum) / frame.spp);
                 }
             }
             progress.update(double(tiles_done.fetch_add(1) + 1) / tile_count);
+        }
+    };
+    // An exception in any worker (out of memory, say) stops the others at
+    // their next tile and reaches the caller as itself, not as terminate().
+    std::vector<std::exception_ptr> errors(threads);
+    auto worker = [&](unsigned thread_index) {
+        try {
+            render_tiles(totals[thread_index]);
+        } catch (...) {
+            errors[thread_index] = std::current_exception();
+            next_tile.store(tile_count);
         }
     };
     std::vector<std::thread> pool;
@@ -88,6 +95,8 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     worker(0);
     for (auto& th : pool) th.join();
     progress.finish();
+    for (const auto& e : errors)
+        if (e) std::rethrow_exception(e);
 
     for (const auto& t : totals) {
         stats.shadow_rays += t.shadow_rays;

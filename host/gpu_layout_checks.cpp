@@ -28,13 +28,12 @@ static_assert(sizeof(Light) == 32);
 static_assert(offsetof(Light, r) == 12);
 static_assert(offsetof(Light, type) == 24);
 
-static_assert(sizeof(LightNode) == 64);
+static_assert(sizeof(LightNode) == 48);
 static_assert(offsetof(LightNode, max_x) == 12);
 static_assert(offsetof(LightNode, intensity_r) == 24);
 static_assert(offsetof(LightNode, rep_light) == 36);
 static_assert(offsetof(LightNode, left) == 40);
 static_assert(offsetof(LightNode, flags) == 44);
-static_assert(offsetof(LightNode, cone_x) == 48);
 
 static_assert(sizeof(GBufferTexel) == 48);
 static_assert(offsetof(GBufferTexel, nx) == 12);
@@ -50,8 +49,10 @@ static_assert(offsetof(FrameParams, relative_error) == 28);
 static_assert(offsetof(FrameParams, max_cut) == 44);
 static_assert(offsetof(FrameParams, spp) == 60);
 static_assert(offsetof(FrameParams, width) == 64);
-static_assert(offsetof(FrameParams, root_point) == 80);
+static_assert(offsetof(FrameParams, roots) == 80);
+static_assert(sizeof(FrameParams::roots) == 4 * kLightTypeCount);
 static_assert(offsetof(FrameParams, tile_x) == 88);
 static_assert(offsetof(FrameParams, sample_index) == 104);
+static_assert(offsetof(FrameParams, loop_probe_rounds) == 108);
 
 }  // namespace lc::gpu

@@ -2,7 +2,7 @@
 // agglomerative clustering under the metric I_C * alpha_C^2 (the cone term
 // c^2 (1 - cos beta)^2 is zero while there are no oriented lights), where
 // I_C is the Rec.709 luminance of the cluster's RGB intensity sum and
-// alpha_C the diagonal of its box.
+// alpha_C the diagonal of its box. One tree per light type.
 //
 // kFast is locally-ordered clustering (Walter et al. 2008; the PLOC variant
 // of Meister and Bittner 2018): clusters sorted along a Morton curve, each
@@ -15,11 +15,15 @@
 // whose partner disappeared. O(n^2) time overall for typical inputs.
 #include "lightcuts/light_tree.h"
 
+#include "shared/color.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 #include <glm/glm.hpp>
@@ -31,24 +35,32 @@ constexpr int kWindow = 16;
 
 struct Cluster {
     glm::vec3 lo, hi;
-    glm::vec3 intensity;
-    float weight;          // luminance of intensity, the metric's I_C
+    // Summed in double: sums of many bright lights must neither overflow
+    // nor lose the small ones (the loader checks each type's total fits a float).
+    glm::dvec3 intensity;
+    double weight;         // luminance of intensity, the metric's I_C
     std::uint32_t rep;     // index into the input light array
     std::uint32_t left = gpu::kInvalidIndex, right = gpu::kInvalidIndex;  // build ids
     bool rep_from_right = false;
 };
 
-float luminance(glm::vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
-
-float merge_cost(const Cluster& a, const Cluster& b) {
-    glm::vec3 d = glm::max(a.hi, b.hi) - glm::min(a.lo, b.lo);
+double merge_cost(const Cluster& a, const Cluster& b) {
+    glm::dvec3 d = glm::dvec3(glm::max(a.hi, b.hi)) - glm::dvec3(glm::min(a.lo, b.lo));
     return (a.weight + b.weight) * glm::dot(d, d);
 }
 
-std::uint32_t hash32(std::uint32_t v) {
-    std::uint32_t state = v * 747796405u + 2891336453u;
-    std::uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
+// The point a light occupies in its tree's box: the position of a point
+// light, the unit direction of a directional light (Walter 2005 §4.1
+// clusters directional lights as points on the unit sphere). The one place
+// the builder looks at a light's type.
+glm::vec3 tree_point(const gpu::Light& l) {
+    switch (l.type) {
+        case gpu::kLightPoint:
+        case gpu::kLightDirectional:
+            return {l.x, l.y, l.z};
+        default:
+            throw std::invalid_argument("light tree: unknown light type " + std::to_string(l.type));
+    }
 }
 
 // Merges clusters a and b (build ids) into a new cluster appended to `all`.
@@ -66,8 +78,8 @@ void merge(std::vector<Cluster>& all, std::uint32_t a, std::uint32_t b, std::uin
     c.left = a;
     c.right = b;
     auto id = static_cast<std::uint32_t>(all.size());
-    float u = float(hash32(seed ^ hash32(id)) >> 8u) * (1.0f / 16777216.0f);
-    float p_left = c.weight > 0.0f ? ca.weight / c.weight : 0.5f;
+    double u = gpu::lc_unit_float(gpu::lc_hash(seed ^ gpu::lc_hash(id)));
+    double p_left = c.weight > 0.0 ? ca.weight / c.weight : 0.5;
     c.rep_from_right = u >= p_left;
     c.rep = c.rep_from_right ? cb.rep : ca.rep;
     all.push_back(c);
@@ -128,11 +140,11 @@ std::uint32_t cluster_fast(std::vector<Cluster>& all, std::vector<std::uint32_t>
             for (std::size_t i = begin; i < end; ++i) {
                 std::size_t jb = i >= std::size_t(kWindow) ? i - kWindow : 0;
                 std::size_t je = std::min(n, i + kWindow + 1);
-                float best_cost = std::numeric_limits<float>::infinity();
+                double best_cost = std::numeric_limits<double>::infinity();
                 std::size_t best_j = i == 0 ? 1 : i - 1;
                 for (std::size_t j = jb; j < je; ++j) {
                     if (j == i) continue;
-                    float cost = merge_cost(all[active[i]], all[active[j]]);
+                    double cost = merge_cost(all[active[i]], all[active[j]]);
                     // Ties go to the nearer index; between i - d and i + d to
                     // the right when i / d is even, else the left. Any choice
                     // at equal distance keeps the globally cheapest pair at the
@@ -182,14 +194,14 @@ std::uint32_t cluster_fast(std::vector<Cluster>& all, std::vector<std::uint32_t>
 
 std::uint32_t cluster_exact(std::vector<Cluster>& all, std::vector<std::uint32_t> active,
                             std::uint32_t seed) {
-    const float inf = std::numeric_limits<float>::infinity();
+    const double inf = std::numeric_limits<double>::infinity();
     std::vector<std::uint32_t> best(active.size());
-    std::vector<float> best_cost(active.size(), inf);
+    std::vector<double> best_cost(active.size(), inf);
     auto rescan = [&](std::size_t i) {
         best_cost[i] = inf;
         for (std::size_t j = 0; j < active.size(); ++j) {
             if (j == i) continue;
-            float c = merge_cost(all[active[i]], all[active[j]]);
+            double c = merge_cost(all[active[i]], all[active[j]]);
             if (c < best_cost[i]) {
                 best_cost[i] = c;
                 best[i] = static_cast<std::uint32_t>(j);
@@ -220,7 +232,7 @@ std::uint32_t cluster_exact(std::vector<Cluster>& all, std::vector<std::uint32_t
             if (best[i] == a || best[i] == b) {
                 rescan(i);
             } else {
-                float c = merge_cost(all[active[i]], all[active[a]]);
+                double c = merge_cost(all[active[i]], all[active[a]]);
                 if (c < best_cost[i]) {
                     best_cost[i] = c;
                     best[i] = static_cast<std::uint32_t>(a);
@@ -234,7 +246,8 @@ std::uint32_t cluster_exact(std::vector<Cluster>& all, std::vector<std::uint32_t
 // Writes the subtree of build id `id` into node slot `slot`: children take
 // two adjacent slots, lights are numbered in depth-first leaf order.
 void flatten(const std::vector<Cluster>& all, std::span<const gpu::Light> input, std::uint32_t root,
-             std::uint32_t base_slot, LightTree& tree) {
+             std::uint32_t type, std::uint32_t base_slot, LightTree& tree) {
+    const std::uint32_t type_bits = type << gpu::kNodeTypeShift;
     struct Item { std::uint32_t id, slot; };
     std::vector<Item> stack{{root, base_slot}};
     std::uint32_t next_slot = base_slot + 1;
@@ -247,17 +260,17 @@ void flatten(const std::vector<Cluster>& all, std::span<const gpu::Light> input,
         gpu::LightNode& n = tree.nodes[it.slot];
         n.min_x = c.lo.x; n.min_y = c.lo.y; n.min_z = c.lo.z;
         n.max_x = c.hi.x; n.max_y = c.hi.y; n.max_z = c.hi.z;
-        n.intensity_r = c.intensity.x; n.intensity_g = c.intensity.y; n.intensity_b = c.intensity.z;
+        n.intensity_r = float(c.intensity.x);
+        n.intensity_g = float(c.intensity.y);
+        n.intensity_b = float(c.intensity.z);
         n.rep_light = c.rep;  // remapped to leaf order below
-        n.cone_x = n.cone_y = n.cone_z = 0.0f;
-        n.cone_cos = -1.0f;
         if (c.left == gpu::kInvalidIndex) {
             n.left = gpu::kInvalidIndex;
-            n.flags = gpu::kNodeLeaf;
+            n.flags = gpu::kNodeLeaf | type_bits;
             leaf_slots.emplace_back(it.slot, c.rep);
         } else {
             n.left = next_slot;
-            n.flags = c.rep_from_right ? gpu::kNodeRepFromRight : 0u;
+            n.flags = (c.rep_from_right ? gpu::kNodeRepFromRight : 0u) | type_bits;
             next_slot += 2;
             stack.push_back({c.right, n.left + 1});
             stack.push_back({c.left, n.left});
@@ -274,20 +287,38 @@ void flatten(const std::vector<Cluster>& all, std::span<const gpu::Light> input,
 
 }  // namespace
 
+std::uint32_t LightTree::root_count() const {
+    std::uint32_t n = 0;
+    for (std::uint32_t root : roots) n += root != gpu::kInvalidIndex ? 1u : 0u;
+    return n;
+}
+
+std::uint32_t LightTree::cut_heap_capacity(std::uint32_t max_cut) const {
+    // Each tree of n lights has n - 1 interior nodes: nodes.size() - lights.size() in all.
+    const std::uint64_t interior = nodes.size() - lights.size();
+    const std::uint64_t cut = std::max<std::uint64_t>(max_cut, root_count());
+    return std::uint32_t(std::max<std::uint64_t>(1, std::min(interior, cut)));
+}
+
 LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t seed, TreeBuilder builder) {
     auto start = std::chrono::steady_clock::now();
     LightTree tree;
     tree.lights.reserve(lights.size());
-    for (std::uint32_t type : {gpu::kLightPoint, gpu::kLightDirectional}) {
+    for (const gpu::Light& l : lights) tree_point(l);  // unknown types fail before any work
+    for (std::uint32_t type = 0; type < gpu::kLightTypeCount; ++type) {
         std::vector<Cluster> all;
         std::vector<std::uint32_t> leaves;
         for (std::uint32_t i = 0; i < lights.size(); ++i) {
             const gpu::Light& l = lights[i];
             if (l.type != type) continue;
             Cluster c;
-            c.lo = c.hi = glm::vec3(l.x, l.y, l.z);
-            c.intensity = glm::vec3(l.r, l.g, l.b);
-            c.weight = luminance(c.intensity);
+            c.lo = c.hi = tree_point(l);
+            c.intensity = glm::dvec3(l.r, l.g, l.b);
+            c.weight = gpu::lc_luminance(glm::vec3(l.r, l.g, l.b));
+            if (!(c.weight > 0.0)) {
+                tree.black_lights += 1;
+                continue;
+            }
             c.rep = i;
             leaves.push_back(static_cast<std::uint32_t>(all.size()));
             all.push_back(c);
@@ -298,10 +329,10 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
                                                             : cluster_fast(all, leaves, seed ^ type);
         auto base = static_cast<std::uint32_t>(tree.nodes.size());
         tree.nodes.resize(tree.nodes.size() + 2 * leaves.size() - 1);
-        (type == gpu::kLightPoint ? tree.root_point : tree.root_directional) = base;
+        tree.roots[type] = base;
         // flatten() numbers lights from tree.lights.size() on, so the light
-        // indices of the second tree follow those of the first.
-        flatten(all, lights, root, base, tree);
+        // indices of each tree follow those of the one before.
+        flatten(all, lights, root, type, base, tree);
     }
     tree.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return tree;

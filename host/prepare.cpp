@@ -45,9 +45,12 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
     prepared.tree = build_light_tree(scene.lights, seed);
     for (const auto& m : scene.materials)
         prepared.has_specular |= (m.flags & gpu::kMaterialHasSpecular) != 0u;
-    float diagonal = glm::length(scene.bounds_max - scene.bounds_min);
-    float min_d = kMinDistanceRelative * diagonal;
-    prepared.min_distance2 = std::max(min_d * min_d, std::numeric_limits<float>::min());
+    // The geometry's size alone (Scene::bounds), in double: a far-away
+    // light or the size of the light set must not change it.
+    const glm::dvec3 extent = glm::dvec3(scene.bounds_max) - glm::dvec3(scene.bounds_min);
+    const double min_d = kMinDistanceRelative * glm::length(extent);
+    prepared.min_distance2 = float(std::clamp(min_d * min_d, double(std::numeric_limits<float>::min()),
+                                              double(std::numeric_limits<float>::max())));
     prepared.scene = std::move(scene);
     return prepared;
 }
@@ -74,13 +77,27 @@ gpu::FrameParams make_frame_params(const PreparedScene& prepared, const RenderOp
     f.spp = std::max(options.spp, 1u);
     f.seed = options.seed;
     f.light_count = static_cast<std::uint32_t>(prepared.tree.lights.size());
-    f.root_point = prepared.tree.root_point;
-    f.root_directional = prepared.tree.root_directional;
+    for (std::uint32_t t = 0; t < gpu::kLightTypeCount; ++t) f.roots[t] = prepared.tree.roots[t];
+    f.loop_probe_rounds = 2;
     f.tile_x = f.tile_y = 0;
     f.tile_width = f.width;
     f.tile_height = f.height;
     f.sample_index = 0;
     return f;
+}
+
+std::vector<SceneArray> scene_arrays(const PreparedScene& p) {
+    auto array = [](const char* name, const auto& v) {
+        return SceneArray{name, v.data(), sizeof(v[0]), v.size()};
+    };
+    return {
+        array("bvh_nodes", p.bvh.nodes),
+        array("triangles", p.scene.triangles),
+        array("normals", p.scene.normals),
+        array("materials", p.scene.materials),
+        array("lights", p.tree.lights),
+        array("light_tree_nodes", p.tree.nodes),
+    };
 }
 
 }  // namespace lc

@@ -6,9 +6,8 @@
 #extension GL_GOOGLE_include_directive : require
 
 #include "kernel.glsl"
-#include "heap.glsl"
 #define LC_LIGHT(i) lights[light_first + (i)]
-#include "shared/lightcuts.h"
+#include "shared/brute.h"
 
 void main() {
     uint i = lc_tile_pixel();

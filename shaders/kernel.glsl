@@ -39,6 +39,7 @@ layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_sta
 // LC_LIGHT is defined by each kernel (brute force offsets it by light_first).
 
 #include "shared/glsl_compat.h"
+#include "shared/color.h"
 #include "shared/trace.h"
 #include "shared/shading.h"
 
@@ -61,11 +62,13 @@ SurfacePoint lc_texel_surface(GBufferTexel g) {
 // llvmpipe (lavapipe) ends every loop of a shader invocation for good once
 // the invocation has run 65535 loop iterations in all (gallivm's loop
 // limiter), silently truncating long brute-force sums and deep cuts. A loop
-// that must run spp + 1 >= 2 rounds, and does not, shows it happened.
+// that must run 2 rounds, and does not, shows it happened.
 bool lc_loops_were_cut_short() {
+    // The round count comes from the push constants so that the compiler
+    // cannot unroll the loop; it is always 2 and independent of spp.
     uint rounds = 0u;
-    for (uint k = 0u; k <= frame.spp; ++k) rounds += 1u;
-    return rounds != frame.spp + 1u;
+    for (uint k = 0u; k < frame.loop_probe_rounds; ++k) rounds += 1u;
+    return rounds != frame.loop_probe_rounds;
 }
 
 // Samples are summed in sample order, the way the CPU reference sums them;

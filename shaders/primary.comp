@@ -12,20 +12,14 @@ void main() {
     uint x = frame.tile_x + i % frame.tile_width;
     uint y = frame.tile_y + i / frame.tile_width;
 
-    vec2 pixel = lc_pixel_sample(x, y, frame.sample_index, frame.spp, frame.seed);
-    vec3 dir = lc_camera_ray_dir(frame, pixel);
-    vec3 org = vec3(frame.cam_pos_x, frame.cam_pos_y, frame.cam_pos_z);
-    float t, b1, b2;
-    uint tri = lc_trace_closest(org, dir, kRayInfinity, t, b1, b2);
-
+    SurfacePoint sp;
     GBufferTexel g;
-    if (tri == kInvalidIndex) {
+    if (!lc_camera_hit(frame, x, y, frame.sample_index, sp)) {
         g.px = 0.0f; g.py = 0.0f; g.pz = 0.0f;
         g.nx = 0.0f; g.ny = 0.0f; g.nz = 0.0f;
         g.wo_x = 0.0f; g.wo_y = 0.0f; g.wo_z = 0.0f;
         g.material = kInvalidIndex;
     } else {
-        SurfacePoint sp = lc_surface_point(tri, b1, b2, dir);
         g.px = sp.p.x; g.py = sp.p.y; g.pz = sp.p.z;
         g.nx = sp.n.x; g.ny = sp.n.y; g.nz = sp.n.z;
         g.wo_x = sp.wo.x; g.wo_y = sp.wo.y; g.wo_z = sp.wo.z;

@@ -13,13 +13,26 @@ namespace {
 // Checks every structural promise of the flattened tree; returns nothing,
 // fails the test on the first broken invariant.
 void check_tree(const LightTree& tree, std::span<const gpu::Light> input) {
-    std::size_t n_point = 0, n_dir = 0;
-    for (const auto& l : input) (l.type == gpu::kLightPoint ? n_point : n_dir) += 1;
+    // Black lights stay out of the tree (and are counted).
+    std::size_t n_point = 0, n_dir = 0, n_black = 0;
+    for (const auto& l : input) {
+        if (l.r == 0.0f && l.g == 0.0f && l.b == 0.0f) n_black += 1;
+        else (l.type == gpu::kLightPoint ? n_point : n_dir) += 1;
+    }
     std::size_t expected = (n_point ? 2 * n_point - 1 : 0) + (n_dir ? 2 * n_dir - 1 : 0);
     ASSERT_EQ(tree.nodes.size(), expected);
-    ASSERT_EQ(tree.lights.size(), input.size());
-    ASSERT_EQ(tree.root_point, n_point ? 0u : gpu::kInvalidIndex);
-    ASSERT_EQ(tree.root_directional, n_dir ? std::uint32_t(n_point ? 2 * n_point - 1 : 0) : gpu::kInvalidIndex);
+    ASSERT_EQ(tree.lights.size(), n_point + n_dir);
+    ASSERT_EQ(tree.black_lights, n_black);
+    ASSERT_EQ(tree.roots[gpu::kLightPoint], n_point ? 0u : gpu::kInvalidIndex);
+    ASSERT_EQ(tree.roots[gpu::kLightDirectional],
+              n_dir ? std::uint32_t(n_point ? 2 * n_point - 1 : 0) : gpu::kInvalidIndex);
+    // Every node of a type's tree carries that type.
+    for (std::uint32_t type = 0; type < gpu::kLightTypeCount; ++type) {
+        const std::uint32_t root = tree.roots[type];
+        if (root == gpu::kInvalidIndex) continue;
+        const std::size_t count = 2 * (type == gpu::kLightPoint ? n_point : n_dir) - 1;
+        for (std::size_t i = root; i < root + count; ++i) ASSERT_EQ(test::node_type(tree.nodes[i]), type) << i;
+    }
 
     std::vector<int> light_seen(tree.lights.size(), 0);
     for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
@@ -57,7 +70,7 @@ void check_tree(const LightTree& tree, std::span<const gpu::Light> input) {
     for (std::size_t i = 0; i < light_seen.size(); ++i) ASSERT_EQ(light_seen[i], 1) << "light " << i;
 
     // Leaves appear in light order in a depth-first walk: subtrees are ranges.
-    for (std::uint32_t root : {tree.root_point, tree.root_directional}) {
+    for (std::uint32_t root : tree.roots) {
         if (root == gpu::kInvalidIndex) continue;
         std::vector<std::uint32_t> stack{root};
         std::uint32_t expected_light = tree.nodes[root].flags & gpu::kNodeLeaf ? tree.nodes[root].rep_light : 0;
@@ -149,8 +162,7 @@ TEST(LightTree, SameSeedSameTree) {
 TEST(LightTree, EmptyInputGivesNoTree) {
     LightTree t = build_light_tree({}, 1);
     EXPECT_TRUE(t.nodes.empty());
-    EXPECT_EQ(t.root_point, gpu::kInvalidIndex);
-    EXPECT_EQ(t.root_directional, gpu::kInvalidIndex);
+    for (std::uint32_t root : t.roots) EXPECT_EQ(root, gpu::kInvalidIndex);
 }
 
 }  // namespace

@@ -78,8 +78,9 @@ TEST(LightcutsBounds, EveryBoundIsConservative) {
         sp.n = n;
         sp.wo = wo;
         sp.material = 0;
-        glm::vec3 bound = k.lc_cluster_bound(sp, m, lo, hi, directional ? gpu::kLightDirectional : gpu::kLightPoint,
-                                             min_distance2);
+        glm::vec3 bound = k.lc_cluster_bound(
+            sp, m, test::node_with_box(lo, hi, directional ? gpu::kLightDirectional : gpu::kLightPoint),
+            min_distance2);
         ASSERT_TRUE(std::isfinite(bound.x) && std::isfinite(bound.y) && std::isfinite(bound.z)) << trial;
         if (bound.x + bound.y + bound.z == 0.0f) ++zero_bounds;
         for (const auto& p : pts) {
@@ -181,17 +182,13 @@ TEST(Lightcuts, MaxCutOneUsesTheRootRepresentative) {
     gpu::FrameParams f = make_frame_params(p, o);
     std::vector<gpu::CutEntry> heap(2);
     Kernel k = cpu::make_shade_kernel(p, heap.data());
-    const gpu::LightNode& root = p.tree.nodes[p.tree.root_point];
+    const gpu::LightNode& root = p.tree.nodes[p.tree.roots[gpu::kLightPoint]];
     glm::vec3 root_intensity(root.intensity_r, root.intensity_g, root.intensity_b);
     int lit = 0;
     for (std::uint32_t y = 0; y < 24; ++y)
         for (std::uint32_t x = 0; x < 24; ++x) {
-            glm::vec3 dir = k.lc_camera_ray_dir(f, k.lc_pixel_sample(x, y, 0, 1, f.seed));
-            float t, b1, b2;
-            std::uint32_t tri = k.lc_trace_closest(glm::vec3(f.cam_pos_x, f.cam_pos_y, f.cam_pos_z), dir,
-                                                   k.kRayInfinity, t, b1, b2);
-            ASSERT_NE(tri, gpu::kInvalidIndex);
-            Kernel::SurfacePoint sp = k.lc_surface_point(tri, b1, b2, dir);
+            Kernel::SurfacePoint sp;
+            ASSERT_TRUE(k.lc_camera_hit(f, x, y, 0, sp));
             Kernel::ShadeStats ss{0, 0, 0};
             glm::vec3 expected = k.lc_rep_unit(sp, root.rep_light, f.min_distance2, ss) * root_intensity;
             glm::vec3 got = r.image.at(x, y);

@@ -39,6 +39,20 @@ inline gpu::Light directional_light(glm::vec3 travel, glm::vec3 irradiance) {
 }
 
 // Adds a triangle with its face normal (or the given vertex normals).
+// A light tree node with the given box and light type, for bound tests.
+inline gpu::LightNode node_with_box(glm::vec3 lo, glm::vec3 hi, std::uint32_t type) {
+    gpu::LightNode n{};
+    n.min_x = lo.x; n.min_y = lo.y; n.min_z = lo.z;
+    n.max_x = hi.x; n.max_y = hi.y; n.max_z = hi.z;
+    n.flags = type << gpu::kNodeTypeShift;
+    return n;
+}
+
+// The type stored in a light tree node.
+inline std::uint32_t node_type(const gpu::LightNode& n) {
+    return (n.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask;
+}
+
 inline void add_triangle(Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, std::uint32_t material) {
     gpu::Triangle t{a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, material, 0u, 0u};
     glm::vec3 n = glm::normalize(glm::cross(b - a, c - a));

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "../../shaders/shared/types.h"
+#include "shared/types.h"
 
 namespace lc {
 

@@ -7,6 +7,8 @@
 
 #include <glm/glm.hpp>
 
+#include "shared/color.h"
+
 namespace lc {
 
 // Row-major, row 0 at the top, three floats per pixel.
@@ -27,8 +29,8 @@ struct Image {
     }
 };
 
-// Rec.709 luminance.
-inline float luminance(glm::vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+// Rec.709 luminance, as the kernels compute it.
+inline float luminance(glm::vec3 c) { return gpu::lc_luminance(c); }
 
 // File writers go through a temporary name in the same folder and rename on
 // success, so a failed write never leaves a half-written file. They throw

@@ -3,32 +3,46 @@
 // CPU reference and the Vulkan kernels.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
 
-#include "../../shaders/shared/types.h"
+#include "shared/types.h"
 
 namespace lc {
 
 struct LightTree {
-    // Point tree first (2*n_point - 1 nodes, root at 0), then the directional
-    // tree (root at root_directional). Lights are in leaf order, so a node's
-    // lights are a contiguous range; nodes' rep_light index into `lights`.
+    // One tree per light type that has lights, one after the other in type
+    // order (2n-1 nodes each); roots[type] is where each starts. Lights are
+    // in leaf order, so a node's lights are a contiguous range; nodes'
+    // rep_light index into `lights`.
     std::vector<gpu::LightNode> nodes;
     std::vector<gpu::Light> lights;
-    std::uint32_t root_point = gpu::kInvalidIndex;
-    std::uint32_t root_directional = gpu::kInvalidIndex;
+    std::array<std::uint32_t, gpu::kLightTypeCount> roots;
+    // Lights with zero intensity: left out of the tree (they would only
+    // widen the boxes of bright clusters) and out of `lights`.
+    std::size_t black_lights = 0;
     double build_seconds = 0.0;
+
+    LightTree() { roots.fill(gpu::kInvalidIndex); }
+
+    std::uint32_t root_count() const;
+    // The most entries a cut's heap can hold: the heap keeps only interior
+    // nodes, and never more than the cut (max(max_cut, roots) clusters).
+    // At least 1, whatever max_cut is.
+    std::uint32_t cut_heap_capacity(std::uint32_t max_cut) const;
 };
 
 enum class TreeBuilder {
-    kFast,    // kd-tree nearest neighbours + lazily invalidated priority queue
+    kFast,    // locally-ordered clustering over a Morton order (light_tree.cpp)
     kExact,   // exhaustive greedy pairing, O(n^2) per merge; small n only
 };
 
-// Builds both trees from lights of any types. Deterministic for a given seed
-// (representative choice) whatever the thread count.
+// Builds one tree per light type from lights of any types. Deterministic for
+// a given seed (representative choice) whatever the thread count. Cluster
+// intensities are summed in double; the loader has checked that every
+// type's total fits a float.
 LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t seed,
                            TreeBuilder builder = TreeBuilder::kFast);
 

@@ -29,6 +29,19 @@ struct PreparedScene {
 // Takes ownership of the scene; builds the BVH and the light tree.
 PreparedScene prepare_scene(Scene scene, std::uint32_t seed);
 
+// One array the kernels read, as raw bytes. scene_arrays() is the one list
+// of them: the Vulkan renderer uploads it (in this order, which is the order
+// of the bindings kBindingBvhNodes .. kBindingLightNodes) and the CLI
+// reports its sizes.
+struct SceneArray {
+    const char* name;         // "bvh_nodes", "triangles", ...
+    const void* data;
+    std::size_t element_bytes;
+    std::size_t count;
+    std::uint64_t bytes() const { return std::uint64_t(element_bytes) * count; }
+};
+std::vector<SceneArray> scene_arrays(const PreparedScene& prepared);
+
 struct RenderOptions {
     std::string method = "brute";     // "brute" or "lightcuts"
     std::uint32_t width = 0, height = 0;  // 0: the scene's camera size

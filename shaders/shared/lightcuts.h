@@ -1,6 +1,5 @@
-// Per-point shading: brute force over all lights, and the Lightcuts cut
-// selection (Walter et al. 2005, section 4). Shared by the CPU reference and
-// the Vulkan kernels; needs trace.h and shading.h first.
+// The Lightcuts cut selection (Walter et al. 2005, section 4). Shared by the
+// CPU reference and the Vulkan kernels; needs trace.h and shading.h first.
 //
 // The includer defines:
 //   LC_LIGHT_NODE(i)        -> LightNode
@@ -11,51 +10,15 @@
 // No include guard: each kernel context (a GLSL shader, a C++ kernel
 // struct in host/cpu_kernel.h) includes it exactly once.
 
-// Statistics of one shaded point.
-struct ShadeStats {
-    uint cut_size;      // clusters in the final cut
-    uint shadow_rays;   // rays actually traced
-    uint hit_max_cut;   // 1 if refinement stopped at max_cut, not at the threshold
-};
-
-// Exact direct lighting: every light, one shadow ray each where it can
-// contribute at all.
-vec3 lc_shade_brute(SurfacePoint sp, uint light_count, float min_distance2,
-                    LC_INOUT(ShadeStats) stats) {
-    vec3 sum = vec3(0.0f);
-    for (uint i = 0u; i < light_count; ++i) {
-        Light light = LC_LIGHT(i);
-        vec3 wi;
-        float t_max;
-        vec3 unit = lc_light_unit(sp, light, min_distance2, wi, t_max);
-        vec3 contribution = unit * lc_light_intensity(light);
-        if (contribution.x + contribution.y + contribution.z > 0.0f) {
-            stats.shadow_rays += 1u;
-            if (lc_visible(sp, wi, t_max)) sum += contribution;
-        }
-    }
-    return sum;
-}
-
 vec3 lc_node_intensity(LightNode node) {
     return vec3(node.intensity_r, node.intensity_g, node.intensity_b);
 }
-
-vec3 lc_node_min(LightNode node) { return vec3(node.min_x, node.min_y, node.min_z); }
-vec3 lc_node_max(LightNode node) { return vec3(node.max_x, node.max_y, node.max_z); }
-
-float lc_luminance(vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 // Unscaled contribution of a light (material * geometry * visibility):
 // the representative's estimate is this times the cluster's RGB intensity.
 vec3 lc_rep_unit(SurfacePoint sp, uint light_index, float min_distance2,
                  LC_INOUT(ShadeStats) stats) {
-    vec3 wi;
-    float t_max;
-    vec3 unit = lc_light_unit(sp, LC_LIGHT(light_index), min_distance2, wi, t_max);
-    if (unit.x + unit.y + unit.z <= 0.0f) return vec3(0.0f);
-    stats.shadow_rays += 1u;
-    return lc_visible(sp, wi, t_max) ? unit : vec3(0.0f);
+    return lc_light_unit_shadowed(sp, LC_LIGHT(light_index), min_distance2, stats);
 }
 
 void lc_heap_push(LC_INOUT(uint) size, CutEntry e) {
@@ -99,8 +62,7 @@ void lc_heap_pop(LC_INOUT(uint) size) {
 // all; leaves are final (exact, zero error) and go to leaf_sum, refinable
 // interior nodes go to the heap. `inherited` is true when the caller already
 // knows the representative's unit contribution (shared with the parent).
-void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, uint light_type,
-                    bool inherited, vec3 inherited_unit, float min_distance2,
+void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, bool inherited, vec3 inherited_unit, float min_distance2,
                     LC_INOUT(uint) heap_size, LC_INOUT(vec3) leaf_sum,
                     LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
     LightNode node = LC_LIGHT_NODE(node_index);
@@ -108,8 +70,7 @@ void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, uint light_typ
     bool leaf = (node.flags & kNodeLeaf) != 0u;
     float error = 0.0f;
     if (!leaf) {
-        vec3 bound = lc_cluster_bound(sp, m, lc_node_min(node), lc_node_max(node), light_type,
-                                      min_distance2);
+        vec3 bound = lc_cluster_bound(sp, m, node, min_distance2);
         error = lc_luminance(bound * intensity);
         // A cluster whose bound is zero contributes exactly zero: no ray.
         if (!(error > 0.0f)) return;
@@ -144,14 +105,10 @@ void lc_cut_start(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_
     heap_sum = vec3(0.0f);
     stats.cut_size = 0u;
     uint root_count = 0u;
-    if (f.root_point != kInvalidIndex) {
-        lc_add_cluster(sp, m, f.root_point, kLightPoint, false, vec3(0.0f), f.min_distance2,
-                       heap_size, leaf_sum, heap_sum, stats);
-        root_count += 1u;
-    }
-    if (f.root_directional != kInvalidIndex) {
-        lc_add_cluster(sp, m, f.root_directional, kLightDirectional, false, vec3(0.0f),
-                       f.min_distance2, heap_size, leaf_sum, heap_sum, stats);
+    for (uint type = 0u; type < kLightTypeCount; ++type) {
+        if (f.roots[type] == kInvalidIndex) continue;
+        lc_add_cluster(sp, m, f.roots[type], false, vec3(0.0f), f.min_distance2, heap_size,
+                       leaf_sum, heap_sum, stats);
         root_count += 1u;
     }
     stats.cut_size = root_count;
@@ -173,12 +130,11 @@ bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) he
     LightNode node = LC_LIGHT_NODE(top.node);
     vec3 unit = vec3(top.unit_r, top.unit_g, top.unit_b);
     heap_sum -= unit * lc_node_intensity(node);
-    uint light_type = top.node >= f.root_directional ? kLightDirectional : kLightPoint;
     bool right_shares = (node.flags & kNodeRepFromRight) != 0u;
-    lc_add_cluster(sp, m, node.left, light_type, !right_shares, unit, f.min_distance2,
-                   heap_size, leaf_sum, heap_sum, stats);
-    lc_add_cluster(sp, m, node.left + 1u, light_type, right_shares, unit, f.min_distance2,
-                   heap_size, leaf_sum, heap_sum, stats);
+    lc_add_cluster(sp, m, node.left, !right_shares, unit, f.min_distance2, heap_size, leaf_sum,
+                   heap_sum, stats);
+    lc_add_cluster(sp, m, node.left + 1u, right_shares, unit, f.min_distance2, heap_size,
+                   leaf_sum, heap_sum, stats);
     stats.cut_size += 1u;
     return true;
 }

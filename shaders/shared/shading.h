@@ -18,15 +18,6 @@ LC_KCONST float kPi = 3.14159265358979f;
 LC_KCONST float kBoundSlack = 1.0f + 1e-5f;
 LC_KCONST float kCosineAbsSlack = 1e-6f;
 
-// --- Random numbers for pixel jitter: PCG hash, identical on CPU and GPU.
-uint lc_hash(uint v) {
-    uint state = v * 747796405u + 2891336453u;
-    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
-
-float lc_unit_float(uint h) { return float(h >> 8u) * (1.0f / 16777216.0f); }
-
 // Position on the image plane of sample `s` of `spp` in pixel (x, y):
 // spp = 1 is the pixel centre; otherwise stratified over a cols x rows grid,
 // jittered within each stratum by the seeded hash.
@@ -84,6 +75,25 @@ SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) 
     return sp;
 }
 
+// A camera sample's first hit: sample `s` of pixel (x, y) traced into the
+// scene. False when the ray leaves the scene.
+bool lc_camera_hit(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp) {
+    vec3 dir = lc_camera_ray_dir(f, lc_pixel_sample(x, y, s, f.spp, f.seed));
+    vec3 org = vec3(f.cam_pos_x, f.cam_pos_y, f.cam_pos_z);
+    float t, b1, b2;
+    uint tri = lc_trace_closest(org, dir, kRayInfinity, t, b1, b2);
+    if (tri == kInvalidIndex) return false;
+    sp = lc_surface_point(tri, b1, b2, dir);
+    return true;
+}
+
+// Statistics of one shaded point.
+struct ShadeStats {
+    uint cut_size;      // clusters in the final cut
+    uint shadow_rays;   // rays actually traced
+    uint hit_max_cut;   // 1 if refinement stopped at max_cut, not at the threshold
+};
+
 // --- BRDF: Lambert kd/pi plus GGX with constant Fresnel ks and separable
 // Smith shadowing. The returned value is f * cos(theta_i); the GGX term is
 // written as D * G1(wi) * G1(wo) / (4 cos_o) so no division by cos_i occurs.
@@ -120,27 +130,38 @@ vec3 lc_brdf_cos(Material m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
 // One light's contribution per unit intensity (material * geometry), with
 // the shadow ray it needs: direction, and length (kRayInfinity for
 // directional lights). Zero when the light is behind the surface.
+// Walter 2005 §3: the one place where a light's type decides its emission;
+// everything else reads the light tree's nodes.
 vec3 lc_light_unit(SurfacePoint sp, Light light, float min_distance2, LC_OUT(vec3) wi,
                    LC_OUT(float) t_max) {
     vec3 lp = vec3(light.x, light.y, light.z);
-    float geometry = 1.0f;
-    if (light.type == kLightPoint) {
-        vec3 to_light = lp - sp.p;
-        float d2 = dot(to_light, to_light);
-        float d = sqrt(d2);
-        // A light exactly at the shaded point has no direction: it adds
-        // nothing (the cosine bound of such a cluster is zero as well).
-        if (!(d > 0.0f)) {
+    float geometry;
+    switch (light.type) {
+        case kLightPoint: {
+            vec3 to_light = lp - sp.p;
+            float d2 = dot(to_light, to_light);
+            float d = sqrt(d2);
+            // A light exactly at the shaded point has no direction: it adds
+            // nothing (the cosine bound of such a cluster is zero as well).
+            if (!(d > 0.0f)) {
+                wi = sp.n;
+                t_max = 0.0f;
+                return vec3(0.0f);
+            }
+            wi = to_light / d;
+            t_max = d * (1.0f - kShadowEndRelative);
+            geometry = 1.0f / max(d2, min_distance2);
+            break;
+        }
+        case kLightDirectional:
+            wi = lp;
+            t_max = kRayInfinity;
+            geometry = 1.0f;
+            break;
+        default:  // the loader and the tree builder admit no other type
             wi = sp.n;
             t_max = 0.0f;
             return vec3(0.0f);
-        }
-        wi = to_light / d;
-        t_max = d * (1.0f - kShadowEndRelative);
-        geometry = 1.0f / max(d2, min_distance2);
-    } else {
-        wi = lp;
-        t_max = kRayInfinity;
     }
     float cos_i = dot(sp.n, wi);
     if (cos_i <= 0.0f) return vec3(0.0f);
@@ -149,6 +170,18 @@ vec3 lc_light_unit(SurfacePoint sp, Light light, float min_distance2, LC_OUT(vec
 
 bool lc_visible(SurfacePoint sp, vec3 wi, float t_max) {
     return !kEnableShadows || !lc_trace_any(sp.p, wi, t_max);
+}
+
+// lc_light_unit times visibility: one shadow ray, counted in stats, where
+// the light can contribute at all.
+vec3 lc_light_unit_shadowed(SurfacePoint sp, Light light, float min_distance2,
+                            LC_INOUT(ShadeStats) stats) {
+    vec3 wi;
+    float t_max;
+    vec3 unit = lc_light_unit(sp, light, min_distance2, wi, t_max);
+    if (!(unit.x + unit.y + unit.z > 0.0f)) return vec3(0.0f);
+    stats.shadow_rays += 1u;
+    return lc_visible(sp, wi, t_max) ? unit : vec3(0.0f);
 }
 
 vec3 lc_light_intensity(Light light) { return vec3(light.r, light.g, light.b); }
@@ -229,20 +262,24 @@ float lc_ggx_bound(Material m, vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec3 
            kBoundSlack;
 }
 
-// Bound of material * geometry (per unit intensity, RGB) for a cluster with
-// the node's box. Point lights: the box holds positions, G <= 1/d_min^2 with
-// the same clamp as the exact term. Directional lights: the box holds unit
-// directions, so x is the origin and G = 1.
-vec3 lc_cluster_bound(SurfacePoint sp, Material m, vec3 box_min, vec3 box_max, uint light_type,
-                      float min_distance2) {
-    vec3 x = light_type == kLightPoint ? sp.p : vec3(0.0f);
+uint lc_node_type(LightNode node) { return (node.flags >> kNodeTypeShift) & kNodeTypeMask; }
+
+// Bound of material * geometry (per unit intensity, RGB) over every light of
+// a cluster, read from its node. Point lights: the box holds positions,
+// G <= 1/d_min^2 with the same clamp as the exact term. Directional lights:
+// the box holds unit directions, so x is the origin and G = 1.
+vec3 lc_cluster_bound(SurfacePoint sp, Material m, LightNode node, float min_distance2) {
+    vec3 box_min = vec3(node.min_x, node.min_y, node.min_z);
+    vec3 box_max = vec3(node.max_x, node.max_y, node.max_z);
+    bool positional = lc_node_type(node) == kLightPoint;
+    vec3 x = positional ? sp.p : vec3(0.0f);
     float cos_bound = lc_cosine_bound(box_min, box_max, x, sp.n);
     if (cos_bound <= 0.0f) return vec3(0.0f);
     vec3 bound = lc_kd(m) * (cos_bound / kPi);
     if (kEnableGgx && (m.flags & kMaterialHasSpecular) != 0u)
         bound += lc_ks(m) * lc_ggx_bound(m, box_min, box_max, x, sp.n, sp.wo);
     float geometry = 1.0f;
-    if (light_type == kLightPoint)
+    if (positional)
         geometry = kBoundSlack / max(lc_box_distance2(box_min, box_max, sp.p), min_distance2);
     return bound * geometry;
 }

@@ -23,13 +23,19 @@ LC_CONST uint kInvalidIndex = 0xFFFFFFFFu;
 LC_CONST uint kBvhStackSize = 32u;    // build caps the BVH depth below this
 LC_CONST uint kBvhMaxLeafTriangles = 4u;
 
-LC_CONST uint kLightPoint = 0u;
-LC_CONST uint kLightDirectional = 1u;
+// Light types. Each type has its own light tree (FrameParams.roots[type]);
+// the type is also stored in every node (LightNode.flags), so the cut code
+// never needs to know which tree a node came from. docs/lightcuts.md says
+// how to add a type.
+LC_CONST uint kLightPoint = 0u;        // position, radiant intensity (W/sr)
+LC_CONST uint kLightDirectional = 1u;  // unit direction towards the light, irradiance (W/m^2)
 LC_CONST uint kLightTypeCount = 2u;
 
-// LightNode.flags
+// LightNode.flags: bits 0-1 as below, bits 8-15 the light type.
 LC_CONST uint kNodeLeaf = 1u;          // node is a single light
 LC_CONST uint kNodeRepFromRight = 2u;  // representative is the right child's
+LC_CONST uint kNodeTypeShift = 8u;
+LC_CONST uint kNodeTypeMask = 0xFFu;
 
 // Material.flags
 LC_CONST uint kMaterialHasSpecular = 1u;
@@ -82,18 +88,17 @@ struct Light {
     uint pad0;
 };
 
-// Light tree node (64 bytes); one array of 2n-1 nodes per light type, root
+// Light tree node (48 bytes); one array of 2n-1 nodes per light type, root
 // first. Interior: children are left and left + 1. Leaf: light == rep_light.
 // The box bounds the positions (point lights) or the unit directions
-// (directional lights). cone_* is reserved for oriented lights.
+// (directional lights) of the cluster's lights.
 struct LightNode {
     float min_x, min_y, min_z;
     float max_x, max_y, max_z;
     float intensity_r, intensity_g, intensity_b;  // sum over the cluster
     uint rep_light;   // index into the leaf-ordered light array
     uint left;        // first child index; kInvalidIndex for leaves
-    uint flags;       // kNode* bits
-    float cone_x, cone_y, cone_z, cone_cos;       // reserved, cos = -1
+    uint flags;       // kNode* bits and the light type
 };
 
 // Per-pixel surface record written by the camera-ray kernel (48 bytes).
@@ -128,12 +133,11 @@ struct FrameParams {
     float cam_fwd_x, cam_fwd_y, cam_fwd_z;
     uint spp;
     uint width, height, seed, light_count;
-    uint root_point;              // light tree roots; kInvalidIndex if absent
-    uint root_directional;
+    uint roots[kLightTypeCount];  // root node of each type's tree; kInvalidIndex if absent
     uint tile_x, tile_y;          // first pixel of the dispatched tile
     uint tile_width, tile_height;
     uint sample_index;            // which of the spp samples this pass renders
-    uint pad0;
+    uint loop_probe_rounds;       // always 2: see lc_loops_were_cut_short (shaders/kernel.glsl)
 };
 
 #ifdef __cplusplus

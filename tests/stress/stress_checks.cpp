@@ -30,10 +30,15 @@ std::string current_test_name() {
 
 std::vector<NodeRange> check_tree(const PreparedScene& p) {
     const LightTree& tree = p.tree;
-    std::size_t n_point = 0, n_dir = 0;
-    for (const auto& l : p.scene.lights) (l.type == gpu::kLightPoint ? n_point : n_dir) += 1;
+    // Black lights stay out of the tree.
+    std::size_t n_point = 0, n_dir = 0, n_black = 0;
+    for (const auto& l : p.scene.lights) {
+        if (l.r == 0.0f && l.g == 0.0f && l.b == 0.0f) n_black += 1;
+        else (l.type == gpu::kLightPoint ? n_point : n_dir) += 1;
+    }
     EXPECT_EQ(tree.nodes.size(), (n_point ? 2 * n_point - 1 : 0) + (n_dir ? 2 * n_dir - 1 : 0));
-    EXPECT_EQ(tree.lights.size(), p.scene.lights.size());
+    EXPECT_EQ(tree.lights.size(), n_point + n_dir);
+    EXPECT_EQ(tree.black_lights, n_black);
     EXPECT_TRUE(std::isfinite(p.min_distance2) && p.min_distance2 > 0.0f) << p.min_distance2;
     for (const auto& b : p.bvh.nodes)
         EXPECT_TRUE(finite({b.min_x, b.min_y, b.min_z}) && finite({b.max_x, b.max_y, b.max_z}));
@@ -89,9 +94,9 @@ std::vector<NodeRange> check_tree(const PreparedScene& p) {
         if (n.rep_light < ranges[i].first || n.rep_light >= ranges[i].first + ranges[i].count)
             fail(i, "representative outside the cluster");
     }
-    for (std::uint32_t root : {tree.root_point, tree.root_directional}) {
+    for (std::uint32_t root : tree.roots) {
         if (root == gpu::kInvalidIndex) continue;
-        const std::size_t expected = root == tree.root_point ? n_point : n_dir;
+        const std::size_t expected = root == tree.roots[gpu::kLightPoint] ? n_point : n_dir;
         EXPECT_EQ(ranges[root].count, expected) << "root " << root;
     }
     if (reports > kMaxReports) ADD_FAILURE() << reports << " tree invariant failures in all";
@@ -104,15 +109,11 @@ std::vector<ShadingPoint> shading_points(const PreparedScene& p, const RenderOpt
     k.bvh_nodes = p.bvh.nodes.data();
     k.triangles = p.scene.triangles.data();
     k.normals = p.scene.normals.data();
-    const glm::vec3 origin(f.cam_pos_x, f.cam_pos_y, f.cam_pos_z);
     std::vector<ShadingPoint> points;
     for (std::uint32_t y = 0; y < f.height; ++y)
         for (std::uint32_t x = 0; x < f.width; ++x) {
-            const glm::vec3 dir = k.lc_camera_ray_dir(f, k.lc_pixel_sample(x, y, 0, 1, f.seed));
-            float t, b1, b2;
-            const std::uint32_t tri = k.lc_trace_closest(origin, dir, k.kRayInfinity, t, b1, b2);
-            if (tri == gpu::kInvalidIndex) continue;
-            points.push_back({x, y, k.lc_surface_point(tri, b1, b2, dir)});
+            Kernel::SurfacePoint sp;
+            if (k.lc_camera_hit(f, x, y, 0, sp)) points.push_back({x, y, sp});
         }
     return points;
 }
@@ -130,11 +131,12 @@ BoundStats check_bounds(const PreparedScene& p, const std::vector<NodeRange>& ra
         how.max_nodes ? std::min(how.max_nodes, tree.nodes.size()) : tree.nodes.size();
     // With a node cap, check the top of both trees: the first slots of each.
     std::vector<std::uint32_t> nodes;
-    for (std::uint32_t root : {tree.root_point, tree.root_directional}) {
+    for (std::uint32_t type = 0; type < gpu::kLightTypeCount; ++type) {
+        const std::uint32_t root = tree.roots[type];
         if (root == gpu::kInvalidIndex) continue;
-        const std::uint32_t end = root == tree.root_point && tree.root_directional != gpu::kInvalidIndex
-                                      ? tree.root_directional
-                                      : std::uint32_t(tree.nodes.size());
+        std::uint32_t end = std::uint32_t(tree.nodes.size());
+        for (std::uint32_t other : tree.roots)
+            if (other != gpu::kInvalidIndex && other > root) end = std::min(end, other);
         for (std::uint32_t i = root; i < end && (how.max_nodes == 0 || i - root < node_count); ++i)
             nodes.push_back(i);
     }
@@ -143,12 +145,9 @@ BoundStats check_bounds(const PreparedScene& p, const std::vector<NodeRange>& ra
         const gpu::Material& m = p.scene.materials[s.sp.material];
         for (std::uint32_t ni : nodes) {
             const gpu::LightNode& n = tree.nodes[ni];
-            const std::uint32_t type =
-                tree.root_directional != gpu::kInvalidIndex && ni >= tree.root_directional
-                    ? gpu::kLightDirectional
-                    : gpu::kLightPoint;
+            const std::uint32_t type = (n.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask;
             const glm::vec3 lo = node_min(n), hi = node_max(n);
-            const glm::vec3 bound = k.lc_cluster_bound(s.sp, m, lo, hi, type, p.min_distance2);
+            const glm::vec3 bound = k.lc_cluster_bound(s.sp, m, n, p.min_distance2);
             if (!finite(bound) || glm::any(glm::lessThan(bound, glm::vec3(0.0f)))) {
                 ++failures;
                 if (reports++ < kMaxReports)
@@ -274,7 +273,7 @@ CpuRenders run_cpu_checks(const PreparedScene& p, const RenderOptions& lightcuts
     EXPECT_GT(points.size(), 0u) << what << ": no camera ray hits the scene";
     out.shading_points = points.size();
     out.bounds = check_bounds(p, ranges, points, how);
-    for (std::uint32_t root : {p.tree.root_point, p.tree.root_directional})
+    for (std::uint32_t root : p.tree.roots)
         if (root != gpu::kInvalidIndex) out.tree_height = std::max(out.tree_height, ranges[root].height);
     std::printf("[ stress   ] %s: tree height %u, %zu shading points, %llu bound checks, %llu inside a box, "
                 "%llu zero bounds\n",

@@ -296,8 +296,8 @@ TEST(StressTree, CoincidentAndBlackLightsGiveABalancedTree) {
     const PreparedScene p = prepare_scene(std::move(s), 1);
     const std::vector<stress::NodeRange> ranges = stress::check_tree(p);
     // 40000 point lights: a balanced tree is 17 levels tall.
-    EXPECT_LE(ranges[p.tree.root_point].height, 2u * 17u);
-    EXPECT_LE(ranges[p.tree.root_directional].height, 2u * 16u);
+    EXPECT_LE(ranges[p.tree.roots[gpu::kLightPoint]].height, 2u * 17u);
+    EXPECT_LE(ranges[p.tree.roots[gpu::kLightDirectional]].height, 2u * 16u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Cases, Stress, ::testing::ValuesIn(kCases),

@@ -45,20 +45,17 @@ constexpr float kPi = 3.14159265358979f;
 std::uint64_t count_spilling_samples(const PreparedScene& p, const RenderOptions& o,
                                      std::uint32_t shared_slots) {
     const gpu::FrameParams f = make_frame_params(p, o);
-    std::vector<gpu::CutEntry> heap(std::max(f.max_cut, 2u));
+    std::vector<gpu::CutEntry> heap(p.tree.cut_heap_capacity(f.max_cut));
     lc::cpu::ShadeKernel k = lc::cpu::make_shade_kernel(p, heap.data());
-    const glm::vec3 origin(f.cam_pos_x, f.cam_pos_y, f.cam_pos_z);
     std::uint64_t spilled = 0;
     for (std::uint32_t y = 0; y < f.height; ++y)
         for (std::uint32_t x = 0; x < f.width; ++x)
             for (std::uint32_t s = 0; s < f.spp; ++s) {
-                glm::vec3 dir = k.lc_camera_ray_dir(f, k.lc_pixel_sample(x, y, s, f.spp, f.seed));
-                float t, b1, b2;
-                std::uint32_t tri = k.lc_trace_closest(origin, dir, k.kRayInfinity, t, b1, b2);
-                if (tri == gpu::kInvalidIndex) continue;
+                lc::cpu::ShadeKernel::SurfacePoint sp;
+                if (!k.lc_camera_hit(f, x, y, s, sp)) continue;
                 lc::cpu::ShadeKernel::ShadeStats stats{0u, 0u, 0u};
                 k.heap_high_water = 0;
-                k.lc_shade_lightcuts(k.lc_surface_point(tri, b1, b2, dir), f, stats);
+                k.lc_shade_lightcuts(sp, f, stats);
                 spilled += k.heap_high_water > shared_slots ? 1 : 0;
             }
     return spilled;
