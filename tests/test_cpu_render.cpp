@@ -168,5 +168,25 @@ TEST(CpuRender, UnknownMethodIsRejected) {
     EXPECT_THROW(render_cpu(p, test::options("path", 8)), std::invalid_argument);
 }
 
+
+// The inverse-square clamp d_min is 1e-4 of the geometry's diagonal. It
+// once covered the point lights too: one light at y = 1e4 made d_min 1 m in
+// a 2 m room and darkened every surface near a light several times over.
+// A far light of tiny intensity must now change neither d_min nor the image
+// beyond its own (negligible) contribution.
+TEST(CpuRender, FarLightDoesNotChangeTheDistanceClamp) {
+    auto lights = test::random_point_lights(50, {-0.9f, 0.05f, -0.9f}, {0.9f, 1.95f, 0.9f}, 10.0f, 5);
+    PreparedScene near_only = prepare_scene(test::room_scene(lights, 16), 1);
+    lights.push_back(test::point_light({0.0f, 1e4f, 0.0f}, glm::vec3(1e-3f)));
+    PreparedScene with_far = prepare_scene(test::room_scene(lights, 16), 1);
+    EXPECT_EQ(with_far.min_distance2, near_only.min_distance2);
+    const float diagonal = std::sqrt(2.0f * 2.0f * 3.0f);  // the room is 2 x 2 x 2
+    EXPECT_NEAR(std::sqrt(with_far.min_distance2), 1e-4f * diagonal, 1e-9f);
+    const RenderResult a = render_cpu(near_only, test::options("brute", 16));
+    const RenderResult b = render_cpu(with_far, test::options("brute", 16));
+    // The far light lies outside the closed room: it adds nothing.
+    EXPECT_LT(compare_images(b.image, a.image).relative_rmse, 1e-6);
+}
+
 }  // namespace
 }  // namespace lc

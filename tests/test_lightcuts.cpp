@@ -1,5 +1,6 @@
 // Lightcuts on the CPU: conservative bounds, cut selection, accuracy, cost.
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <numeric>
 #include <random>
@@ -25,8 +26,9 @@ glm::vec3 random_unit(std::mt19937& rng) {
 
 // Over 2 x 10^5 random cases (cluster box with lights inside, shaded point
 // outside, inside or on the box, normals random or grazing, Lambert or GGX
-// of random roughness, random view direction), the bound of material *
-// geometry is at least the exact value for every light of the cluster.
+// of random roughness down to the loader's floor, random view direction),
+// the bound of material * geometry is at least the exact value for every
+// light of the cluster.
 TEST(LightcutsBounds, EveryBoundIsConservative) {
     std::mt19937 rng(12345);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
@@ -39,8 +41,9 @@ TEST(LightcutsBounds, EveryBoundIsConservative) {
         const bool directional = trial % 5 == 0;
         gpu::Material& m = materials[0];
         glm::vec3 kd(u(rng), u(rng), u(rng));
+        // GGX alpha log-uniform from 1e-3 (the loader's floor) to 1.
         m = trial % 2 ? test::lambert(kd)
-                      : test::glossy(kd, glm::vec3(u(rng), u(rng), u(rng)), std::max(0.02f, u(rng)));
+                      : test::glossy(kd, glm::vec3(u(rng), u(rng), u(rng)), std::pow(10.0f, -3.0f * u(rng)));
 
         // Cluster box and its lights.
         std::vector<glm::vec3> pts(1 + trial % 6);
@@ -200,23 +203,57 @@ TEST(Lightcuts, MaxCutOneUsesTheRootRepresentative) {
 }
 
 // The seed report compared the bound with the estimate in absolute terms;
-// the threshold here is relative: scaling every intensity by 1e6 (or 1e-6)
-// must select exactly the same cuts.
+// the threshold here is relative. Scaling every intensity by an exact power
+// of two scales every bound, estimate and cluster sum exactly (no rounding,
+// far from overflow and denormals), so every cut must stay the same and the
+// image must scale exactly.
 TEST(Lightcuts, ThresholdIsRelativeToTheEstimate) {
     auto base = test::random_point_lights(500, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 8);
-    std::vector<float> reference_cuts;
-    for (float scale : {1.0f, 1e6f, 1e-6f}) {
+    PreparedScene p0 = prepare_scene(test::room_scene(base, 24), 1);
+    const RenderResult reference = render_cpu(p0, test::options("lightcuts", 24));
+    for (float scale : {std::ldexp(1.0f, 20), std::ldexp(1.0f, -20)}) {
         auto lights = base;
         for (auto& l : lights) { l.r *= scale; l.g *= scale; l.b *= scale; }
         PreparedScene p = prepare_scene(test::room_scene(lights, 24), 1);
         RenderResult r = render_cpu(p, test::options("lightcuts", 24));
-        if (reference_cuts.empty()) reference_cuts = r.stats.cut_size;
-        std::size_t same = 0;
-        for (std::size_t i = 0; i < reference_cuts.size(); ++i) same += reference_cuts[i] == r.stats.cut_size[i];
-        // Scaling by a power of ten is not exact in float; allow a handful of
-        // pixels whose decision sits on the threshold to differ.
-        EXPECT_GE(double(same), 0.98 * double(reference_cuts.size())) << "scale " << scale;
+        ASSERT_EQ(r.stats.cut_size, reference.stats.cut_size) << "scale " << scale;
+        for (std::size_t i = 0; i < r.image.rgb.size(); ++i)
+            ASSERT_EQ(r.image.rgb[i], reference.image.rgb[i] * scale) << "scale " << scale << " value " << i;
     }
+}
+
+// The heap holds only interior nodes, and never more than the cut: its
+// capacity follows the tree, whatever max_cut says.
+TEST(Lightcuts, HeapCapacityFollowsTheTree) {
+    std::vector<gpu::Light> lights;
+    for (int i = 0; i < 8; ++i) lights.push_back(test::point_light({float(i), 1, 0}, {1, 1, 1}));
+    LightTree points_only = build_light_tree(lights, 1);
+    EXPECT_EQ(points_only.cut_heap_capacity(4000000000u), 7u);  // 8 lights: 7 interior nodes
+    EXPECT_EQ(points_only.cut_heap_capacity(3u), 3u);
+    EXPECT_EQ(points_only.cut_heap_capacity(1u), 1u);
+    lights.push_back(test::directional_light({0, -1, 0}, {1, 1, 1}));
+    lights.push_back(test::directional_light({1, -1, 0}, {1, 1, 1}));
+    LightTree both = build_light_tree(lights, 1);
+    EXPECT_EQ(both.cut_heap_capacity(4000000000u), 8u);  // 7 + 1 interior nodes
+    EXPECT_EQ(both.cut_heap_capacity(1u), 2u);           // the two roots start the cut
+    LightTree single = build_light_tree(std::vector<gpu::Light>{lights[0]}, 1);
+    EXPECT_EQ(single.cut_heap_capacity(1000u), 1u);      // no interior node; never zero
+}
+
+// max_cut = 4e9 once sized the heap by max_cut: 80 GB per thread, and
+// bad_alloc in a worker thread ended the process. Now it renders, and as
+// the cut never reaches the limit it equals a render with max_cut = n.
+TEST(Lightcuts, HugeMaxCutRendersLikeAnUnreachableLimit) {
+    auto lights = test::random_point_lights(64, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 3);
+    PreparedScene p = prepare_scene(test::room_scene(lights, 16), 1);
+    RenderOptions o = test::options("lightcuts", 16);
+    o.relative_error = 0.0f;
+    o.max_cut = 64;
+    const RenderResult limited = render_cpu(p, o);
+    o.max_cut = 4000000000u;
+    const RenderResult huge = render_cpu(p, o);
+    EXPECT_EQ(huge.image.rgb, limited.image.rgb);
+    EXPECT_EQ(huge.stats.max_cut_pixels, 0u);
 }
 
 // Cost grows sublinearly: 100x more lights, less than 3x the mean cut.

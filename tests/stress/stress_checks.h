@@ -60,11 +60,14 @@ struct LightcutsLimits {
     double max_rmse = 0.0;        // relative RMSE of lightcuts against brute force
     double max_above_5pct = 0.0;  // fraction of pixels whose luminance error exceeds 5%
 };
-// Lightcuts against brute force: the aggregate limits above, and per pixel
-// the guarantee the cut selection gives (see stress_checks.cpp).
+// Lightcuts against brute force over the image: the aggregate limits above.
 void expect_lightcuts_within_limits(const RenderResult& lightcuts, const RenderResult& brute,
-                                    const RenderOptions& o, const LightcutsLimits& limits,
-                                    const std::string& what);
+                                    const LightcutsLimits& limits, const std::string& what);
+
+// At every shading point: |Y(lightcuts) - Y(brute force)| is at most the sum
+// of the final cut's error bounds (see stress_checks.cpp).
+void expect_cut_guarantee(const PreparedScene& p, const RenderOptions& o,
+                          const std::vector<ShadingPoint>& points, const std::string& what);
 
 // Same image up to `rel` relative RMSE with at most `max_fraction_above_1pct`
 // of pixels above 1% error (used for transformed scenes and CPU vs Vulkan).
