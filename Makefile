@@ -19,7 +19,7 @@ demo: build
 	@$(BUILD)/host/lightcuts render $(SCENE) -o out/room.exr --stats out/room-stats.json
 
 test: build
-	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+	@cd $(BUILD) && LC_REQUIRE_VULKAN=1 ctest --output-on-failure -j $(JOBS)
 
 clean:
 	@rm -rf $(BUILD) out
