@@ -6,7 +6,6 @@
 #include <atomic>
 #include <chrono>
 #include <exception>
-#include <stdexcept>
 #include <thread>
 
 #include "cpu_kernel.h"
@@ -18,10 +17,58 @@ namespace {
 
 constexpr std::uint32_t kTile = 8;  // small, so small images still use every core
 
-struct ThreadTotals {
+// What each worker thread owns: its cut heap and its counters.
+struct Worker {
+    std::vector<gpu::CutEntry> heap;
     std::uint64_t shadow_rays = 0;
     std::uint64_t max_cut_hits = 0;
 };
+
+// All samples of one pixel: the mean radiance and the mean cut size.
+struct PixelResult {
+    glm::vec3 radiance{0.0f};
+    float cut_size = 0.0f;
+};
+
+PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, bool lightcuts, std::uint32_t x,
+                        std::uint32_t y, Worker& t) {
+    glm::vec3 sum(0.0f);
+    std::uint64_t cut_sum = 0;
+    for (std::uint32_t s = 0; s < frame.spp; ++s) {
+        cpu::ShadeKernel::SurfacePoint sp;
+        if (!k.lc_camera_hit(frame, x, y, s, sp)) continue;
+        cpu::ShadeKernel::ShadeStats ss{0u, 0u, 0u};
+        sum += lightcuts ? k.lc_shade_lightcuts(sp, frame, ss)
+                         : k.lc_shade_brute(sp, frame.light_count, frame.min_distance2, ss);
+        cut_sum += ss.cut_size;
+        t.shadow_rays += ss.shadow_rays;
+        t.max_cut_hits += ss.hit_max_cut;
+    }
+    return {sum / float(frame.spp), float(double(cut_sum) / frame.spp)};
+}
+
+// Runs work(tile, worker) for every tile, one thread per worker. An
+// exception in any worker (out of memory, say) stops the others at their
+// next tile and reaches the caller as itself, not as std::terminate.
+template <typename Work>
+void for_each_tile(std::uint32_t tile_count, std::vector<Worker>& workers, Work work) {
+    std::atomic<std::uint32_t> next_tile{0};
+    std::vector<std::exception_ptr> errors(workers.size());
+    auto worker = [&](std::size_t index) {
+        try {
+            for (std::uint32_t tile; (tile = next_tile.fetch_add(1)) < tile_count;) work(tile, workers[index]);
+        } catch (...) {
+            errors[index] = std::current_exception();
+            next_tile.store(tile_count);
+        }
+    };
+    std::vector<std::thread> pool;
+    for (std::size_t i = 1; i < workers.size(); ++i) pool.emplace_back(worker, i);
+    worker(0);
+    for (auto& th : pool) th.join();
+    for (const auto& e : errors)
+        if (e) std::rethrow_exception(e);
+}
 
 }  // namespace
 
@@ -38,67 +85,27 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     if (lightcuts) stats.cut_size.assign(std::size_t(frame.width) * frame.height, 0.0f);
 
     const std::uint32_t tiles_x = (frame.width + kTile - 1) / kTile;
-    const std::uint32_t tiles_y = (frame.height + kTile - 1) / kTile;
-    const std::uint32_t tile_count = tiles_x * tiles_y;
+    const std::uint32_t tile_count = tiles_x * ((frame.height + kTile - 1) / kTile);
     unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
-    threads = std::min(threads, tile_count);
-
-    std::atomic<std::uint32_t> next_tile{0};
+    std::vector<Worker> workers(std::max(1u, std::min(threads, tile_count)));
+    for (Worker& w : workers) w.heap.resize(lightcuts ? prepared.tree.cut_heap_capacity(frame.max_cut) : 0);
     std::atomic<std::uint32_t> tiles_done{0};
-    std::vector<ThreadTotals> totals(threads);
     Progress progress(options.progress);
-    const std::uint32_t heap_capacity = prepared.tree.cut_heap_capacity(frame.max_cut);
 
-    auto render_tiles = [&](ThreadTotals& t) {
-        std::vector<gpu::CutEntry> heap(lightcuts ? heap_capacity : 0);
-        cpu::ShadeKernel k = cpu::make_shade_kernel(prepared, heap.data());
-        for (std::uint32_t tile; (tile = next_tile.fetch_add(1)) < tile_count;) {
-            std::uint32_t x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
-            for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); ++y) {
-                for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); ++x) {
-                    glm::vec3 sum(0.0f);
-                    std::uint64_t cut_sum = 0;
-                    for (std::uint32_t s = 0; s < frame.spp; ++s) {
-                        cpu::ShadeKernel::SurfacePoint sp;
-                        if (!k.lc_camera_hit(frame, x, y, s, sp)) continue;
-                        cpu::ShadeKernel::ShadeStats ss{0u, 0u, 0u};
-                        if (lightcuts) {
-                            sum += k.lc_shade_lightcuts(sp, frame, ss);
-                        } else {
-                            sum += k.lc_shade_brute(sp, frame.light_count, frame.min_distance2, ss);
-                        }
-                        cut_sum += ss.cut_size;
-                        t.shadow_rays += ss.shadow_rays;
-                        t.max_cut_hits += ss.hit_max_cut;
-                    }
-                    result.image.set(x, y, sum / float(frame.spp));
-                    if (lightcuts)
-                        stats.cut_size[std::size_t(y) * frame.width + x] = float(double(cut_sum) / frame.spp);
-                }
+    for_each_tile(tile_count, workers, [&](std::uint32_t tile, Worker& t) {
+        cpu::ShadeKernel k = cpu::make_shade_kernel(prepared, t.heap.data());
+        const std::uint32_t x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+        for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); ++y)
+            for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); ++x) {
+                const PixelResult px = shade_pixel(k, frame, lightcuts, x, y, t);
+                result.image.set(x, y, px.radiance);
+                if (lightcuts) stats.cut_size[std::size_t(y) * frame.width + x] = px.cut_size;
             }
-            progress.update(double(tiles_done.fetch_add(1) + 1) / tile_count);
-        }
-    };
-    // An exception in any worker (out of memory, say) stops the others at
-    // their next tile and reaches the caller as itself, not as terminate().
-    std::vector<std::exception_ptr> errors(threads);
-    auto worker = [&](unsigned thread_index) {
-        try {
-            render_tiles(totals[thread_index]);
-        } catch (...) {
-            errors[thread_index] = std::current_exception();
-            next_tile.store(tile_count);
-        }
-    };
-    std::vector<std::thread> pool;
-    for (unsigned i = 1; i < threads; ++i) pool.emplace_back(worker, i);
-    worker(0);
-    for (auto& th : pool) th.join();
+        progress.update(double(tiles_done.fetch_add(1) + 1) / tile_count);
+    });
     progress.finish();
-    for (const auto& e : errors)
-        if (e) std::rethrow_exception(e);
 
-    for (const auto& t : totals) {
+    for (const auto& t : workers) {
         stats.shadow_rays += t.shadow_rays;
         stats.max_cut_pixels += t.max_cut_hits;
     }

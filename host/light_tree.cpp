@@ -110,10 +110,8 @@ void parallel_for(std::size_t n, Fn fn) {
     for (auto& th : pool) th.join();
 }
 
-// Returns the root's build id.
-std::uint32_t cluster_fast(std::vector<Cluster>& all, std::vector<std::uint32_t> active,
-                           std::uint32_t seed) {
-    // Sort leaves along a 30-bit Morton curve of their box centres.
+// Sorts cluster ids along a 30-bit Morton curve of their box centres.
+void sort_morton(const std::vector<Cluster>& all, std::vector<std::uint32_t>& active) {
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (auto id : active) {
         lo = glm::min(lo, all[id].lo);
@@ -130,54 +128,65 @@ std::uint32_t cluster_fast(std::vector<Cluster>& all, std::vector<std::uint32_t>
     }
     std::sort(keyed.begin(), keyed.end());
     for (std::size_t i = 0; i < keyed.size(); ++i) active[i] = keyed[i].second;
+}
 
+// The cheapest partner of active[i] within kWindow positions each side.
+//
+// Ties go to the nearer index; between i - d and i + d to the right when
+// i / d is even, else the left. Any choice at equal distance keeps the
+// globally cheapest pair at the smallest distance mutual, so rounds
+// progress; alternating sides makes a run of equal costs pair up as (0,1),
+// (2,3), ... Always taking the lower index merged one pair per round when
+// every cost is equal, which they are for coincident lights (cost 0):
+// O(n^2) rounds' work and a tree as deep as n (8000 coincident lights took
+// 5 s).
+std::size_t best_partner(const std::vector<Cluster>& all, const std::vector<std::uint32_t>& active,
+                         std::size_t i) {
+    const std::size_t n = active.size();
+    const std::size_t jb = i >= std::size_t(kWindow) ? i - kWindow : 0;
+    const std::size_t je = std::min(n, i + kWindow + 1);
+    double best_cost = std::numeric_limits<double>::infinity();
+    std::size_t best_j = i == 0 ? 1 : i - 1;
+    for (std::size_t j = jb; j < je; ++j) {
+        if (j == i) continue;
+        const double cost = merge_cost(all[active[i]], all[active[j]]);
+        const std::size_t dist = j > i ? j - i : i - j;
+        const std::size_t best_dist = best_j > i ? best_j - i : i - best_j;
+        const bool prefer_right = (i / dist) % 2 == 0;
+        if (cost < best_cost ||
+            (cost == best_cost && (dist < best_dist || (dist == best_dist && (j > i) == prefer_right)))) {
+            best_cost = cost;
+            best_j = j;
+        }
+    }
+    return best_j;
+}
+
+// Locally-ordered clustering; returns the root's build id.
+std::uint32_t cluster_fast(std::vector<Cluster>& all, std::vector<std::uint32_t> active,
+                           std::uint32_t seed) {
+    sort_morton(all, active);
     std::vector<std::uint32_t> best(active.size());
     std::vector<std::uint32_t> next;
     while (active.size() > 1) {
         const std::size_t n = active.size();
         best.resize(n);
         parallel_for(n, [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end; ++i) {
-                std::size_t jb = i >= std::size_t(kWindow) ? i - kWindow : 0;
-                std::size_t je = std::min(n, i + kWindow + 1);
-                double best_cost = std::numeric_limits<double>::infinity();
-                std::size_t best_j = i == 0 ? 1 : i - 1;
-                for (std::size_t j = jb; j < je; ++j) {
-                    if (j == i) continue;
-                    double cost = merge_cost(all[active[i]], all[active[j]]);
-                    // Ties go to the nearer index; between i - d and i + d to
-                    // the right when i / d is even, else the left. Any choice
-                    // at equal distance keeps the globally cheapest pair at the
-                    // smallest distance mutual, so rounds progress; alternating
-                    // sides makes a run of equal costs pair up as (0,1), (2,3),
-                    // ... Always taking the lower index merged one pair per round
-                    // when every cost is equal, which they are for coincident or
-                    // black lights (cost 0): O(n^2) rounds' work and a tree as
-                    // deep as n (8000 coincident lights took 5 s).
-                    std::size_t dist = j > i ? j - i : i - j;
-                    std::size_t best_dist = best_j > i ? best_j - i : i - best_j;
-                    const bool prefer_right = (i / dist) % 2 == 0;
-                    if (cost < best_cost || (cost == best_cost && (dist < best_dist ||
-                                                                  (dist == best_dist && (j > i) == prefer_right)))) {
-                        best_cost = cost;
-                        best_j = j;
-                    }
-                }
-                best[i] = static_cast<std::uint32_t>(best_j);
-            }
+            for (std::size_t i = begin; i < end; ++i)
+                best[i] = static_cast<std::uint32_t>(best_partner(all, active, i));
         });
+        // Mutual best pairs merge (in place of their first member, so the
+        // Morton order holds); the others wait for the next round.
         next.clear();
         std::size_t merged = 0;
         for (std::size_t i = 0; i < n; ++i) {
-            std::size_t j = best[i];
-            if (best[j] == i) {
-                if (i < j) {
-                    merge(all, active[i], active[j], seed);
-                    next.push_back(static_cast<std::uint32_t>(all.size() - 1));
-                    ++merged;
-                }
-            } else {
+            const std::size_t j = best[i];
+            if (best[j] != i) {
                 next.push_back(active[i]);
+            } else if (i < j) {
+                merge(all, active[i], active[j], seed);
+                next.push_back(static_cast<std::uint32_t>(all.size() - 1));
+                ++merged;
             }
         }
         if (merged == 0) {
