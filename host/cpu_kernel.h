@@ -8,6 +8,7 @@
 #include "lightcuts/render.h"
 #include "shared/types.h"
 #include "shared/color.h"
+#include "shared/octahedral.h"
 #include "shared/glsl_compat.h"
 
 namespace lc::cpu {
@@ -46,6 +47,7 @@ struct ShadeKernel {
     // off only where the scene cannot use them.
     static constexpr bool kEnableGgx = true;
     static constexpr bool kEnableShadows = true;
+    static constexpr bool kEnableOriented = true;
 
 #define LC_BVH_NODE(i) bvh_nodes[i]
 #define LC_TRIANGLE(i) triangles[i]

@@ -19,16 +19,21 @@ static_assert(offsetof(Triangle, material) == 36);
 static_assert(sizeof(TriangleNormals) == 48);
 static_assert(offsetof(TriangleNormals, n2_z) == 32);
 
-static_assert(sizeof(Material) == 32);
+static_assert(sizeof(Material) == 48);
+static_assert(offsetof(Material, emission_r) == 32);
 static_assert(offsetof(Material, ks_r) == 12);
 static_assert(offsetof(Material, alpha) == 24);
 static_assert(offsetof(Material, flags) == 28);
 
-static_assert(sizeof(Light) == 32);
+static_assert(sizeof(Light) == 48);
+static_assert(offsetof(Light, axis_x) == 24);
+static_assert(offsetof(Light, cos_inner) == 36);
+static_assert(offsetof(Light, type) == 44);
 static_assert(offsetof(Light, r) == 12);
-static_assert(offsetof(Light, type) == 24);
 
-static_assert(sizeof(LightNode) == 48);
+static_assert(sizeof(LightNode) == 64);
+static_assert(offsetof(LightNode, axis_oct) == 48);
+static_assert(offsetof(LightNode, cos_theta_e) == 56);
 static_assert(offsetof(LightNode, max_x) == 12);
 static_assert(offsetof(LightNode, intensity_r) == 24);
 static_assert(offsetof(LightNode, rep_light) == 36);
@@ -43,7 +48,7 @@ static_assert(offsetof(GBufferTexel, material) == 36);
 static_assert(sizeof(CutEntry) == 20);
 static_assert(offsetof(CutEntry, unit_r) == 8);
 
-static_assert(sizeof(FrameParams) == 112);
+static_assert(sizeof(FrameParams) == 120);
 static_assert(offsetof(FrameParams, min_distance2) == 12);
 static_assert(offsetof(FrameParams, relative_error) == 28);
 static_assert(offsetof(FrameParams, max_cut) == 44);
@@ -51,8 +56,8 @@ static_assert(offsetof(FrameParams, spp) == 60);
 static_assert(offsetof(FrameParams, width) == 64);
 static_assert(offsetof(FrameParams, roots) == 80);
 static_assert(sizeof(FrameParams::roots) == 4 * kLightTypeCount);
-static_assert(offsetof(FrameParams, tile_x) == 88);
-static_assert(offsetof(FrameParams, sample_index) == 104);
-static_assert(offsetof(FrameParams, loop_probe_rounds) == 108);
+static_assert(offsetof(FrameParams, tile_x) == 96);
+static_assert(offsetof(FrameParams, sample_index) == 112);
+static_assert(offsetof(FrameParams, loop_probe_rounds) == 116);
 
 }  // namespace lc::gpu

@@ -1,8 +1,9 @@
 // Light tree construction (Walter et al. 2005, section 4.1): bottom-up
-// agglomerative clustering under the metric I_C * alpha_C^2 (the cone term
-// c^2 (1 - cos beta)^2 is zero while there are no oriented lights), where
-// I_C is the Rec.709 luminance of the cluster's RGB intensity sum and
-// alpha_C the diagonal of its box. One tree per light type.
+// agglomerative clustering under the metric I_C (alpha_C^2 + c^2 (1 - cos
+// beta_C)^2), where I_C is the Rec.709 luminance of the cluster's RGB
+// intensity sum, alpha_C the diagonal of its box and beta_C the spread of
+// the emission axes of its spot or oriented lights (emission_cone.h). One
+// tree per light type.
 //
 // kFast is locally-ordered clustering (Walter et al. 2008; the PLOC variant
 // of Meister and Bittner 2018): clusters sorted along a Morton curve, each
@@ -28,6 +29,8 @@
 
 #include <glm/glm.hpp>
 
+#include "emission_cone.h"
+
 namespace lc {
 namespace {
 
@@ -39,24 +42,45 @@ struct Cluster {
     // nor lose the small ones (the loader checks each type's total fits a float).
     glm::dvec3 intensity;
     double weight;         // luminance of intensity, the metric's I_C
+    EmissionCone cone;     // as stored: axis quantized, theta_o widened to match
+    std::uint32_t axis_packed = 0;
     std::uint32_t rep;     // index into the input light array
     std::uint32_t left = gpu::kInvalidIndex, right = gpu::kInvalidIndex;  // build ids
     bool rep_from_right = false;
 };
 
-double merge_cost(const Cluster& a, const Cluster& b) {
-    glm::dvec3 d = glm::dvec3(glm::max(a.hi, b.hi)) - glm::dvec3(glm::min(a.lo, b.lo));
-    return (a.weight + b.weight) * glm::dot(d, d);
+// One tree in the making: every cluster so far (leaves first) and what the
+// merges need.
+struct Build {
+    std::vector<Cluster> all;
+    std::uint32_t seed = 0;
+    // c^2 of the metric's cone term: 0 for lights that emit everywhere.
+    double cone_weight = 0.0;
+};
+
+// Walter 2005 §4.1: I_C * (alpha_C^2 + c^2 (1 - cos beta_C)^2) for the
+// cluster a and b would make.
+double merge_cost(const Build& b, const Cluster& x, const Cluster& y) {
+    glm::dvec3 d = glm::dvec3(glm::max(x.hi, y.hi)) - glm::dvec3(glm::min(x.lo, y.lo));
+    double size = glm::dot(d, d);
+    if (b.cone_weight > 0.0) {
+        const double spread = 1.0 - double(cone_union(x.cone, y.cone).cos_beta());
+        size += b.cone_weight * spread * spread;
+    }
+    return (x.weight + y.weight) * size;
 }
 
-// The point a light occupies in its tree's box: the position of a point
-// light, the unit direction of a directional light (Walter 2005 §4.1
-// clusters directional lights as points on the unit sphere). The one place
-// the builder looks at a light's type.
+// The point a light occupies in its tree's box: the position of a point,
+// spot or oriented light, the unit direction of a directional light
+// (Walter 2005 §4.1 clusters directional lights as points on the unit
+// sphere). With EmissionCone::of_light, the only places the builder looks
+// at a light's type.
 glm::vec3 tree_point(const gpu::Light& l) {
-    switch (l.type) {
+    switch (l.type & gpu::kLightTypeMask) {
         case gpu::kLightPoint:
         case gpu::kLightDirectional:
+        case gpu::kLightSpot:
+        case gpu::kLightOriented:
             return {l.x, l.y, l.z};
         default:
             throw std::invalid_argument("light tree: unknown light type " + std::to_string(l.type));
@@ -67,7 +91,9 @@ glm::vec3 tree_point(const gpu::Light& l) {
 // The representative is one of the children's, chosen with probability
 // proportional to their intensities from a hash of (seed, new id), so the
 // choice is the same whatever order or thread made it.
-void merge(std::vector<Cluster>& all, std::uint32_t a, std::uint32_t b, std::uint32_t seed) {
+void merge(Build& build, std::uint32_t a, std::uint32_t b) {
+    std::vector<Cluster>& all = build.all;
+    const std::uint32_t seed = build.seed;
     Cluster c;
     const Cluster& ca = all[a];
     const Cluster& cb = all[b];
@@ -75,6 +101,7 @@ void merge(std::vector<Cluster>& all, std::uint32_t a, std::uint32_t b, std::uin
     c.hi = glm::max(ca.hi, cb.hi);
     c.intensity = ca.intensity + cb.intensity;
     c.weight = ca.weight + cb.weight;
+    c.cone = quantized(cone_union(ca.cone, cb.cone), c.axis_packed);
     c.left = a;
     c.right = b;
     auto id = static_cast<std::uint32_t>(all.size());
@@ -140,8 +167,8 @@ void sort_morton(const std::vector<Cluster>& all, std::vector<std::uint32_t>& ac
 // every cost is equal, which they are for coincident lights (cost 0):
 // O(n^2) rounds' work and a tree as deep as n (8000 coincident lights took
 // 5 s).
-std::size_t best_partner(const std::vector<Cluster>& all, const std::vector<std::uint32_t>& active,
-                         std::size_t i) {
+std::size_t best_partner(const Build& b, const std::vector<std::uint32_t>& active, std::size_t i) {
+    const std::vector<Cluster>& all = b.all;
     const std::size_t n = active.size();
     const std::size_t jb = i >= std::size_t(kWindow) ? i - kWindow : 0;
     const std::size_t je = std::min(n, i + kWindow + 1);
@@ -149,7 +176,7 @@ std::size_t best_partner(const std::vector<Cluster>& all, const std::vector<std:
     std::size_t best_j = i == 0 ? 1 : i - 1;
     for (std::size_t j = jb; j < je; ++j) {
         if (j == i) continue;
-        const double cost = merge_cost(all[active[i]], all[active[j]]);
+        const double cost = merge_cost(b, all[active[i]], all[active[j]]);
         const std::size_t dist = j > i ? j - i : i - j;
         const std::size_t best_dist = best_j > i ? best_j - i : i - best_j;
         const bool prefer_right = (i / dist) % 2 == 0;
@@ -163,9 +190,8 @@ std::size_t best_partner(const std::vector<Cluster>& all, const std::vector<std:
 }
 
 // Locally-ordered clustering; returns the root's build id.
-std::uint32_t cluster_fast(std::vector<Cluster>& all, std::vector<std::uint32_t> active,
-                           std::uint32_t seed) {
-    sort_morton(all, active);
+std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
+    sort_morton(build.all, active);
     std::vector<std::uint32_t> best(active.size());
     std::vector<std::uint32_t> next;
     while (active.size() > 1) {
@@ -173,7 +199,7 @@ std::uint32_t cluster_fast(std::vector<Cluster>& all, std::vector<std::uint32_t>
         best.resize(n);
         parallel_for(n, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i)
-                best[i] = static_cast<std::uint32_t>(best_partner(all, active, i));
+                best[i] = static_cast<std::uint32_t>(best_partner(build, active, i));
         });
         // Mutual best pairs merge (in place of their first member, so the
         // Morton order holds); the others wait for the next round.
@@ -184,25 +210,25 @@ std::uint32_t cluster_fast(std::vector<Cluster>& all, std::vector<std::uint32_t>
             if (best[j] != i) {
                 next.push_back(active[i]);
             } else if (i < j) {
-                merge(all, active[i], active[j], seed);
-                next.push_back(static_cast<std::uint32_t>(all.size() - 1));
+                merge(build, active[i], active[j]);
+                next.push_back(static_cast<std::uint32_t>(build.all.size() - 1));
                 ++merged;
             }
         }
         if (merged == 0) {
             // Cannot happen with the tie-breaking above (the cheapest pair in
             // any window is mutual); merge neighbours rather than loop forever.
-            merge(all, active[0], active[1], seed);
+            merge(build, active[0], active[1]);
             next.erase(next.begin(), next.begin() + 2);
-            next.insert(next.begin(), static_cast<std::uint32_t>(all.size() - 1));
+            next.insert(next.begin(), static_cast<std::uint32_t>(build.all.size() - 1));
         }
         active.swap(next);
     }
     return active[0];
 }
 
-std::uint32_t cluster_exact(std::vector<Cluster>& all, std::vector<std::uint32_t> active,
-                            std::uint32_t seed) {
+std::uint32_t cluster_exact(Build& build, std::vector<std::uint32_t> active) {
+    std::vector<Cluster>& all = build.all;
     const double inf = std::numeric_limits<double>::infinity();
     std::vector<std::uint32_t> best(active.size());
     std::vector<double> best_cost(active.size(), inf);
@@ -210,7 +236,7 @@ std::uint32_t cluster_exact(std::vector<Cluster>& all, std::vector<std::uint32_t
         best_cost[i] = inf;
         for (std::size_t j = 0; j < active.size(); ++j) {
             if (j == i) continue;
-            double c = merge_cost(all[active[i]], all[active[j]]);
+            double c = merge_cost(build, all[active[i]], all[active[j]]);
             if (c < best_cost[i]) {
                 best_cost[i] = c;
                 best[i] = static_cast<std::uint32_t>(j);
@@ -222,7 +248,7 @@ std::uint32_t cluster_exact(std::vector<Cluster>& all, std::vector<std::uint32_t
         std::size_t a = std::size_t(std::min_element(best_cost.begin(), best_cost.end()) - best_cost.begin());
         std::size_t b = best[a];
         if (b < a) std::swap(a, b);
-        merge(all, active[a], active[b], seed);
+        merge(build, active[a], active[b]);
         // Slot a takes the merged cluster; slot b takes the last one.
         active[a] = static_cast<std::uint32_t>(all.size() - 1);
         std::size_t last = active.size() - 1;
@@ -241,7 +267,7 @@ std::uint32_t cluster_exact(std::vector<Cluster>& all, std::vector<std::uint32_t
             if (best[i] == a || best[i] == b) {
                 rescan(i);
             } else {
-                double c = merge_cost(all[active[i]], all[active[a]]);
+                double c = merge_cost(build, all[active[i]], all[active[a]]);
                 if (c < best_cost[i]) {
                     best_cost[i] = c;
                     best[i] = static_cast<std::uint32_t>(a);
@@ -273,13 +299,18 @@ void flatten(const std::vector<Cluster>& all, std::span<const gpu::Light> input,
         n.intensity_g = float(c.intensity.y);
         n.intensity_b = float(c.intensity.z);
         n.rep_light = c.rep;  // remapped to leaf order below
+        n.axis_oct = c.axis_packed;
+        n.cos_theta_o = c.cone.emits_everywhere() ? -1.0f : std::cos(c.cone.theta_o);
+        n.cos_theta_e = std::cos(c.cone.theta_e);
+        n.pad0 = 0;
+        const std::uint32_t node_bits = type_bits | (c.cone.two_sided ? gpu::kNodeTwoSided : 0u);
         if (c.left == gpu::kInvalidIndex) {
             n.left = gpu::kInvalidIndex;
-            n.flags = gpu::kNodeLeaf | type_bits;
+            n.flags = gpu::kNodeLeaf | node_bits;
             leaf_slots.emplace_back(it.slot, c.rep);
         } else {
             n.left = next_slot;
-            n.flags = (c.rep_from_right ? gpu::kNodeRepFromRight : 0u) | type_bits;
+            n.flags = (c.rep_from_right ? gpu::kNodeRepFromRight : 0u) | node_bits;
             next_slot += 2;
             stack.push_back({c.right, n.left + 1});
             stack.push_back({c.left, n.left});
@@ -315,13 +346,17 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
     tree.lights.reserve(lights.size());
     for (const gpu::Light& l : lights) tree_point(l);  // unknown types fail before any work
     for (std::uint32_t type = 0; type < gpu::kLightTypeCount; ++type) {
-        std::vector<Cluster> all;
+        Build build;
+        build.seed = seed ^ type;
+        std::vector<Cluster>& all = build.all;
         std::vector<std::uint32_t> leaves;
+        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
         for (std::uint32_t i = 0; i < lights.size(); ++i) {
             const gpu::Light& l = lights[i];
-            if (l.type != type) continue;
+            if ((l.type & gpu::kLightTypeMask) != type) continue;
             Cluster c;
             c.lo = c.hi = tree_point(l);
+            c.cone = quantized(EmissionCone::of_light(l), c.axis_packed);
             c.intensity = glm::dvec3(l.r, l.g, l.b);
             c.weight = gpu::lc_luminance(glm::vec3(l.r, l.g, l.b));
             if (!(c.weight > 0.0)) {
@@ -329,13 +364,19 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
                 continue;
             }
             c.rep = i;
+            lo = glm::min(lo, c.lo);
+            hi = glm::max(hi, c.hi);
             leaves.push_back(static_cast<std::uint32_t>(all.size()));
             all.push_back(c);
         }
         if (leaves.empty()) continue;
+        // Walter 2005 §4.1 sets c, which weighs directional against spatial
+        // similarity, to the scene's diagonal; here the diagonal of this
+        // tree's lights. Lights that emit everywhere have no cone term.
+        if (type == gpu::kLightSpot || type == gpu::kLightOriented)
+            build.cone_weight = glm::dot(glm::dvec3(hi - lo), glm::dvec3(hi - lo));
         all.reserve(2 * leaves.size());
-        std::uint32_t root = builder == TreeBuilder::kExact ? cluster_exact(all, leaves, seed ^ type)
-                                                            : cluster_fast(all, leaves, seed ^ type);
+        std::uint32_t root = builder == TreeBuilder::kExact ? cluster_exact(build, leaves) : cluster_fast(build, leaves);
         auto base = static_cast<std::uint32_t>(tree.nodes.size());
         tree.nodes.resize(tree.nodes.size() + 2 * leaves.size() - 1);
         tree.roots[type] = base;

@@ -40,6 +40,7 @@ layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_sta
 
 #include "shared/glsl_compat.h"
 #include "shared/color.h"
+#include "shared/octahedral.h"
 #include "shared/trace.h"
 #include "shared/shading.h"
 

@@ -28,14 +28,39 @@ inline gpu::Material glossy(glm::vec3 kd, glm::vec3 ks, float alpha) {
 }
 
 inline gpu::Light point_light(glm::vec3 p, glm::vec3 intensity) {
-    return {p.x, p.y, p.z, intensity.x, intensity.y, intensity.z, gpu::kLightPoint, 0u};
+    gpu::Light l{};
+    l.x = p.x; l.y = p.y; l.z = p.z;
+    l.r = intensity.x; l.g = intensity.y; l.b = intensity.z;
+    l.type = gpu::kLightPoint;
+    return l;
 }
 
 // `travel` is the way the light travels, as in the scene format.
 inline gpu::Light directional_light(glm::vec3 travel, glm::vec3 irradiance) {
-    glm::vec3 to_light = -glm::normalize(travel);
-    return {to_light.x, to_light.y, to_light.z, irradiance.x, irradiance.y, irradiance.z,
-            gpu::kLightDirectional, 0u};
+    gpu::Light l = point_light(-glm::normalize(travel), irradiance);
+    l.type = gpu::kLightDirectional;
+    return l;
+}
+
+// A spot at p shining along `axis`, half-angles in degrees.
+inline gpu::Light spot_light(glm::vec3 p, glm::vec3 axis, glm::vec3 intensity, float inner_degrees,
+                             float outer_degrees) {
+    gpu::Light l = point_light(p, intensity);
+    const glm::vec3 a = glm::normalize(axis);
+    l.axis_x = a.x; l.axis_y = a.y; l.axis_z = a.z;
+    l.cos_inner = std::cos(glm::radians(inner_degrees));
+    l.cos_outer = std::cos(glm::radians(outer_degrees));
+    l.type = gpu::kLightSpot;
+    return l;
+}
+
+// A cosine emitter at p around `normal`, intensity along the normal.
+inline gpu::Light oriented_light(glm::vec3 p, glm::vec3 normal, glm::vec3 intensity, bool two_sided = false) {
+    gpu::Light l = point_light(p, intensity);
+    const glm::vec3 n = glm::normalize(normal);
+    l.axis_x = n.x; l.axis_y = n.y; l.axis_z = n.z;
+    l.type = gpu::kLightOriented | (two_sided ? gpu::kLightTwoSided : 0u);
+    return l;
 }
 
 // Adds a triangle with its face normal (or the given vertex normals).
@@ -45,6 +70,7 @@ inline gpu::LightNode node_with_box(glm::vec3 lo, glm::vec3 hi, std::uint32_t ty
     n.min_x = lo.x; n.min_y = lo.y; n.min_z = lo.z;
     n.max_x = hi.x; n.max_y = hi.y; n.max_z = hi.z;
     n.flags = type << gpu::kNodeTypeShift;
+    n.cos_theta_o = -1.0f;  // emits everywhere, as point and directional lights do
     return n;
 }
 

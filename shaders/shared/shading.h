@@ -6,9 +6,10 @@
 //   LC_MATERIAL(i)   -> Material
 //   LC_NORMALS(i)    -> TriangleNormals
 //   LC_LIGHT(i)      -> Light
-// and the feature switches kEnableGgx and kEnableShadows (specialization
-// constants on the GPU, so a scene without GGX materials or without
-// occluders gets a kernel without that code; always true on the CPU).
+// and the feature switches kEnableGgx, kEnableShadows and kEnableOriented
+// (specialization constants on the GPU, so a scene without GGX materials,
+// without occluders or without spot and oriented lights gets a kernel
+// without that code; always true on the CPU).
 // No include guard: each kernel context (a GLSL shader, a C++ kernel
 // struct in host/cpu_kernel.h) includes it exactly once.
 
@@ -130,45 +131,56 @@ vec3 lc_brdf_cos(Material m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
     return value;
 }
 
-// One light's contribution per unit intensity (material * geometry), with
-// the shadow ray it needs: direction, and length (kRayInfinity for
-// directional lights). Zero when the light is behind the surface.
+// glTF KHR_lights_punctual's spot falloff: s = clamp((cos - cos_outer) /
+// max(1e-3, cos_inner - cos_outer), 0, 1); the intensity is scaled by s^2.
+float lc_spot_falloff(Light light, float cos_theta) {
+    float s = clamp((cos_theta - light.cos_outer) / max(1e-3f, light.cos_inner - light.cos_outer), 0.0f, 1.0f);
+    return s * s;
+}
+
+// One light's contribution per unit intensity (material * geometry *
+// emission), with the shadow ray it needs: direction, and length
+// (kRayInfinity for directional lights). Zero when the light is behind the
+// surface or emits nothing towards it.
 // Walter 2005 §3: the one place where a light's type decides its emission;
 // everything else reads the light tree's nodes.
 vec3 lc_light_unit(SurfacePoint sp, Light light, float min_distance2, LC_OUT(vec3) wi,
                    LC_OUT(float) t_max) {
-    vec3 lp = vec3(light.x, light.y, light.z);
-    float geometry;
-    switch (light.type) {
-        case kLightPoint: {
-            vec3 to_light = lp - sp.p;
-            float d2 = dot(to_light, to_light);
-            float d = sqrt(d2);
-            // A light exactly at the shaded point has no direction: it adds
-            // nothing (the cosine bound of such a cluster is zero as well).
-            if (!(d > 0.0f)) {
-                wi = sp.n;
-                t_max = 0.0f;
+    uint type = light.type & kLightTypeMask;
+    wi = sp.n;
+    t_max = 0.0f;
+    float factor = 1.0f;  // geometry times emission towards sp
+    if (type == kLightDirectional) {
+        wi = vec3(light.x, light.y, light.z);
+        t_max = kRayInfinity;
+    } else {
+        vec3 to_light = vec3(light.x, light.y, light.z) - sp.p;
+        float d2 = dot(to_light, to_light);
+        float d = sqrt(d2);
+        // A light exactly at the shaded point has no direction: it adds
+        // nothing (the cosine bound of such a cluster is zero as well).
+        if (!(d > 0.0f)) return vec3(0.0f);
+        wi = to_light / d;
+        t_max = d * (1.0f - kShadowEndRelative);
+        factor = 1.0f / max(d2, min_distance2);
+        // cos of the angle between the light's axis and the way to sp.
+        float cos_axis = -dot(vec3(light.axis_x, light.axis_y, light.axis_z), wi);
+        switch (kEnableOriented ? type : kLightPoint) {
+            case kLightPoint:
+                break;
+            case kLightSpot:
+                factor *= lc_spot_falloff(light, cos_axis);
+                break;
+            case kLightOriented:
+                factor *= (light.type & kLightTwoSided) != 0u ? abs(cos_axis) : max(cos_axis, 0.0f);
+                break;
+            default:  // the loader and the tree builder admit no other type
                 return vec3(0.0f);
-            }
-            wi = to_light / d;
-            t_max = d * (1.0f - kShadowEndRelative);
-            geometry = 1.0f / max(d2, min_distance2);
-            break;
         }
-        case kLightDirectional:
-            wi = lp;
-            t_max = kRayInfinity;
-            geometry = 1.0f;
-            break;
-        default:  // the loader and the tree builder admit no other type
-            wi = sp.n;
-            t_max = 0.0f;
-            return vec3(0.0f);
     }
     float cos_i = dot(sp.n, wi);
-    if (cos_i <= 0.0f) return vec3(0.0f);
-    return lc_brdf_cos(LC_MATERIAL(sp.material), sp.n, wi, sp.wo, cos_i) * geometry;
+    if (cos_i <= 0.0f || !(factor > 0.0f)) return vec3(0.0f);
+    return lc_brdf_cos(LC_MATERIAL(sp.material), sp.n, wi, sp.wo, cos_i) * factor;
 }
 
 bool lc_visible(SurfacePoint sp, vec3 wi, float t_max) {
@@ -267,22 +279,57 @@ float lc_ggx_bound(Material m, vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec3 
 
 uint lc_node_type(LightNode node) { return (node.flags >> kNodeTypeShift) & kNodeTypeMask; }
 
-// Bound of material * geometry (per unit intensity, RGB) over every light of
-// a cluster, read from its node. Point lights: the box holds positions,
-// G <= 1/d_min^2 with the same clamp as the exact term. Directional lights:
-// the box holds unit directions, so x is the origin and G = 1.
+// Angles in the emission bound come from acos, whose float result is off by
+// up to ~3.5e-4 rad near 0 and pi; the bound gives away this much more.
+LC_KCONST float kAngleSlack = 1e-3f;
+
+float lc_safe_acos(float c) { return acos(clamp(c, -1.0f, 1.0f)); }
+
+// Upper bound of the emission factor towards x over every light of the
+// cluster (pbrt-v4's LightBounds::Importance, angles written out): a light
+// at p with axis a emits towards x at the angle (a, x - p), which is at
+// least theta' = theta_w - theta_o - theta_b by the triangle inequality on
+// the sphere, where theta_w is the angle between the cluster's axis and the
+// way from the box centre to x, theta_o the spread of the lights' axes and
+// theta_b the half-angle the box's bounding sphere subtends at x. Nothing is
+// emitted past theta_e; cosine emitters emit at most cos(theta') before.
+float lc_emission_bound(LightNode node, vec3 x) {
+    if (node.cos_theta_o <= -1.0f) return 1.0f;  // emits everywhere
+    vec3 lo = vec3(node.min_x, node.min_y, node.min_z) - x;
+    vec3 hi = vec3(node.max_x, node.max_y, node.max_z) - x;
+    vec3 to_centre = 0.5f * (lo + hi);
+    float radius = 0.5f * length(hi - lo);
+    float d = length(to_centre);
+    if (!(d > radius)) return 1.0f;  // x inside the bounding sphere: any direction
+    float cos_w = -dot(lc_decode_axis(node.axis_oct), to_centre) / d;
+    if ((node.flags & kNodeTwoSided) != 0u) cos_w = abs(cos_w);
+    float theta = lc_safe_acos(cos_w) - lc_safe_acos(node.cos_theta_o) - asin(min(radius / d, 1.0f)) -
+                  kAngleSlack;
+    theta = max(theta, 0.0f);
+    if (theta >= lc_safe_acos(node.cos_theta_e)) return 0.0f;
+    return lc_node_type(node) == kLightOriented ? min(cos(theta) * kBoundSlack, 1.0f) : 1.0f;
+}
+
+// Bound of material * geometry * emission (per unit intensity, RGB) over
+// every light of a cluster, read from its node. Positional lights: the box
+// holds positions, G <= 1/d_min^2 with the same clamp as the exact term.
+// Directional lights: the box holds unit directions, so x is the origin and
+// G = 1.
 vec3 lc_cluster_bound(SurfacePoint sp, Material m, LightNode node, float min_distance2) {
     vec3 box_min = vec3(node.min_x, node.min_y, node.min_z);
     vec3 box_max = vec3(node.max_x, node.max_y, node.max_z);
-    bool positional = lc_node_type(node) == kLightPoint;
+    bool positional = lc_node_type(node) != kLightDirectional;
     vec3 x = positional ? sp.p : vec3(0.0f);
     float cos_bound = lc_cosine_bound(box_min, box_max, x, sp.n);
     if (cos_bound <= 0.0f) return vec3(0.0f);
+    float factor = 1.0f;
+    if (positional) {
+        if (kEnableOriented) factor = lc_emission_bound(node, sp.p);
+        if (factor <= 0.0f) return vec3(0.0f);
+        factor *= kBoundSlack / max(lc_box_distance2(box_min, box_max, sp.p), min_distance2);
+    }
     vec3 bound = lc_kd(m) * (cos_bound / kPi);
     if (kEnableGgx && (m.flags & kMaterialHasSpecular) != 0u)
         bound += lc_ks(m) * lc_ggx_bound(m, box_min, box_max, x, sp.n, sp.wo);
-    float geometry = 1.0f;
-    if (positional)
-        geometry = kBoundSlack / max(lc_box_distance2(box_min, box_max, sp.p), min_distance2);
-    return bound * geometry;
+    return bound * factor;
 }

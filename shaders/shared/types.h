@@ -29,16 +29,25 @@ LC_CONST uint kBvhMaxLeafTriangles = 4u;
 // how to add a type.
 LC_CONST uint kLightPoint = 0u;        // position, radiant intensity (W/sr)
 LC_CONST uint kLightDirectional = 1u;  // unit direction towards the light, irradiance (W/m^2)
-LC_CONST uint kLightTypeCount = 2u;
+LC_CONST uint kLightSpot = 2u;         // position, axis, intensity on the axis, glTF cone falloff
+LC_CONST uint kLightOriented = 3u;     // position, normal, intensity along the normal, cosine falloff
+LC_CONST uint kLightTypeCount = 4u;
 
-// LightNode.flags: bits 0-1 as below, bits 8-15 the light type.
+// Light.type: the type in bits 0-7, and:
+LC_CONST uint kLightTypeMask = 0xFFu;
+LC_CONST uint kLightTwoSided = 0x100u;  // oriented: emits on both sides of its normal
+
+// LightNode.flags: bits 0-2 as below, bits 8-15 the light type.
 LC_CONST uint kNodeLeaf = 1u;          // node is a single light
 LC_CONST uint kNodeRepFromRight = 2u;  // representative is the right child's
+LC_CONST uint kNodeTwoSided = 4u;      // some light of the cluster emits on both sides
 LC_CONST uint kNodeTypeShift = 8u;
 LC_CONST uint kNodeTypeMask = 0xFFu;
 
 // Material.flags
 LC_CONST uint kMaterialHasSpecular = 1u;
+LC_CONST uint kMaterialEmissive = 2u;        // emission is not black
+LC_CONST uint kMaterialEmitsBothSides = 4u;  // emits on both sides of the triangle
 
 // ---------------------------------------------------------------------------
 // BVH over triangles (32 bytes). Interior: child0 = first_or_left,
@@ -71,27 +80,41 @@ struct TriangleNormals {
 };
 
 // Lambert albedo kd plus an optional GGX lobe with reflectance ks and
-// roughness alpha (GGX alpha = roughness^2) (32 bytes).
+// roughness alpha (GGX alpha = roughness^2), and the radiance a surface
+// emits (W/(sr m^2)), on the side of its geometric normal unless
+// kMaterialEmitsBothSides (48 bytes).
 struct Material {
     float kd_r, kd_g, kd_b;
     float ks_r, ks_g, ks_b;
     float alpha;
     uint flags;
-};
-
-// One light (32 bytes). Point: position and radiant intensity (W/sr).
-// Directional: unit vector *towards* the light and irradiance (W/m^2).
-struct Light {
-    float x, y, z;
-    float r, g, b;
-    uint type;
+    float emission_r, emission_g, emission_b;
     uint pad0;
 };
 
-// Light tree node (48 bytes); one array of 2n-1 nodes per light type, root
+// One light (48 bytes).
+//   point:        position, radiant intensity (W/sr)
+//   directional:  unit vector *towards* the light, irradiance (W/m^2)
+//   spot:         position, unit axis it shines along, intensity on the axis
+//                 (W/sr), cosines of the inner and outer half-angles
+//   oriented:     position, unit normal, intensity along the normal (W/sr);
+//                 I(w) = I * max(0, cos) (|cos| when two-sided): one point
+//                 sample of an emissive surface
+struct Light {
+    float x, y, z;
+    float r, g, b;
+    float axis_x, axis_y, axis_z;
+    float cos_inner, cos_outer;
+    uint type;        // kLight* type and kLightTwoSided
+};
+
+// Light tree node (64 bytes); one array of 2n-1 nodes per light type, root
 // first. Interior: children are left and left + 1. Leaf: light == rep_light.
-// The box bounds the positions (point lights) or the unit directions
-// (directional lights) of the cluster's lights.
+// The box bounds the positions (directional lights: the unit directions) of
+// the cluster's lights; the cone bounds the directions they emit into
+// (pbrt-v4's LightBounds): every light's axis lies within theta_o of `axis`
+// and emits only within theta_e of its own axis. cos_theta_o = -1 means the
+// lights emit everywhere (point and directional lights).
 struct LightNode {
     float min_x, min_y, min_z;
     float max_x, max_y, max_z;
@@ -99,6 +122,10 @@ struct LightNode {
     uint rep_light;   // index into the leaf-ordered light array
     uint left;        // first child index; kInvalidIndex for leaves
     uint flags;       // kNode* bits and the light type
+    uint axis_oct;    // cone axis, octahedral, two snorm16 (lc_decode_axis)
+    float cos_theta_o;
+    float cos_theta_e;
+    uint pad0;
 };
 
 // Per-pixel surface record written by the camera-ray kernel (48 bytes).

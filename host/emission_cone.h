@@ -1,0 +1,41 @@
+// Bounds on the directions a cluster of lights emits into (pbrt-v4's
+// LightBounds cone): every light's axis lies within theta_o of `axis`, and
+// each light emits only within theta_e of its own axis. Built on the host
+// for the light tree's nodes; read by the kernels' lc_emission_bound.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "shared/types.h"
+
+namespace lc {
+
+struct EmissionCone {
+    glm::vec3 axis{0.0f, 0.0f, 1.0f};  // as the kernels decode it (see quantized())
+    float theta_o = 3.14159265f;       // pi: the axes can point anywhere
+    float theta_e = 1.57079633f;
+    bool two_sided = false;
+
+    // A light that emits everywhere (point and directional lights).
+    static EmissionCone everywhere();
+    // The cone of one light (spot: its axis and outer angle; oriented: its
+    // normal and pi/2).
+    static EmissionCone of_light(const gpu::Light& light);
+
+    bool emits_everywhere() const { return theta_o >= 3.14159265f; }
+    // cos of Walter's cone half-angle beta, for the tree metric's term
+    // c^2 (1 - cos beta)^2.
+    float cos_beta() const;
+};
+
+// The smallest cone (in pbrt-v4's sense) holding both (DirectionCone::Union).
+EmissionCone cone_union(const EmissionCone& a, const EmissionCone& b);
+
+// The cone with its axis packed as the node stores it (octahedral, two
+// snorm16) and theta_o widened by the angle the packing moved the axis, so
+// it still holds every light. `packed` receives the stored bits.
+EmissionCone quantized(const EmissionCone& cone, std::uint32_t& packed);
+
+}  // namespace lc

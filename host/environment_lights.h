@@ -1,0 +1,34 @@
+// An HDR environment map as directional lights (Walter et al. 2005, §5: the
+// environment becomes many directional lights in the light tree).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "shared/types.h"
+
+namespace lc {
+
+// A lat-long RGB radiance map (docs/scene-format.md): for a unit world
+// direction d (+Y up), u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi,
+// column floor(u W), row floor(v H), row 0 at the top.
+struct EnvironmentMap {
+    std::uint32_t width = 0, height = 0;
+    std::vector<float> rgb;  // row-major, three floats per texel, already scaled
+};
+
+// The unit direction through texel position (u, v) in [0, 1]^2.
+void environment_direction(float u, float v, float out[3]);
+
+// `count` directional lights chosen by stratified importance sampling of
+// luminance x solid angle: the map is split recursively (along the side
+// that is longer in angle, at its middle) and each part gets a share of the
+// samples in proportion to its power, at least one if it has any, until a
+// part holds one sample. Each light points at the power-weighted mean
+// direction of its part and carries the part's irradiance (the integral of
+// L over its solid angle), so the lights' total is the map's. A texel that
+// gets several samples splits into a stratified grid of directions.
+std::vector<gpu::Light> environment_lights(const EnvironmentMap& map, std::uint32_t count);
+
+}  // namespace lc
