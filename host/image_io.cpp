@@ -23,21 +23,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// "<name>.tmp-<pid>-<n>" beside the target, so the final rename stays within
-// one file system and concurrent writers (threads or processes) never share it.
-fs::path temp_path_for(const fs::path& file) {
-    static std::atomic<unsigned> counter{0};
-    fs::path tmp = file;
-    tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-    return tmp;
-}
-
 // Runs `write(tmp)`, which returns an empty string on success or the reason
 // it failed, then renames the temporary over `file`. On any failure the
 // temporary is removed and std::runtime_error names `file`.
 template <class Write>
 void write_via_temp(const fs::path& file, Write&& write) {
-    const fs::path tmp = temp_path_for(file);
+    const fs::path tmp = temporary_path_for(file);
     std::string problem;
     try {
         problem = write(tmp);
@@ -96,6 +87,14 @@ float auto_exposure(const Image& image) {
 }
 
 }  // namespace
+
+// Concurrent writers (threads or processes) never share a temporary.
+fs::path temporary_path_for(const fs::path& file) {
+    static std::atomic<unsigned> counter{0};
+    fs::path tmp = file;
+    tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+    return tmp;
+}
 
 void write_exr(const fs::path& file, const Image& image) {
     check_image(image, "write_exr");

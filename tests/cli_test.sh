@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The lightcuts command line end to end: a small render with stats and
-# heatmaps, compare on identical and on different images, info, and bad
-# input (a clear message naming the file and field, a non-zero exit, no
-# output file left behind).
+# heatmaps, compare on identical and on different images, info, bad input
+# (a clear message naming the file and field, a non-zero exit, no output file
+# left behind), the settings' range edges, the device fallback, and failures
+# after the render that must leave no output and no temporary.
 #   tests/cli_test.sh BUILD_DIR
 set -uo pipefail
 exe="$1/host/lightcuts"
@@ -18,6 +19,7 @@ fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
   fail "render exited non-zero: $(cat "$tmp/out.txt")"
 for f in a.exr a.png a.json cuts.png; do [ -s "$tmp/$f" ] || fail "render did not write $f"; done
 grep -q '"cut_size_mean"' "$tmp/a.json" || fail "stats JSON lacks cut_size_mean"
+grep -q '"black_lights": 0' "$tmp/a.json" || fail "stats JSON lacks black_lights"
 ls "$tmp" | grep -q '\.tmp' && fail "temporary files left behind"
 
 # compare: identical images give zero error; brute force differs from lightcuts a little.
@@ -43,6 +45,90 @@ expect_error "folder $tmp/nowhere does not exist" render "$root/scenes/room/room
 expect_error "must end in .exr" render "$root/scenes/room/room.json" -o "$tmp/c.png"
 expect_error "nope.exr" compare "$tmp/a.exr" "$tmp/nope.exr"
 [ -e "$tmp/c.exr" ] && fail "a failed render left c.exr behind"
+
+# Range edges: the command line takes the ranges of lightcuts/settings.h and
+# says what is wrong in the words the scene loader uses.
+mini="$root/tests/data/scenes/minimal.json"
+accept() {  # options for a CPU render of the one-triangle scene
+  "$exe" render "$mini" -o "$tmp/edge.exr" --no-png --device cpu "$@" >"$tmp/err.txt" 2>&1 ||
+    fail "refused $*: $(cat "$tmp/err.txt")"
+}
+accept --width 1 --height 1 --spp 1 --error 0 --max-cut 1 --seed 0 --method lightcuts
+accept --width 1 --height 1 --spp 65536 --error 1 --max-cut 4000000000 --seed 4294967295 --method lightcuts
+accept --width 1 --height 1 --max-cut 4294967295 --method lightcuts
+accept --width 16384 --height 1 --method brute
+accept --width 1 --height 16384 --method brute
+integer="must be an integer from"
+for bad in "--spp=0" "--spp=65537" "--spp=1.5" "--spp=x"; do
+  expect_error "--spp: $integer 1 to 65536" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
+for bad in "--error=-0.001" "--error=1.001" "--error=nan"; do
+  expect_error "--error: must be a number from 0 to 1" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
+for bad in "--max-cut=0" "--max-cut=4294967296"; do
+  expect_error "--max-cut: $integer 1 to 4294967295" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
+for bad in "--seed=-1" "--seed=4294967296"; do
+  expect_error "--seed: $integer 0 to 4294967295" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
+for side in width height; do for bad in 0 16385; do
+  expect_error "--$side: $integer 1 to 16384" render "$mini" -o "$tmp/edge2.exr" "--$side=$bad"; done; done
+expect_error '--method: must be "brute" or "lightcuts", got "fast"' render "$mini" -o "$tmp/edge2.exr" --method fast
+expect_error '--device: must be "auto", "cpu" or "vulkan"' render "$mini" -o "$tmp/edge2.exr" --device gpu
+[ -e "$tmp/edge2.exr" ] && fail "a refused render left edge2.exr behind"
+
+# --device auto without any Vulkan driver renders on the CPU and says so in
+# one line; --device vulkan fails.
+no_vulkan=(env VK_DRIVER_FILES=/nonexistent.json VK_ICD_FILENAMES=/nonexistent.json)
+"${no_vulkan[@]}" "$exe" render "$mini" -o "$tmp/auto.exr" --width 4 --height 4 --stats "$tmp/auto.json" \
+  >/dev/null 2>"$tmp/auto.txt" || fail "auto without Vulkan failed: $(cat "$tmp/auto.txt")"
+[ "$(grep -c '^note: no Vulkan device' "$tmp/auto.txt")" = 1 ] && [ "$(wc -l <"$tmp/auto.txt")" = 1 ] ||
+  fail "auto without Vulkan said: $(cat "$tmp/auto.txt")"
+grep -q '"device": "cpu"' "$tmp/auto.json" || fail "auto without Vulkan: $(cat "$tmp/auto.json")"
+if "${no_vulkan[@]}" "$exe" render "$mini" -o "$tmp/vk.exr" --device vulkan >"$tmp/vk.txt" 2>&1 ||
+   ! grep -q "no Vulkan device" "$tmp/vk.txt"; then fail "--device vulkan without Vulkan: $(cat "$tmp/vk.txt")"; fi
+
+# Outputs are all or nothing. no_output NAME: no file of that stem and no
+# temporary is left.
+no_output() {
+  local left; left="$(cd "$tmp" && ls -d "$1".* "$1"_* *.tmp* 2>/dev/null)"
+  [ -z "$left" ] || fail "$2 left behind: $left"
+}
+# Combinations refused before rendering.
+expect_error "needs method lightcuts" render "$mini" -o "$tmp/v.exr" --method brute --cut-heatmap "$tmp/v_cuts.png"
+expect_error "is also the PNG preview" render "$mini" -o "$tmp/v.exr" --method lightcuts --cut-heatmap "$tmp/v.png"
+expect_error "folder $tmp/nowhere does not exist" render "$mini" -o "$tmp/v.exr" --stats "$tmp/nowhere/v.json"
+mkdir "$tmp/v_dir"
+expect_error "v_dir: is a folder" render "$mini" -o "$tmp/v.exr" --stats "$tmp/v_dir"
+rmdir "$tmp/v_dir"
+no_output v "a refused render"
+mkdir "$tmp/scene" && cp "$mini" "$root/tests/data/scenes/tri.obj" "$tmp/scene/"
+expect_error "is the scene" render "$tmp/scene/minimal.json" -o "$tmp/v.exr" --stats "$tmp/scene/minimal.json"
+cmp -s "$mini" "$tmp/scene/minimal.json" || fail "a render overwrote its scene"
+no_output v "a render refused for overwriting its scene"
+
+# A write that fails after the render (the stats file exceeds the file size
+# limit; SIGXFSZ ignored so the write returns EFBIG), once the image and its
+# preview are written: neither may be left. A long scene path makes the JSON
+# over 1 KiB, the 1x1 image under.
+long="$tmp/scene_$(printf 'x%.0s' {1..200})"
+mkdir "$long" && cp "$mini" "$root/tests/data/scenes/tri.obj" "$long/"
+(trap '' XFSZ; ulimit -f 1; exec "$exe" render "$long/minimal.json" -o "$tmp/big.exr" --width 1 --height 1 \
+  --device cpu --method lightcuts --stats "$tmp/big.json" --cut-heatmap "$tmp/big_cuts.png") >"$tmp/log_big.txt" 2>&1 &&
+  fail "a stats file over the size limit did not fail the render"
+grep -q "big.json" "$tmp/log_big.txt" || fail "the failed stats write said: $(cat "$tmp/log_big.txt")"
+no_output big "a stats write that failed after the render"
+
+# A rename that fails after the render: the stats file's path becomes a folder
+# while the render runs (after its temporary is reserved). The image written
+# before it is taken back and the file it replaced restored.
+printf old >"$tmp/late.exr"
+"$exe" render "$root/scenes/room/room.json" -o "$tmp/late.exr" --width 48 --height 48 --device cpu \
+  --method brute --stats "$tmp/late.json" >"$tmp/log_late.txt" 2>&1 &
+pid=$!
+for _ in $(seq 500); do compgen -G "$tmp/late.json.tmp-*" >/dev/null && break; sleep 0.01; done
+kill -STOP "$pid" 2>/dev/null; mkdir "$tmp/late.json"; kill -CONT "$pid" 2>/dev/null
+wait "$pid" && fail "a stats path that became a folder did not fail the render"
+grep -q "late.json: cannot rename" "$tmp/log_late.txt" || fail "the failed rename said: $(cat "$tmp/log_late.txt")"
+printf old | cmp -s - "$tmp/late.exr" || fail "the failed render did not put the earlier late.exr back"
+rmdir "$tmp/late.json" && rm "$tmp/late.exr"
+no_output late "a rename that failed after the render"
 
 echo "$(( failures == 0 ? 1 : 0 )) passed, $failures failed"
 [ "$failures" -eq 0 ]

@@ -43,6 +43,12 @@ void write_png_rgb8(const std::filesystem::path& file, std::uint32_t width, std:
 // exposure <= 0 picks one that maps the 99th percentile luminance to 1.
 void write_png_tonemapped(const std::filesystem::path& file, const Image& image, float exposure = 0.0f);
 
+// The temporary the writers write before renaming onto `file`:
+// "<file>.tmp-<pid>-<n>", in the same folder so the rename stays within one
+// file system, and unique per process and call. Thread-safe. OutputSet names
+// its temporaries with it too, so one pattern finds every leftover.
+std::filesystem::path temporary_path_for(const std::filesystem::path& file);
+
 struct CompareResult {
     double relative_rmse = 0.0;       // sqrt(sum (a-r)^2 / sum r^2), all pixels and channels
     double fraction_above_1pct = 0.0; // of pixels whose relative luminance error exceeds 1%

@@ -5,6 +5,7 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bvh.h"
@@ -105,5 +106,26 @@ std::vector<std::string> list_vulkan_devices();
 // integrated or virtual GPU), as opposed to a software rasterizer such as
 // lavapipe, which is slower than the CPU path.
 bool vulkan_hardware_device_present();
+
+// ---- Device choice: which of the two renderers runs a render ----
+
+struct DeviceChoice {
+    std::string device = "auto";  // "auto", "cpu" or "vulkan"
+    VulkanOptions vulkan;
+    // Receives the one line that says why "auto" renders on the CPU (no
+    // hardware GPU, no Vulkan at all); unset: nothing is said.
+    std::function<void(const std::string&)> note;
+};
+
+// What is wrong with a device name, or "" for "auto", "cpu" and "vulkan".
+std::string device_problem(std::string_view device);
+
+// "cpu": render_cpu. "vulkan": render_vulkan, whatever the device, failing
+// as it fails (NoVulkanDevice included). "auto": Vulkan on a hardware GPU or
+// on the device `vulkan.gpu` names; otherwise, or when render_vulkan throws
+// NoVulkanDevice, the CPU, with a note (only a software rasterizer such as
+// lavapipe is slower than the CPU path). Throws std::invalid_argument for
+// any other device name.
+RenderResult render(const PreparedScene& prepared, const RenderOptions& options, const DeviceChoice& choice);
 
 }  // namespace lc

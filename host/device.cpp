@@ -1,0 +1,46 @@
+// Which renderer runs a render (DeviceChoice, include/lightcuts/render.h).
+// Compiled into lc_vulkan, the one library that sees both renderers.
+#include <stdexcept>
+#include <string>
+
+#include "lightcuts/render.h"
+
+namespace lc {
+
+namespace {
+
+void say(const DeviceChoice& choice, const std::string& line) {
+    if (choice.note) choice.note(line);
+}
+
+}  // namespace
+
+std::string device_problem(std::string_view device) {
+    if (device == "auto" || device == "cpu" || device == "vulkan") return "";
+    return "must be \"auto\", \"cpu\" or \"vulkan\", got \"" + std::string(device) + "\"";
+}
+
+RenderResult render(const PreparedScene& prepared, const RenderOptions& options, const DeviceChoice& choice) {
+    const std::string problem = device_problem(choice.device);
+    if (!problem.empty()) throw std::invalid_argument("device " + problem);
+    if (choice.device == "cpu") return render_cpu(prepared, options);
+    if (choice.device == "vulkan") return render_vulkan(prepared, options, choice.vulkan);
+
+    // auto: a named device is always tried; otherwise only real GPU hardware
+    // beats the CPU path (lavapipe on the same cores is several times slower).
+    if (choice.vulkan.gpu.empty() && !vulkan_hardware_device_present()) {
+        say(choice, list_vulkan_devices().empty()
+                        ? "no Vulkan device; rendering on the CPU"
+                        : "only a software Vulkan device is present; rendering on the CPU "
+                          "(device \"vulkan\" uses it anyway)");
+        return render_cpu(prepared, options);
+    }
+    try {
+        return render_vulkan(prepared, options, choice.vulkan);
+    } catch (const NoVulkanDevice& e) {
+        say(choice, std::string(e.what()) + "; rendering on the CPU");
+        return render_cpu(prepared, options);
+    }
+}
+
+}  // namespace lc

@@ -1,0 +1,180 @@
+// All-or-nothing output files (include/lightcuts/output_set.h).
+#include "lightcuts/output_set.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+#include <system_error>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include "lightcuts/image.h"
+
+namespace lc {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// What commit did for one output, so that a later failure can undo it.
+struct Placement {
+    fs::path backup;   // where the file the output replaces was moved; "" if none
+    bool placed = false;
+};
+
+fs::path identity_of(const fs::path& file) {
+    std::error_code ec;
+    fs::path id = fs::weakly_canonical(fs::absolute(file), ec);
+    return ec ? fs::absolute(file).lexically_normal() : id;
+}
+
+// Equal identities, or one file under two names (a hard link).
+bool same_file(const fs::path& a, const fs::path& b) {
+    std::error_code ec;
+    return a == b || (fs::equivalent(a, b, ec) && !ec);
+}
+
+// The temporary exists from the start so that a folder we may not write to
+// is found before the work, not after it.
+void create_empty(const fs::path& file, const std::string& label) {
+    const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0) throw std::runtime_error(label + ": cannot create a file beside it: " + std::strerror(errno));
+    ::close(fd);
+}
+
+// Moves a file already at `file` aside, then `temporary` onto `file`.
+// Returns the problem, or "" on success.
+std::string place(const fs::path& temporary, const fs::path& file, Placement& step) {
+    std::error_code ec;
+    const fs::file_status status = fs::symlink_status(file, ec);
+    // A folder is never moved aside: the rename below must fail on it.
+    if (fs::exists(status) && !fs::is_directory(status)) {
+        const fs::path backup = temporary_path_for(file);
+        fs::rename(file, backup, ec);
+        if (ec) return "cannot move the existing file aside: " + ec.message();
+        step.backup = backup;
+    }
+    fs::rename(temporary, file, ec);
+    if (ec) return "cannot rename the temporary file into place: " + ec.message();
+    step.placed = true;
+    return "";
+}
+
+// Undoes `place` for steps [0, end), newest first.
+void roll_back(const std::vector<fs::path>& files, const std::vector<Placement>& steps, std::size_t end) {
+    for (std::size_t i = end; i-- > 0;) {
+        std::error_code ec;
+        if (steps[i].placed) fs::remove(files[i], ec);
+        if (!steps[i].backup.empty()) fs::rename(steps[i].backup, files[i], ec);
+    }
+}
+
+void write_text(const fs::path& file, std::string_view text) {
+    errno = 0;
+    std::ofstream out(file, std::ios::binary | std::ios::trunc);
+    out.write(text.data(), std::streamsize(text.size()));
+    out.close();
+    if (!out) {
+        const std::string why = errno ? std::string(": ") + std::strerror(errno) : "";
+        throw std::runtime_error(file.string() + ": cannot write" + why);
+    }
+}
+
+fs::path preview_path(const fs::path& image) { return fs::path(image).replace_extension(".png"); }
+
+}  // namespace
+
+OutputSet::OutputSet(OutputSet&& other) noexcept
+    : inputs_(std::move(other.inputs_)), outputs_(std::move(other.outputs_)), committed_(other.committed_) {
+    other.outputs_.clear();
+}
+
+OutputSet::~OutputSet() {
+    if (committed_) return;
+    for (const Output& out : outputs_) {
+        std::error_code ignored;
+        fs::remove(out.temporary, ignored);
+    }
+}
+
+void OutputSet::add_input(const fs::path& file, std::string_view what) {
+    inputs_.push_back({file, identity_of(file), std::string(what)});
+}
+
+fs::path OutputSet::add(const fs::path& file, std::string_view what) {
+    const std::string label = std::string(what) + " " + file.string();
+    fs::path folder = file.parent_path();
+    if (folder.empty()) folder = ".";
+    if (!fs::is_directory(folder))
+        throw std::invalid_argument(label + ": folder " + folder.string() + " does not exist");
+    if (fs::is_directory(file)) throw std::invalid_argument(label + ": is a folder");
+    Named name{file, identity_of(file), std::string(what)};
+    for (const Named& input : inputs_)
+        if (same_file(name.identity, input.identity)) throw std::invalid_argument(label + ": is the " + input.what);
+    for (const Output& out : outputs_)
+        if (same_file(name.identity, out.name.identity))
+            throw std::invalid_argument(label + ": is also the " + out.name.what);
+    fs::path temporary = temporary_path_for(file);
+    create_empty(temporary, label);
+    outputs_.push_back({std::move(name), temporary});
+    return temporary;
+}
+
+fs::path OutputSet::temporary(const fs::path& file) const {
+    for (const Output& out : outputs_)
+        if (out.name.file == file) return out.temporary;
+    throw std::out_of_range("OutputSet: " + file.string() + " was not added");
+}
+
+void OutputSet::commit() {
+    if (committed_) throw std::logic_error("OutputSet::commit called twice");
+    std::vector<fs::path> files;
+    for (const Output& out : outputs_) files.push_back(out.name.file);
+    std::vector<Placement> steps(outputs_.size());
+    for (std::size_t i = 0; i < outputs_.size(); ++i) {
+        const std::string problem = place(outputs_[i].temporary, files[i], steps[i]);
+        if (problem.empty()) continue;
+        roll_back(files, steps, i + 1);
+        throw std::runtime_error(files[i].string() + ": " + problem);
+    }
+    committed_ = true;
+    for (const Placement& step : steps) {
+        std::error_code ignored;
+        if (!step.backup.empty()) fs::remove(step.backup, ignored);
+    }
+}
+
+OutputSet reserve_render_outputs(const RenderOutputs& outputs, const fs::path& scene_file, std::string_view method) {
+    if (outputs.image.extension() != ".exr")
+        throw std::invalid_argument("image " + outputs.image.string() + ": must end in .exr");
+    if (!outputs.cut_heatmap.empty() && method != "lightcuts")
+        throw std::invalid_argument("cut heatmap " + outputs.cut_heatmap.string() +
+                                    ": needs method lightcuts, not " + std::string(method));
+    OutputSet set;
+    set.add_input(scene_file, "scene");
+    set.add(outputs.image, "image");
+    if (outputs.png_preview) set.add(preview_path(outputs.image), "PNG preview");
+    if (!outputs.stats.empty()) set.add(outputs.stats, "stats file");
+    if (!outputs.cut_heatmap.empty()) set.add(outputs.cut_heatmap, "cut heatmap");
+    return set;
+}
+
+void write_render_outputs(OutputSet& set, const RenderOutputs& outputs, const RenderResult& result,
+                          std::string_view stats_json) {
+    write_exr(set.temporary(outputs.image), result.image);
+    if (outputs.png_preview) write_png_tonemapped(set.temporary(preview_path(outputs.image)), result.image);
+    if (!outputs.stats.empty()) write_text(set.temporary(outputs.stats), stats_json);
+    if (!outputs.cut_heatmap.empty()) {
+        const std::vector<float>& cuts = result.stats.cut_size;
+        // The scale runs from 0 to the largest cut, so the map uses its whole range.
+        const float largest = cuts.empty() ? 1.0f : *std::max_element(cuts.begin(), cuts.end());
+        write_heatmap_png(set.temporary(outputs.cut_heatmap), result.image.width, result.image.height, cuts,
+                          std::max(1.0f, largest));
+    }
+    set.commit();
+}
+
+}  // namespace lc

@@ -1,0 +1,181 @@
+// One record of a render, printed for people and written as JSON
+// (include/lightcuts/report.h).
+#include "lightcuts/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+#include <nlohmann/json.hpp>
+
+namespace lc {
+
+namespace {
+
+using nlohmann::json;
+
+// Nearest-rank percentile, p in [0, 1].
+double percentile(std::vector<float> v, double p) {
+    if (v.empty()) return 0.0;
+    const auto k = static_cast<std::size_t>(
+        std::min<double>(double(v.size() - 1), std::ceil(p * double(v.size())) - 1));
+    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
+    return v[k];
+}
+
+std::string human_bytes(std::uint64_t b) {
+    char buf[64];
+    if (b >= (1ull << 20)) std::snprintf(buf, sizeof buf, "%.1f MiB", double(b) / double(1 << 20));
+    else if (b >= 1024) std::snprintf(buf, sizeof buf, "%.1f KiB", double(b) / 1024.0);
+    else std::snprintf(buf, sizeof buf, "%llu B", static_cast<unsigned long long>(b));
+    return buf;
+}
+
+// printf into a std::string.
+template <class... Args>
+std::string format(const char* fmt, Args... args) {
+    const int n = std::snprintf(nullptr, 0, fmt, args...);
+    std::string s(std::size_t(std::max(n, 0)), '\0');
+    std::snprintf(s.data(), s.size() + 1, fmt, args...);
+    return s;
+}
+
+LightcutsReport lightcuts_report(const RenderOptions& o, const PreparedScene& p, const RenderStats& s) {
+    LightcutsReport l;
+    l.relative_error = o.relative_error;
+    l.max_cut = o.max_cut;
+    l.tree_nodes = p.tree.nodes.size();
+    l.tree_bytes = p.tree.nodes.size() * sizeof(gpu::LightNode);
+    const std::vector<float>& cuts = s.cut_size;
+    if (!cuts.empty()) {
+        l.cut_size_mean = std::accumulate(cuts.begin(), cuts.end(), 0.0) / double(cuts.size());
+        l.cut_size_max = *std::max_element(cuts.begin(), cuts.end());
+    }
+    l.cut_size_p50 = percentile(cuts, 0.5);
+    l.cut_size_p99 = percentile(cuts, 0.99);
+    l.max_cut_samples = s.max_cut_pixels;
+    l.heap_capacity_shared = s.heap_capacity_shared;
+    l.heap_spill_samples = s.heap_spill_pixels;
+    return l;
+}
+
+std::string lightcuts_text(const RenderReport& r, const LightcutsReport& l) {
+    std::string text = format("  light tree %zu nodes (%s) built in %.3f s\n", l.tree_nodes,
+                              human_bytes(l.tree_bytes).c_str(), r.seconds.light_tree_build);
+    text += format("  cut size mean %.1f, p50 %.0f, p99 %.0f, max %.0f; %llu samples hit max_cut %u\n",
+                   l.cut_size_mean, l.cut_size_p50, l.cut_size_p99, l.cut_size_max,
+                   static_cast<unsigned long long>(l.max_cut_samples), l.max_cut);
+    if (r.device != "cpu")
+        text += format("  cut heap: %u slots per pixel in shared memory; %llu samples spilled to global memory\n",
+                       l.heap_capacity_shared, static_cast<unsigned long long>(l.heap_spill_samples));
+    return text;
+}
+
+json lightcuts_json(const LightcutsReport& l) {
+    return {{"relative_error", l.relative_error},
+            {"max_cut", l.max_cut},
+            {"tree_nodes", l.tree_nodes},
+            {"tree_bytes", l.tree_bytes},
+            {"cut_size_mean", l.cut_size_mean},
+            {"cut_size_p50", l.cut_size_p50},
+            {"cut_size_p99", l.cut_size_p99},
+            {"cut_size_max", l.cut_size_max},
+            {"max_cut_samples", l.max_cut_samples},
+            {"heap_capacity_shared", l.heap_capacity_shared},
+            {"heap_spill_samples", l.heap_spill_samples}};
+}
+
+}  // namespace
+
+std::vector<BufferBytes> scene_buffer_bytes(const PreparedScene& prepared) {
+    std::vector<BufferBytes> buffers;
+    for (const SceneArray& a : scene_arrays(prepared)) buffers.push_back({a.name, a.bytes()});
+    return buffers;
+}
+
+RenderReport make_report(const std::string& scene_file, const RenderOptions& options,
+                         const PreparedScene& prepared, const RenderResult& result, double load_seconds) {
+    const RenderStats& s = result.stats;
+    RenderReport r;
+    r.scene = scene_file;
+    r.method = options.method;
+    r.device = s.device;
+    r.width = result.image.width;
+    r.height = result.image.height;
+    r.spp = options.spp;
+    r.triangles = prepared.scene.triangles.size();
+    r.lights = prepared.tree.lights.size();
+    r.bvh_nodes = prepared.bvh.nodes.size();
+    r.black_lights = prepared.tree.black_lights;
+    r.seconds = {load_seconds,    prepared.bvh.build_seconds, prepared.tree.build_seconds,
+                 s.seconds_total, s.seconds_primary,          s.seconds_shading};
+    r.camera_rays = s.camera_rays;
+    r.shadow_rays = s.shadow_rays;
+    const double pixels = double(r.width) * double(r.height);
+    r.shadow_rays_per_pixel = pixels > 0.0 ? double(s.shadow_rays) / pixels : 0.0;
+    r.rays_per_second = double(s.camera_rays + s.shadow_rays) / std::max(s.seconds_total, 1e-9);
+    r.buffer_bytes = scene_buffer_bytes(prepared);
+    for (const auto& [name, bytes] : s.buffer_bytes) {
+        auto same = std::find_if(r.buffer_bytes.begin(), r.buffer_bytes.end(),
+                                 [&](const BufferBytes& b) { return b.name == name; });
+        if (same != r.buffer_bytes.end()) same->bytes = bytes;
+        else r.buffer_bytes.push_back({name, bytes});
+    }
+    if (options.method == "lightcuts") r.lightcuts = lightcuts_report(options, prepared, s);
+    return r;
+}
+
+std::string report_text(const RenderReport& r) {
+    std::string text = format("%s: %ux%u, %u spp, %s on %s\n", r.scene.c_str(), r.width, r.height, r.spp,
+                              r.method.c_str(), r.device.c_str());
+    const std::string black =
+        r.black_lights ? format(" (and %zu black, left out of the tree)", r.black_lights) : std::string();
+    text += format("  triangles %zu, lights %zu%s, BVH %zu nodes built in %.3f s\n", r.triangles, r.lights,
+                   black.c_str(), r.bvh_nodes, r.seconds.bvh_build);
+    text += format("  render %.3f s, %.0f rays (%.2f Mrays/s), %.1f shadow rays per pixel\n", r.seconds.render,
+                   double(r.camera_rays + r.shadow_rays), r.rays_per_second * 1e-6, r.shadow_rays_per_pixel);
+    if (r.lightcuts) text += lightcuts_text(r, *r.lightcuts);
+    return text;
+}
+
+std::string report_json(const RenderReport& r) {
+    json buffers = json::object();
+    for (const BufferBytes& b : r.buffer_bytes) buffers[b.name] = b.bytes;
+    json j = {
+        {"scene", r.scene},
+        {"method", r.method},
+        {"device", r.device},
+        {"width", r.width},
+        {"height", r.height},
+        {"spp", r.spp},
+        {"triangles", r.triangles},
+        {"lights", r.lights},
+        {"black_lights", r.black_lights},
+        {"seconds", {{"load", r.seconds.load},
+                     {"bvh_build", r.seconds.bvh_build},
+                     {"light_tree_build", r.seconds.light_tree_build},
+                     {"render", r.seconds.render},
+                     {"primary", r.seconds.primary},
+                     {"shading", r.seconds.shading}}},
+        {"camera_rays", r.camera_rays},
+        {"shadow_rays", r.shadow_rays},
+        {"shadow_rays_per_pixel", r.shadow_rays_per_pixel},
+        {"rays_per_second", r.rays_per_second},
+        {"buffer_bytes", buffers},
+    };
+    if (r.lightcuts) j["lightcuts"] = lightcuts_json(*r.lightcuts);
+    return j.dump(2) + "\n";
+}
+
+std::string buffer_table(const std::vector<BufferBytes>& buffers) {
+    std::string text;
+    std::uint64_t total = 0;
+    for (const BufferBytes& b : buffers) {
+        text += format("    %-18s %s\n", b.name.c_str(), human_bytes(b.bytes).c_str());
+        total += b.bytes;
+    }
+    return text + format("    %-18s %s\n", "total", human_bytes(total).c_str());
+}
+
+}  // namespace lc

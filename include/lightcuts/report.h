@@ -1,0 +1,65 @@
+// What one render did, as one record: printed for people (report_text) and
+// written as JSON for scripts (report_json; bench/run reads its keys, so
+// keys are added, never renamed). Both are built from the same record, so
+// they cannot disagree.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "render.h"
+
+namespace lc {
+
+struct BufferBytes {
+    std::string name;
+    std::uint64_t bytes = 0;
+};
+
+struct LightcutsReport {
+    float relative_error = 0.0f;
+    std::uint32_t max_cut = 0;
+    std::size_t tree_nodes = 0;
+    std::uint64_t tree_bytes = 0;
+    double cut_size_mean = 0.0, cut_size_p50 = 0.0, cut_size_p99 = 0.0, cut_size_max = 0.0;
+    std::uint64_t max_cut_samples = 0;        // samples whose refinement stopped at max_cut
+    std::uint32_t heap_capacity_shared = 0;   // GPU only
+    std::uint64_t heap_spill_samples = 0;     // GPU only
+};
+
+struct RenderReport {
+    std::string scene, method, device;
+    std::uint32_t width = 0, height = 0, spp = 0;
+    std::size_t triangles = 0, lights = 0, bvh_nodes = 0;
+    std::size_t black_lights = 0;             // zero-intensity lights left out of the tree
+    struct Seconds {
+        double load = 0.0, bvh_build = 0.0, light_tree_build = 0.0;
+        double render = 0.0, primary = 0.0, shading = 0.0;
+    } seconds;
+    std::uint64_t camera_rays = 0, shadow_rays = 0;
+    double shadow_rays_per_pixel = 0.0, rays_per_second = 0.0;
+    // The kernels' arrays (scene_arrays), then the device's own buffers; a
+    // device buffer of the same name replaces the scene array's entry.
+    std::vector<BufferBytes> buffer_bytes;
+    std::optional<LightcutsReport> lightcuts; // method "lightcuts" only
+};
+
+// `scene_file` is reported as given; `load_seconds` is the time load_scene took.
+RenderReport make_report(const std::string& scene_file, const RenderOptions& options,
+                         const PreparedScene& prepared, const RenderResult& result, double load_seconds);
+
+// A few lines for a terminal, each ending in '\n'.
+std::string report_text(const RenderReport& report);
+
+// The report as an indented JSON object, ending in '\n'.
+std::string report_json(const RenderReport& report);
+
+// The sizes of the arrays the kernels read, in scene_arrays() order.
+std::vector<BufferBytes> scene_buffer_bytes(const PreparedScene& prepared);
+
+// One indented line per buffer ("    name   1.5 MiB") and a total line.
+std::string buffer_table(const std::vector<BufferBytes>& buffers);
+
+}  // namespace lc

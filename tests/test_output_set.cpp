@@ -1,0 +1,163 @@
+// All-or-nothing outputs (lightcuts/output_set.h): refusals come before any
+// work, and after any failure no output and no temporary is left and the
+// files the outputs would have replaced are as they were.
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include <unistd.h>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "lightcuts/output_set.h"
+#include "test_util.h"
+
+namespace lc {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+class OutputSetTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = fs::temp_directory_path() /
+               ("lc_test_output_set_" + std::to_string(::getpid()) + "_" + info->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    fs::path at(const std::string& name) const { return dir_ / name; }
+    std::set<std::string> entries() const {
+        std::set<std::string> names;
+        for (const auto& e : fs::directory_iterator(dir_)) names.insert(e.path().filename().string());
+        return names;
+    }
+    static void write(const fs::path& file, const std::string& text) { std::ofstream(file) << text; }
+    static std::string read(const fs::path& file) {
+        std::ostringstream s;
+        s << std::ifstream(file).rdbuf();
+        return s.str();
+    }
+    template <class F>
+    static std::string error_of(F&& f) {
+        try {
+            f();
+        } catch (const std::exception& e) {
+            return e.what();
+        }
+        return "(no exception)";
+    }
+
+    fs::path dir_;
+};
+
+TEST_F(OutputSetTest, CommitPutsEveryFileInPlace) {
+    write(at("b.txt"), "old");
+    {
+        OutputSet set;
+        write(set.add(at("a.txt"), "first"), "A");
+        write(set.add(at("b.txt"), "second"), "B");
+        EXPECT_EQ(entries().size(), 3u) << "the temporaries exist from add() on";
+        set.commit();
+    }
+    EXPECT_EQ(entries(), (std::set<std::string>{"a.txt", "b.txt"}));
+    EXPECT_EQ(read(at("a.txt")), "A");
+    EXPECT_EQ(read(at("b.txt")), "B");
+}
+
+TEST_F(OutputSetTest, UncommittedSetLeavesNothing) {
+    write(at("b.txt"), "old");
+    {
+        OutputSet set;
+        write(set.add(at("a.txt"), "first"), "A");
+        set.add(at("b.txt"), "second");
+        OutputSet moved(std::move(set));
+    }
+    EXPECT_EQ(entries(), (std::set<std::string>{"b.txt"}));
+    EXPECT_EQ(read(at("b.txt")), "old");
+}
+
+TEST_F(OutputSetTest, RefusesWhatCannotBeWrittenBeforeTheWork) {
+    write(at("scene.json"), "{}");
+    fs::create_directory(at("folder"));
+    fs::create_symlink(at("scene.json"), at("symlink.json"));
+    fs::create_hard_link(at("scene.json"), at("hardlink.json"));
+    OutputSet set;
+    set.add_input(at("scene.json"), "scene");
+    set.add(at("a.png"), "preview");
+    EXPECT_THAT(error_of([&] { set.add(at("missing") / "x.exr", "image"); }),
+                HasSubstr("image " + (at("missing") / "x.exr").string() + ": folder " + at("missing").string() +
+                          " does not exist"));
+    EXPECT_THAT(error_of([&] { set.add(at("folder"), "stats file"); }),
+                HasSubstr("stats file " + at("folder").string() + ": is a folder"));
+    for (const fs::path& scene : {dir_ / "." / "scene.json", at("symlink.json"), at("hardlink.json")})
+        EXPECT_THAT(error_of([&] { set.add(scene, "stats file"); }), HasSubstr(": is the scene")) << scene;
+    EXPECT_THAT(error_of([&] { set.add(dir_ / "folder" / ".." / "a.png", "cut heatmap"); }),
+                HasSubstr(": is also the preview"));
+    // The one accepted output reserved its temporary; the refused ones nothing.
+    std::set<std::string> now = entries();
+    ASSERT_EQ(now.size(), 5u);
+    for (const char* kept : {"folder", "hardlink.json", "scene.json", "symlink.json"}) EXPECT_TRUE(now.count(kept));
+    auto temporary = [](const std::string& name) { return name.starts_with("a.png.tmp-"); };
+    EXPECT_EQ(std::count_if(now.begin(), now.end(), temporary), 1);
+}
+
+// The rename of the last output fails (its path became a folder during the
+// work): the outputs renamed before it are taken back, the file one of them
+// replaced is restored, and no temporary or moved-aside file remains.
+TEST_F(OutputSetTest, FailedCommitTakesEverythingBack) {
+    write(at("a.txt"), "old a");
+    {
+        OutputSet set;
+        write(set.add(at("a.txt"), "first"), "new a");
+        write(set.add(at("b.txt"), "second"), "new b");
+        write(set.add(at("c.txt"), "third"), "new c");
+        fs::create_directory(at("c.txt"));
+        EXPECT_THAT(error_of([&] { set.commit(); }), HasSubstr(at("c.txt").string() + ": cannot rename"));
+    }
+    EXPECT_EQ(entries(), (std::set<std::string>{"a.txt", "c.txt"}));
+    EXPECT_EQ(read(at("a.txt")), "old a");
+    EXPECT_TRUE(fs::is_empty(at("c.txt")));
+}
+
+TEST_F(OutputSetTest, RenderOutputsRefuseImpossibleCombinations) {
+    write(at("scene.json"), "{}");
+    RenderOutputs o;
+    o.image = at("a.png");
+    EXPECT_THAT(error_of([&] { reserve_render_outputs(o, at("scene.json"), "brute"); }),
+                HasSubstr("must end in .exr"));
+    o.image = at("a.exr");
+    o.cut_heatmap = at("cuts.png");
+    EXPECT_THAT(error_of([&] { reserve_render_outputs(o, at("scene.json"), "brute"); }),
+                HasSubstr("needs method lightcuts"));
+    o.cut_heatmap = at("a.png");
+    EXPECT_THAT(error_of([&] { reserve_render_outputs(o, at("scene.json"), "lightcuts"); }),
+                HasSubstr("is also the PNG preview"));
+    o.png_preview = false;
+    o.stats = at("scene.json");
+    EXPECT_THAT(error_of([&] { reserve_render_outputs(o, at("scene.json"), "lightcuts"); }),
+                HasSubstr("is the scene"));
+    EXPECT_EQ(entries(), (std::set<std::string>{"scene.json"}));
+}
+
+TEST_F(OutputSetTest, RenderOutputsAreWrittenTogether) {
+    Scene s = test::room_scene({test::point_light({0.0f, 1.5f, 0.0f}, glm::vec3(1.0f))}, 4);
+    const PreparedScene prepared = prepare_scene(std::move(s), 1);
+    const RenderResult result = render_cpu(prepared, test::options("lightcuts", 4));
+    const RenderOutputs o{at("a.exr"), true, at("a.json"), at("cuts.png")};
+    OutputSet set = reserve_render_outputs(o, at("scene.json"), "lightcuts");
+    write_render_outputs(set, o, result, "{}\n");
+    EXPECT_EQ(entries(), (std::set<std::string>{"a.exr", "a.json", "a.png", "cuts.png"}));
+    EXPECT_EQ(read(at("a.json")), "{}\n");
+    EXPECT_EQ(read_exr(at("a.exr")).rgb, result.image.rgb);
+}
+
+}  // namespace
+}  // namespace lc

@@ -1,0 +1,85 @@
+// The render report (lightcuts/report.h): the JSON keeps every key scripts
+// read (bench/run) and adds the black lights; the text says what the JSON says.
+#include <string>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "lightcuts/report.h"
+#include "test_util.h"
+
+namespace lc {
+namespace {
+
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+// 20 lit lights and 3 black ones in the test room.
+PreparedScene room_with_black_lights() {
+    std::vector<gpu::Light> lights = test::random_point_lights(20, {-0.9f, 0.1f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 7);
+    for (float x : {-0.5f, 0.0f, 0.5f}) lights.push_back(test::point_light({x, 1.0f, 0.0f}, glm::vec3(0.0f)));
+    return prepare_scene(test::room_scene(std::move(lights), 8), 1);
+}
+
+TEST(Report, JsonHasEveryKeyScriptsReadAndTheBlackLights) {
+    const PreparedScene p = room_with_black_lights();
+    ASSERT_EQ(p.tree.black_lights, 3u);
+    const RenderOptions o = test::options("lightcuts", 8);
+    RenderResult r = render_cpu(p, o);
+    r.stats.buffer_bytes = {{"lights", 7}, {"g_buffer", 99}};  // as the Vulkan renderer reports its buffers
+    const RenderReport report = make_report("room.json", o, p, r, 0.25);
+    const std::string json = report_json(report);
+    for (const char* key : {"scene", "method", "device", "width", "height", "spp", "triangles", "lights",
+                            "seconds", "load", "bvh_build", "light_tree_build", "render", "primary", "shading",
+                            "camera_rays", "shadow_rays", "shadow_rays_per_pixel", "rays_per_second",
+                            "buffer_bytes", "bvh_nodes", "normals", "materials", "light_tree_nodes", "lightcuts",
+                            "relative_error", "max_cut", "tree_nodes", "tree_bytes", "cut_size_mean",
+                            "cut_size_p50", "cut_size_p99", "cut_size_max", "max_cut_samples",
+                            "heap_capacity_shared", "heap_spill_samples"}) {
+        std::string quoted = "\"";
+        quoted.append(key).append("\": ");
+        EXPECT_THAT(json, HasSubstr(quoted));
+    }
+    EXPECT_THAT(json, HasSubstr("\"black_lights\": 3,"));
+    EXPECT_THAT(json, HasSubstr("\"lights\": 20,"));
+    EXPECT_THAT(json, HasSubstr("\"lights\": 7")) << "a device buffer replaces the scene array of its name";
+    EXPECT_THAT(json, HasSubstr("\"g_buffer\": 99"));
+    EXPECT_THAT(json, HasSubstr("\"load\": 0.25"));
+    EXPECT_THAT(report_text(report), HasSubstr("lights 20 (and 3 black, left out of the tree)"));
+    EXPECT_THAT(report_text(report), HasSubstr("cut size mean"));
+}
+
+TEST(Report, BruteForceHasNoLightcutsPart) {
+    Scene s = test::room_scene({test::point_light({0.0f, 1.5f, 0.0f}, glm::vec3(1.0f))}, 4);
+    const PreparedScene p = prepare_scene(std::move(s), 1);
+    const RenderOptions o = test::options("brute", 4);
+    const RenderReport report = make_report("room.json", o, p, render_cpu(p, o), 0.0);
+    EXPECT_FALSE(report.lightcuts.has_value());
+    EXPECT_THAT(report_json(report), Not(HasSubstr("\"lightcuts\"")));
+    EXPECT_THAT(report_json(report), HasSubstr("\"black_lights\": 0,"));
+    EXPECT_THAT(report_text(report), Not(HasSubstr("black")));
+    EXPECT_THAT(report_text(report), Not(HasSubstr("cut size")));
+}
+
+// info and the report list the same arrays: the ones the kernels read.
+TEST(Report, BufferTableListsTheKernelsArraysAndTheirTotal) {
+    const PreparedScene p = room_with_black_lights();
+    const std::vector<BufferBytes> buffers = scene_buffer_bytes(p);
+    const std::vector<SceneArray> arrays = scene_arrays(p);
+    ASSERT_EQ(buffers.size(), arrays.size());
+    std::uint64_t total = 0;
+    for (std::size_t i = 0; i < arrays.size(); ++i) {
+        EXPECT_EQ(buffers[i].name, arrays[i].name);
+        EXPECT_EQ(buffers[i].bytes, arrays[i].bytes());
+        total += arrays[i].bytes();
+    }
+    const std::string table = buffer_table({{"a", 512}, {"b", 2048}, {"c", 3u << 20}});
+    EXPECT_THAT(table, HasSubstr("a                  512 B\n"));
+    EXPECT_THAT(table, HasSubstr("b                  2.0 KiB\n"));
+    EXPECT_THAT(table, HasSubstr("c                  3.0 MiB\n"));
+    EXPECT_THAT(table, HasSubstr("total              3.0 MiB\n"));
+    EXPECT_GT(total, 0u);
+}
+
+}  // namespace
+}  // namespace lc
