@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -108,7 +109,7 @@ TEST(SceneLoader, LoadsDefaultRoomScene) {
     EXPECT_GE(specular, 1u);
     for (const gpu::Triangle& t : scene.triangles) ASSERT_LT(t.material, scene.materials.size());
 
-    // Closed room: the camera and every light are inside the bounds.
+    // Closed room: the camera is inside the bounds (of the walls).
     for (int a = 0; a < 3; ++a) {
         EXPECT_LT(scene.bounds_min[a], scene.camera.position[a]);
         EXPECT_GT(scene.bounds_max[a], scene.camera.position[a]);
@@ -291,21 +292,59 @@ TEST(SceneLoader, DegenerateTrianglesAreDroppedAndCounted) {
     EXPECT_EQ(scene.degenerate_triangles_dropped, 3u);
 }
 
-TEST(SceneLoader, BoundsCoverTrianglesAndPointLightsOnly) {
+TEST(SceneLoader, BoundsCoverTrianglesOnlyNotLights) {
     Scene scene = load_scene(kFixtures / "all_lights.json");
-    // tri.obj spans [0,1]^2 x {0}; point lights reach (0,2,1), (1,2,3), (-1.5,0.25,0.2), (4,5,6).
-    expect_near(scene.bounds_min, {-1.5f, 0.0f, 0.0f});
-    expect_near(scene.bounds_max, {4.0f, 5.0f, 6.0f});
+    // tri.obj spans [0,1]^2 x {0}; the point lights at (0,2,1), (1,2,3),
+    // (-1.5,0.25,0.2) and (4,5,6) lie outside it and must not widen it.
+    expect_near(scene.bounds_min, {0.0f, 0.0f, 0.0f});
+    expect_near(scene.bounds_max, {1.0f, 1.0f, 0.0f});
 
     Scene empty;
+    empty.lights.push_back(gpu::Light{0, 9, 0, 1, 1, 1, gpu::kLightPoint, 0});
     empty.lights.push_back(gpu::Light{0, 0, 9, 1, 1, 1, gpu::kLightDirectional, 0});
-    update_bounds(empty);  // directional lights have no position
+    update_bounds(empty);  // no triangles: the zero box, whatever the lights
     expect_near(empty.bounds_min, glm::vec3(0.0f));
     expect_near(empty.bounds_max, glm::vec3(0.0f));
 
     scene.lights.push_back(gpu::Light{-10, 0, 0, 1, 1, 1, gpu::kLightPoint, 0});
     update_bounds(scene);
-    EXPECT_FLOAT_EQ(scene.bounds_min.x, -10.0f);
+    EXPECT_FLOAT_EQ(scene.bounds_min.x, 0.0f);
+}
+
+// Regression: prepare_scene derives the inverse-square clamp from the bounds,
+// so one far light used to set d_min = 1e-4 x 1e4 m = 1 m and darken the room.
+TEST(SceneLoader, FarPointLightDoesNotChangeTheBounds) {
+    const fs::path room_dir = kScenes / "room";
+    std::ifstream in(room_dir / "room.json");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // The copy lives elsewhere: point its relative paths back at scenes/room.
+    for (const std::string key : {"\"obj\": \"", "\"file\": \""}) {
+        for (auto at = text.find(key); at != std::string::npos; at = text.find(key, at + 1)) {
+            text.insert(at + key.size(), room_dir.string() + "/");
+        }
+    }
+    const std::string lights = "\"lights\": [";
+    const auto at = text.find(lights);
+    ASSERT_NE(at, std::string::npos);
+    text.insert(at + lights.size(), R"({"type": "point", "position": [0, 1e4, 0], "intensity": [1, 1, 1]},)");
+    TempDir dir;
+    const Scene far = load_scene(dir.write("room_far_light.json", text));
+    const Scene room = load_scene(room_dir / "room.json");
+    ASSERT_EQ(far.lights.size(), room.lights.size() + 1);
+    EXPECT_FLOAT_EQ(far.lights[0].y, 1e4f);
+    EXPECT_EQ(far.bounds_min, room.bounds_min);
+    EXPECT_EQ(far.bounds_max, room.bounds_max);
+    expect_near(far.bounds_max, {2.5f, 3.0f, 3.0f});
+}
+
+TEST(SceneLoader, UpdateBoundsRefusesAnExtentBeyondFloat) {
+    Scene scene;
+    scene.file = "hand_built.json";
+    scene.triangles.push_back(gpu::Triangle{2e38f, 0, 0, 3e38f, 0, 0, 2e38f, 1, 0, 0, 0, 0});
+    scene.triangles.push_back(gpu::Triangle{-2e38f, 0, 0, -2e38f, 1, 0, -3e38f, 0, 0, 0, 0, 0});
+    const std::string message = input_error_of([&] { update_bounds(scene); });
+    EXPECT_NE(message.find("hand_built.json: triangles[1]: "), std::string::npos) << message;
+    EXPECT_NE(message.find("extent along x exceeds the float range"), std::string::npos) << message;
 }
 
 // ---------------------------------------------------------------------------
@@ -386,6 +425,7 @@ const BadInput kBadInputs[] = {
     {"bad_obj_no_faces.json", "no_faces.obj", "", "no usable triangles"},
     {"bad_obj_all_degenerate.json", "all_degenerate.obj", "", "no usable triangles"},
     {"bad_obj_index.json", "bad_index.obj", "triangle 1: ", "vertex index 9 out of range"},
+    {"bad_obj_far_apart.json", "far_apart.obj", "triangle 2: ", "extent along x exceeds the float range (3.4e38)"},
     {"bad_obj_missing_mtl.json", "missing_mtl.obj", "mtllib: ", "'not_there.mtl' not found"},
     {"bad_obj_unknown_usemtl.json", "unknown_usemtl.obj", "usemtl: ", "no_such_material"},
     {"bad_mtl_kd.json", "bad_kd.obj", "material 'hot'.Kd: ", "[0, 1]"},

@@ -94,7 +94,7 @@ public:
             first += corners;
             check_indices(idx, f, shape);
             const int mtl_id = mesh.material_ids.empty() ? -1 : mesh.material_ids[f];
-            kept += add_triangle(idx, mtl_id) ? 1 : 0;
+            kept += add_triangle(idx, mtl_id, f, shape) ? 1 : 0;
         }
         return kept;
     }
@@ -169,7 +169,7 @@ private:
     }
 
     // False when the triangle is degenerate and dropped.
-    bool add_triangle(const Corners& idx, int mtl_id) {
+    bool add_triangle(const Corners& idx, int mtl_id, std::size_t f, const tinyobj::shape_t& shape) {
         const std::array<glm::vec3, 3> v{position(idx[0].vertex_index), position(idx[1].vertex_index),
                                          position(idx[2].vertex_index)};
         const glm::vec3 cross = glm::cross(v[1] - v[0], v[2] - v[0]);
@@ -178,6 +178,10 @@ private:
         if (!finite || !(twice_area > 0.0f)) {
             ++target_.scene.degenerate_triangles_dropped;
             return false;
+        }
+        for (const glm::vec3& p : v) target_.geometry.grow(glm::dvec3(p));
+        if (const std::string problem = extent_problem(target_.geometry); !problem.empty()) {
+            throw InputError(obj_name_, face_name(f, shape), "too far from the rest of the geometry: " + problem);
         }
         // Keep the face normal on the side the OBJ winding says, even when a
         // mirroring scale has flipped the winding.

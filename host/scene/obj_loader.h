@@ -7,6 +7,7 @@
 
 #include <glm/glm.hpp>
 
+#include "float_limits.h"
 #include "lightcuts/scene.h"
 
 namespace lc::loader {
@@ -21,12 +22,14 @@ struct MeshTransform {
 // The scene under construction, as the meshes see it.
 struct MeshTarget {
     Scene& scene;
+    Box geometry;  // around every triangle kept so far, in double
     std::optional<std::uint32_t> default_material;  // index, added on first use
 };
 
 // Appends the OBJ's triangles (transformed; degenerate ones dropped and
 // counted) and its MTL materials, or the one override material, to
-// target.scene. Throws InputError naming the OBJ and the place in it.
+// target.scene. Throws InputError naming the OBJ and the place in it; also
+// when the geometry so far would be too large for floats (float_limits.h).
 void load_obj(const std::filesystem::path& file, const MeshTransform& transform,
               const std::optional<gpu::Material>& override_material, MeshTarget& target);
 

@@ -53,7 +53,7 @@ private:
     fs::path dir_;
     JsonReader in_;
     Scene scene_;
-    MeshTarget meshes_{scene_, {}};
+    MeshTarget meshes_{scene_, {}, {}};
 
     fs::path resolve(const std::string& relative) const { return dir_ / relative; }
 

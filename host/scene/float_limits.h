@@ -1,0 +1,40 @@
+// What the renderer computes in 32-bit floats must stay finite there.
+//
+// Every coordinate in a scene is a finite float on its own, but the distance
+// clamp takes the diagonal of the scene bounds: coordinates near ±1e38 give an
+// infinite extent and then NaN. The loader unites in double as it reads, and
+// refuses the input where a float would overflow, naming the value that
+// tipped it over.
+#pragma once
+
+#include <limits>
+#include <string>
+
+#include <glm/glm.hpp>
+
+namespace lc::loader {
+
+inline constexpr double kFloatMax = std::numeric_limits<float>::max();
+
+// Finite and within ±FLT_MAX (false for NaN).
+inline bool fits_float(double v) { return v >= -kFloatMax && v <= kFloatMax; }
+inline bool fits_float(glm::dvec3 p) { return fits_float(p.x) && fits_float(p.y) && fits_float(p.z); }
+
+// An axis-aligned box in double; empty until the first point. glm::min and
+// glm::max skip NaN, so check points with fits_float before growing.
+struct Box {
+    glm::dvec3 lo{std::numeric_limits<double>::infinity()};
+    glm::dvec3 hi{-std::numeric_limits<double>::infinity()};
+
+    bool empty() const { return lo.x > hi.x; }
+    void grow(glm::dvec3 p) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+};
+
+// "" when the box's corners and its extent (max - min) along every axis are
+// finite as floats; otherwise which axis is not, for an error message.
+std::string extent_problem(const Box& box);
+
+}  // namespace lc::loader
