@@ -409,6 +409,16 @@ const BadInput kBadInputs[] = {
     {"bad_negative_irradiance.json", "bad_negative_irradiance.json", "lights[1].irradiance[0]: ",
      "negative"},
     {"bad_zero_direction.json", "bad_zero_direction.json", "lights[1].direction: ", "zero-length"},
+    // Sums the light tree would overflow: totals per light type and channel,
+    // also where a CSV tips them over, and a light too far from the geometry.
+    {"bad_point_total.json", "bad_point_total.json", ": lights: ",
+     "total red intensity of the point lights exceeds the float range (3.4e38)"},
+    {"bad_directional_total.json", "bad_directional_total.json", ": lights: ",
+     "total blue irradiance of the directional lights exceeds the float range (3.4e38)"},
+    {"bad_csv_total.json", "total_overflow.csv", "line 5: ",
+     "total red intensity of the point lights exceeds the float range (3.4e38)"},
+    {"bad_light_far.json", "bad_light_far.json", "lights[1].position: ",
+     "extent along y exceeds the float range (3.4e38)"},
     // Camera.
     {"bad_zero_width.json", "bad_zero_width.json", "camera.width: ", "[1, 16384]"},
     {"bad_negative_width.json", "bad_negative_width.json", "camera.width: ", "[1, 16384]"},
@@ -448,6 +458,14 @@ INSTANTIATE_TEST_SUITE_P(Fixtures, SceneLoaderBadInput, ::testing::ValuesIn(kBad
                              for (char& ch : name) ch = std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
                              return name;
                          });
+
+// The limits are per light type and only refuse what a float cannot hold.
+TEST(SceneLoader, LightTotalsAreKeptPerTypeUpToFloatMax) {
+    const Scene scene = load_scene(kFixtures / "large_totals.json");
+    EXPECT_EQ(scene.count_lights(gpu::kLightPoint), 2u);
+    EXPECT_EQ(scene.count_lights(gpu::kLightDirectional), 1u);
+    EXPECT_FLOAT_EQ(scene.lights[2].x, 3e38f);
+}
 
 TEST(SceneLoader, MissingSceneFileIsAnInputError) {
     const std::string message = input_error_of([] { load_scene(kFixtures / "nonexistent.json"); });
@@ -523,6 +541,10 @@ const CsvError kCsvErrors[] = {
     {"inf", "1,2,3,4,5,6\n-inf,2,3,4,5,6\n", "line 2: ", "is not finite"},
     {"overflow", "1,2,3,4,5,1e999\n", "line 1: ", "out of range"},
     {"negative", "1,2,3,4,-5,6\n", "line 1: ", "column 5 (g): intensity must not be negative"},
+    {"total_overflow", "0,0,0,0,0,3e38\n1,1,1,0,0,1\n2,2,2,0,0,3e38\n", "line 3: ",
+     "total blue intensity of the point lights exceeds the float range (3.4e38)"},
+    {"far_apart", "0,2e38,0,1,1,1\n0,0,0,1,1,1\n0,-2e38,0,1,1,1\n", "line 3: ",
+     "extent along y exceeds the float range (3.4e38)"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Cases, PointsCsvError, ::testing::ValuesIn(kCsvErrors),

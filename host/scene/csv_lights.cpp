@@ -106,7 +106,7 @@ gpu::Light parse_light(const Fields& fields, const std::string& file, const std:
 
 }  // namespace
 
-std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file) {
+std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file, LightLimits& limits) {
     const std::string name = display(file);
     const std::string text = read_input_file(file);
     std::vector<gpu::Light> lights;
@@ -132,7 +132,11 @@ std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file) {
         if (first_content && is_header(fields)) continue;
 
         const std::string where = "line " + std::to_string(line_number);
-        lights.push_back(parse_light(fields, name, where));
+        const gpu::Light light = parse_light(fields, name, where);
+        if (const LightLimits::Problem p = limits.add(light); p.fault != LightLimits::Fault::none) {
+            throw InputError(name, where, p.text);
+        }
+        lights.push_back(light);
     }
     return lights;
 }
@@ -140,7 +144,8 @@ std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file) {
 }  // namespace loader
 
 std::vector<gpu::Light> load_points_csv(const std::filesystem::path& file) {
-    return loader::read_points_csv(file);
+    loader::LightLimits limits;
+    return loader::read_points_csv(file, limits);
 }
 
 }  // namespace lc

@@ -4,11 +4,13 @@
 #include <filesystem>
 #include <vector>
 
-#include "../../shaders/shared/types.h"
+#include "float_limits.h"
 
 namespace lc::loader {
 
-// load_points_csv (lightcuts/scene.h).
-std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file);
+// load_points_csv (lightcuts/scene.h), with the totals and the box carried
+// over from the rest of the scene, so that an overflow is reported at the
+// CSV line that caused it.
+std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file, LightLimits& limits);
 
 }  // namespace lc::loader

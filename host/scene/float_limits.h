@@ -1,16 +1,20 @@
-// What the renderer computes in 32-bit floats must stay finite there.
+// What the renderer adds up in 32-bit floats must stay finite there.
 //
-// Every coordinate in a scene is a finite float on its own, but the distance
-// clamp takes the diagonal of the scene bounds: coordinates near ±1e38 give an
-// infinite extent and then NaN. The loader unites in double as it reads, and
-// refuses the input where a float would overflow, naming the value that
-// tipped it over.
+// Every value in a scene is a finite float on its own, but the light tree
+// sums intensities per light type and unites light boxes, and the distance
+// clamp takes the diagonal of the scene bounds: two lights of 2e38 make an
+// infinite root intensity, coordinates near ±1e38 an infinite extent and then
+// NaN. The loader sums and unites in double as it reads, and refuses the input
+// where a float would overflow, naming the value that tipped it over.
 #pragma once
 
+#include <array>
 #include <limits>
 #include <string>
 
 #include <glm/glm.hpp>
+
+#include "../../shaders/shared/types.h"
 
 namespace lc::loader {
 
@@ -36,5 +40,26 @@ struct Box {
 // "" when the box's corners and its extent (max - min) along every axis are
 // finite as floats; otherwise which axis is not, for an error message.
 std::string extent_problem(const Box& box);
+
+// Running totals over the lights of a scene, in file order: intensity per
+// light type and colour channel, and the box around the geometry and every
+// point light so far.
+class LightLimits {
+public:
+    explicit LightLimits(const Box& geometry = {}) : box_(geometry) {}
+
+    enum class Fault { none, total, position };
+    struct Problem {
+        Fault fault = Fault::none;
+        std::string text;  // for the InputError; empty when fault is none
+    };
+
+    // Adds one light; reports the first total or extent it pushes past FLT_MAX.
+    Problem add(const gpu::Light& light);
+
+private:
+    Box box_;
+    std::array<glm::dvec3, gpu::kLightTypeCount> totals_{};
+};
 
 }  // namespace lc::loader

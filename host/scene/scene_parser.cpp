@@ -17,6 +17,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "csv_lights.h"
+#include "float_limits.h"
 #include "input_file.h"
 #include "json_reader.h"
 #include "lightcuts/settings.h"
@@ -41,6 +42,7 @@ public:
 
         scene_.file = file_;
         parse_camera(in_.require(root, "", "camera"));
+        // Meshes before lights: the lights' extent is checked against the geometry.
         parse_meshes(in_.require(root, "", "meshes"));
         parse_lights(in_.require(root, "", "lights"));
         if (const json* r = JsonReader::find(root, "render")) parse_render(*r);
@@ -54,6 +56,7 @@ private:
     JsonReader in_;
     Scene scene_;
     MeshTarget meshes_{scene_, {}, {}};
+    LightLimits limits_;
 
     fs::path resolve(const std::string& relative) const { return dir_ / relative; }
 
@@ -181,11 +184,19 @@ private:
 
     void parse_lights(const json& j) {
         in_.expect_array(j, "lights");
+        limits_ = LightLimits(meshes_.geometry);
         for (std::size_t i = 0; i < j.size(); ++i) parse_light(j[i], join_index("lights", i));
         if (scene_.lights.empty()) in_.fail("lights", "the scene has no lights (after loading CSV files)");
     }
 
-    void add_light(const gpu::Light& light, const std::string&) { scene_.lights.push_back(light); }
+    // A total that overflows is the list's fault, not one entry's; a position
+    // too far out is the fault of the light that has it.
+    void add_light(const gpu::Light& light, const std::string& path) {
+        const LightLimits::Problem p = limits_.add(light);
+        if (p.fault == LightLimits::Fault::total) in_.fail("lights", p.text);
+        if (p.fault == LightLimits::Fault::position) in_.fail(path + ".position", p.text);
+        scene_.lights.push_back(light);
+    }
 
     void parse_light(const json& j, const std::string& path) {
         in_.expect_object(j, path);
@@ -211,7 +222,7 @@ private:
             const fs::path csv = resolve(in_.string(in_.require(j, path, "file"), field));
             std::error_code ec;
             if (!fs::is_regular_file(csv, ec)) in_.fail(field, "file not found: " + display(csv));
-            const std::vector<gpu::Light> loaded = read_points_csv(csv);
+            const std::vector<gpu::Light> loaded = read_points_csv(csv, limits_);
             scene_.lights.insert(scene_.lights.end(), loaded.begin(), loaded.end());
         } else {
             in_.fail(path + ".type", "unknown light type \"" + type + "\" (expected point, directional or points_csv)");

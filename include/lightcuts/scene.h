@@ -52,11 +52,14 @@ struct Scene {
 
 // Loads a scene from JSON (docs/scene-format.md). Throws InputError naming
 // the file and the field on any problem; never returns a half-loaded scene.
-// Also refuses geometry whose extent along an axis exceeds FLT_MAX.
+// Also refuses what would overflow the renderer's float sums: a per-type,
+// per-channel light intensity total above FLT_MAX, or a box around the
+// geometry and the point lights whose extent along an axis exceeds FLT_MAX.
 Scene load_scene(const std::filesystem::path& file);
 
 // Parses "x,y,z,r,g,b" lines into point lights (optional header line, '#'
-// comments). Throws InputError naming the file and line number.
+// comments). Throws InputError naming the file and line number, also for the
+// first line where the lights' total intensity or extent overflows a float.
 std::vector<gpu::Light> load_points_csv(const std::filesystem::path& file);
 
 // Recomputes scene.bounds_min/max from the triangles alone (lights are left
