@@ -16,6 +16,7 @@
 
 #include "lightcuts/error.h"
 #include "lightcuts/scene.h"
+#include "lightcuts/settings.h"
 
 namespace lc {
 namespace {
@@ -47,6 +48,8 @@ public:
         std::ofstream(file, std::ios::binary) << text;
         return file;
     }
+
+    const fs::path& path() const { return path_; }
 
 private:
     fs::path path_;
@@ -444,11 +447,12 @@ const BadInput kBadInputs[] = {
     {"bad_kd_override.json", "bad_kd_override.json", "meshes[0].material.kd[1]: ", "at most 1"},
     // Render block.
     {"bad_render_method.json", "bad_render_method.json", "render.method: ", "\"brute\" or \"lightcuts\""},
-    {"bad_render_spp.json", "bad_render_spp.json", "render.spp: ", "[1, "},
+    {"bad_render_spp.json", "bad_render_spp.json", "render.spp: ", "must be an integer from 1 to 65536"},
     {"bad_render_relative_error.json", "bad_render_relative_error.json", "render.relative_error: ",
-     "[0, inf)"},
-    {"bad_render_max_cut.json", "bad_render_max_cut.json", "render.max_cut: ", "[1, "},
-    {"bad_render_seed.json", "bad_render_seed.json", "render.seed: ", "4294967295"},
+     "must be a number from 0 to 1"},
+    {"bad_render_max_cut.json", "bad_render_max_cut.json", "render.max_cut: ",
+     "must be an integer from 1 to 4294967295"},
+    {"bad_render_seed.json", "bad_render_seed.json", "render.seed: ", "must be an integer from 0 to 4294967295"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Fixtures, SceneLoaderBadInput, ::testing::ValuesIn(kBadInputs),
@@ -465,6 +469,74 @@ TEST(SceneLoader, LightTotalsAreKeptPerTypeUpToFloatMax) {
     EXPECT_EQ(scene.count_lights(gpu::kLightPoint), 2u);
     EXPECT_EQ(scene.count_lights(gpu::kLightDirectional), 1u);
     EXPECT_FLOAT_EQ(scene.lights[2].x, 3e38f);
+}
+
+// ---------------------------------------------------------------------------
+// Render block: the ranges and texts of lightcuts/settings.h, as the CLI
+// ---------------------------------------------------------------------------
+
+// minimal.json with the given "render" block, in a fresh directory.
+fs::path scene_with_render(const TempDir& dir, const std::string& render) {
+    fs::copy_file(kFixtures / "tri.obj", dir.path() / "tri.obj", fs::copy_options::overwrite_existing);
+    return dir.write("render.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "tri.obj"}],
+ "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}],
+ "render": )" + render + "}\n");
+}
+
+struct BadSetting {
+    const char* key;
+    const char* json;  // the value as written in the file
+    double value;      // the same value, for setting_problem
+};
+
+void PrintTo(const BadSetting& c, std::ostream* os) { *os << c.key << " = " << c.json; }
+
+class RenderSettingRange : public ::testing::TestWithParam<BadSetting> {};
+
+TEST_P(RenderSettingRange, RefusedWithTheSettingsText) {
+    const BadSetting& c = GetParam();
+    TempDir dir;
+    const fs::path file = scene_with_render(dir, std::string(R"({")") + c.key + R"(": )" + c.json + "}");
+    const std::string message = input_error_of([&] { load_scene(file); });
+    const std::string problem = setting_problem(c.key, c.value);
+    ASSERT_FALSE(problem.empty());
+    EXPECT_EQ(message, file.lexically_normal().string() + ": render." + c.key + ": " + problem);
+}
+
+const BadSetting kBadSettings[] = {
+    {"spp", "65537", 65537.0},
+    {"spp", "2.5", 2.5},
+    {"max_cut", "0", 0.0},
+    {"relative_error", "1.5", 1.5},
+    {"relative_error", "-0.1", -0.1},
+    {"seed", "4294967296", 4294967296.0},
+};
+
+INSTANTIATE_TEST_SUITE_P(Cases, RenderSettingRange, ::testing::ValuesIn(kBadSettings),
+                         [](const ::testing::TestParamInfo<BadSetting>& info) {
+                             return std::string(info.param.key) + "_" + std::to_string(info.index);
+                         });
+
+TEST(SceneLoader, RenderSettingsAcceptTheFullRange) {
+    TempDir dir;
+    const Scene scene = load_scene(scene_with_render(
+        dir, R"({"method": "brute", "spp": 65536, "relative_error": 1, "max_cut": 4000000000, "seed": 0})"));
+    EXPECT_EQ(scene.render.spp, 65536u);
+    EXPECT_FLOAT_EQ(scene.render.relative_error, 1.0f);
+    EXPECT_EQ(scene.render.max_cut, 4000000000u);
+    EXPECT_EQ(scene.render.seed, 0u);
+}
+
+TEST(SceneLoader, RenderSettingProblemTextMatchesTheCommandLine) {
+    TempDir dir;
+    const fs::path file = scene_with_render(dir, R"({"spp": 65537})");
+    EXPECT_EQ(input_error_of([&] { load_scene(file); }),
+              file.lexically_normal().string() + ": render.spp: must be an integer from 1 to 65536");
+    // A type error stays the JSON reader's.
+    const fs::path typed = scene_with_render(dir, R"({"spp": "4"})");
+    EXPECT_EQ(input_error_of([&] { load_scene(typed); }),
+              typed.lexically_normal().string() + ": render.spp: expected a number, got string");
 }
 
 TEST(SceneLoader, MissingSceneFileIsAnInputError) {

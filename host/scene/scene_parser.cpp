@@ -90,27 +90,30 @@ private:
         if (!(sin_angle > 1e-6f)) in_.fail("camera.up", "must not be parallel to the view direction");
     }
 
+    // Ranges and problem texts come from lightcuts/settings.h, so a value is
+    // judged here exactly as on the command line.
     void parse_render(const json& j) {
         const std::string path = "render";
         in_.expect_object(j, path);
-        in_.check_keys(j, path, {"method", "spp", "relative_error", "max_cut", "seed"});
+        in_.check_keys(j, path, {kSettingMethod, kSettingSpp, kSettingRelativeError, kSettingMaxCut, kSettingSeed});
         RenderSettings& r = scene_.render;
-        if (const json* v = JsonReader::find(j, "method")) {
-            r.method = in_.string(*v, "render.method");
-            if (r.method != "brute" && r.method != "lightcuts") {
-                in_.fail("render.method", "must be \"brute\" or \"lightcuts\", got \"" + r.method + "\"");
-            }
+        if (const json* v = JsonReader::find(j, kSettingMethod)) {
+            const std::string field = join_key(path, kSettingMethod);
+            r.method = in_.string(*v, field);
+            if (const std::string problem = method_problem(r.method); !problem.empty()) in_.fail(field, problem);
         }
-        constexpr std::uint32_t kMaxU32 = std::numeric_limits<std::uint32_t>::max();
-        if (const json* v = JsonReader::find(j, "spp")) r.spp = in_.unsigned_int(*v, "render.spp", 1, kMaxU32);
-        if (const json* v = JsonReader::find(j, "relative_error")) {
-            r.relative_error = in_.number_in(*v, "render.relative_error", 0.0f,
-                                             std::numeric_limits<float>::infinity(), false, true);
-        }
-        if (const json* v = JsonReader::find(j, "max_cut")) {
-            r.max_cut = in_.unsigned_int(*v, "render.max_cut", 1, kMaxU32);
-        }
-        if (const json* v = JsonReader::find(j, "seed")) r.seed = in_.unsigned_int(*v, "render.seed", 0, kMaxU32);
+        const auto setting = [&](std::string_view key) -> std::optional<double> {
+            const json* v = JsonReader::find(j, key);
+            if (!v) return std::nullopt;
+            const std::string field = join_key(path, key);
+            const double value = in_.number_value(*v, field);
+            if (const std::string problem = setting_problem(key, value); !problem.empty()) in_.fail(field, problem);
+            return value;
+        };
+        if (const auto v = setting(kSettingSpp)) r.spp = static_cast<std::uint32_t>(*v);
+        if (const auto v = setting(kSettingRelativeError)) r.relative_error = static_cast<float>(*v);
+        if (const auto v = setting(kSettingMaxCut)) r.max_cut = static_cast<std::uint32_t>(*v);
+        if (const auto v = setting(kSettingSeed)) r.seed = static_cast<std::uint32_t>(*v);
     }
 
     // -- meshes -------------------------------------------------------------
