@@ -59,17 +59,17 @@ std::string face_name(std::size_t face, const tinyobj::shape_t& shape) {
 }
 
 // One OBJ's faces into target.scene: indices checked, positions and normals
-// transformed, degenerate triangles dropped, materials mapped.
+// transformed, degenerate triangles dropped, materials mapped. Construction
+// adds the OBJ's materials: either the one override or every MTL material.
 class FaceConverter {
 public:
-    FaceConverter(const tinyobj::ObjReader& reader, const MeshTransform& transform, MeshTarget& target,
-                  const std::string& obj_name, bool override_material)
+    FaceConverter(const tinyobj::ObjReader& reader, const MeshTransform& transform,
+                  const std::optional<gpu::Material>& override_material, MeshTarget& target,
+                  const std::string& obj_name)
         : attrib_(reader.GetAttrib()), transform_(transform), target_(target), obj_name_(obj_name),
-          override_(override_material), mtl_count_(override_material ? 0 : reader.GetMaterials().size()) {}
-
-    // Materials: either the one override or every MTL material of this OBJ.
-    void add_materials(const tinyobj::ObjReader& reader, const std::optional<gpu::Material>& override_material) {
-        material_base_ = static_cast<std::uint32_t>(target_.scene.materials.size());
+          override_(override_material.has_value()),
+          mtl_count_(override_ ? 0 : reader.GetMaterials().size()),
+          material_base_(static_cast<std::uint32_t>(target.scene.materials.size())) {
         if (override_material) {
             target_.scene.materials.push_back(*override_material);
             return;
@@ -106,7 +106,7 @@ private:
     const std::string& obj_name_;
     bool override_;
     std::size_t mtl_count_;
-    std::uint32_t material_base_ = 0;
+    std::uint32_t material_base_;
 
     // tinyobj only warns about out-of-range indices and keeps them.
     void check_indices(const Corners& idx, std::size_t f, const tinyobj::shape_t& shape) const {
@@ -205,8 +205,7 @@ void load_obj(const std::filesystem::path& file, const MeshTransform& transform,
     tinyobj::ObjReader reader;
     read_obj(file, obj_name, !override_material, reader);
 
-    FaceConverter faces(reader, transform, target, obj_name, override_material.has_value());
-    faces.add_materials(reader, override_material);
+    FaceConverter faces(reader, transform, override_material, target, obj_name);
     std::size_t kept = 0;
     for (const tinyobj::shape_t& shape : reader.GetShapes()) kept += faces.add_shape(shape);
     if (kept == 0) throw InputError(obj_name, "", "no usable triangles (after dropping degenerate ones)");
