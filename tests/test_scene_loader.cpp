@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 
 #include "lightcuts/error.h"
 #include "lightcuts/scene.h"
+#include "lightcuts/settings.h"
 
 namespace lc {
 namespace {
@@ -46,6 +48,8 @@ public:
         std::ofstream(file, std::ios::binary) << text;
         return file;
     }
+
+    const fs::path& path() const { return path_; }
 
 private:
     fs::path path_;
@@ -108,7 +112,7 @@ TEST(SceneLoader, LoadsDefaultRoomScene) {
     EXPECT_GE(specular, 1u);
     for (const gpu::Triangle& t : scene.triangles) ASSERT_LT(t.material, scene.materials.size());
 
-    // Closed room: the camera and every light are inside the bounds.
+    // Closed room: the camera is inside the bounds (of the walls).
     for (int a = 0; a < 3; ++a) {
         EXPECT_LT(scene.bounds_min[a], scene.camera.position[a]);
         EXPECT_GT(scene.bounds_max[a], scene.camera.position[a]);
@@ -291,21 +295,59 @@ TEST(SceneLoader, DegenerateTrianglesAreDroppedAndCounted) {
     EXPECT_EQ(scene.degenerate_triangles_dropped, 3u);
 }
 
-TEST(SceneLoader, BoundsCoverTrianglesAndPointLightsOnly) {
+TEST(SceneLoader, BoundsCoverTrianglesOnlyNotLights) {
     Scene scene = load_scene(kFixtures / "all_lights.json");
-    // tri.obj spans [0,1]^2 x {0}; point lights reach (0,2,1), (1,2,3), (-1.5,0.25,0.2), (4,5,6).
-    expect_near(scene.bounds_min, {-1.5f, 0.0f, 0.0f});
-    expect_near(scene.bounds_max, {4.0f, 5.0f, 6.0f});
+    // tri.obj spans [0,1]^2 x {0}; the point lights at (0,2,1), (1,2,3),
+    // (-1.5,0.25,0.2) and (4,5,6) lie outside it and must not widen it.
+    expect_near(scene.bounds_min, {0.0f, 0.0f, 0.0f});
+    expect_near(scene.bounds_max, {1.0f, 1.0f, 0.0f});
 
     Scene empty;
+    empty.lights.push_back(gpu::Light{0, 9, 0, 1, 1, 1, gpu::kLightPoint, 0});
     empty.lights.push_back(gpu::Light{0, 0, 9, 1, 1, 1, gpu::kLightDirectional, 0});
-    update_bounds(empty);  // directional lights have no position
+    update_bounds(empty);  // no triangles: the zero box, whatever the lights
     expect_near(empty.bounds_min, glm::vec3(0.0f));
     expect_near(empty.bounds_max, glm::vec3(0.0f));
 
     scene.lights.push_back(gpu::Light{-10, 0, 0, 1, 1, 1, gpu::kLightPoint, 0});
     update_bounds(scene);
-    EXPECT_FLOAT_EQ(scene.bounds_min.x, -10.0f);
+    EXPECT_FLOAT_EQ(scene.bounds_min.x, 0.0f);
+}
+
+// Regression: prepare_scene derives the inverse-square clamp from the bounds,
+// so one far light used to set d_min = 1e-4 x 1e4 m = 1 m and darken the room.
+TEST(SceneLoader, FarPointLightDoesNotChangeTheBounds) {
+    const fs::path room_dir = kScenes / "room";
+    std::ifstream in(room_dir / "room.json");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // The copy lives elsewhere: point its relative paths back at scenes/room.
+    for (const std::string key : {"\"obj\": \"", "\"file\": \""}) {
+        for (auto at = text.find(key); at != std::string::npos; at = text.find(key, at + 1)) {
+            text.insert(at + key.size(), room_dir.string() + "/");
+        }
+    }
+    const std::string lights = "\"lights\": [";
+    const auto at = text.find(lights);
+    ASSERT_NE(at, std::string::npos);
+    text.insert(at + lights.size(), R"({"type": "point", "position": [0, 1e4, 0], "intensity": [1, 1, 1]},)");
+    TempDir dir;
+    const Scene far = load_scene(dir.write("room_far_light.json", text));
+    const Scene room = load_scene(room_dir / "room.json");
+    ASSERT_EQ(far.lights.size(), room.lights.size() + 1);
+    EXPECT_FLOAT_EQ(far.lights[0].y, 1e4f);
+    EXPECT_EQ(far.bounds_min, room.bounds_min);
+    EXPECT_EQ(far.bounds_max, room.bounds_max);
+    expect_near(far.bounds_max, {2.5f, 3.0f, 3.0f});
+}
+
+TEST(SceneLoader, UpdateBoundsRefusesAnExtentBeyondFloat) {
+    Scene scene;
+    scene.file = "hand_built.json";
+    scene.triangles.push_back(gpu::Triangle{2e38f, 0, 0, 3e38f, 0, 0, 2e38f, 1, 0, 0, 0, 0});
+    scene.triangles.push_back(gpu::Triangle{-2e38f, 0, 0, -2e38f, 1, 0, -3e38f, 0, 0, 0, 0, 0});
+    const std::string message = input_error_of([&] { update_bounds(scene); });
+    EXPECT_NE(message.find("hand_built.json: triangles[1]: "), std::string::npos) << message;
+    EXPECT_NE(message.find("extent along x exceeds the float range"), std::string::npos) << message;
 }
 
 // ---------------------------------------------------------------------------
@@ -370,6 +412,16 @@ const BadInput kBadInputs[] = {
     {"bad_negative_irradiance.json", "bad_negative_irradiance.json", "lights[1].irradiance[0]: ",
      "negative"},
     {"bad_zero_direction.json", "bad_zero_direction.json", "lights[1].direction: ", "zero-length"},
+    // Sums the light tree would overflow: totals per light type and channel,
+    // also where a CSV tips them over, and a light too far from the geometry.
+    {"bad_point_total.json", "bad_point_total.json", ": lights: ",
+     "total red intensity of the point lights exceeds the float range (3.4e38)"},
+    {"bad_directional_total.json", "bad_directional_total.json", ": lights: ",
+     "total blue irradiance of the directional lights exceeds the float range (3.4e38)"},
+    {"bad_csv_total.json", "total_overflow.csv", "line 5: ",
+     "total red intensity of the point lights exceeds the float range (3.4e38)"},
+    {"bad_light_far.json", "bad_light_far.json", "lights[1].position: ",
+     "extent along y exceeds the float range (3.4e38)"},
     // Camera.
     {"bad_zero_width.json", "bad_zero_width.json", "camera.width: ", "[1, 16384]"},
     {"bad_negative_width.json", "bad_negative_width.json", "camera.width: ", "[1, 16384]"},
@@ -386,6 +438,7 @@ const BadInput kBadInputs[] = {
     {"bad_obj_no_faces.json", "no_faces.obj", "", "no usable triangles"},
     {"bad_obj_all_degenerate.json", "all_degenerate.obj", "", "no usable triangles"},
     {"bad_obj_index.json", "bad_index.obj", "triangle 1: ", "vertex index 9 out of range"},
+    {"bad_obj_far_apart.json", "far_apart.obj", "triangle 2: ", "extent along x exceeds the float range (3.4e38)"},
     {"bad_obj_missing_mtl.json", "missing_mtl.obj", "mtllib: ", "'not_there.mtl' not found"},
     {"bad_obj_unknown_usemtl.json", "unknown_usemtl.obj", "usemtl: ", "no_such_material"},
     {"bad_mtl_kd.json", "bad_kd.obj", "material 'hot'.Kd: ", "[0, 1]"},
@@ -394,11 +447,12 @@ const BadInput kBadInputs[] = {
     {"bad_kd_override.json", "bad_kd_override.json", "meshes[0].material.kd[1]: ", "at most 1"},
     // Render block.
     {"bad_render_method.json", "bad_render_method.json", "render.method: ", "\"brute\" or \"lightcuts\""},
-    {"bad_render_spp.json", "bad_render_spp.json", "render.spp: ", "[1, "},
+    {"bad_render_spp.json", "bad_render_spp.json", "render.spp: ", "must be an integer from 1 to 65536"},
     {"bad_render_relative_error.json", "bad_render_relative_error.json", "render.relative_error: ",
-     "[0, inf)"},
-    {"bad_render_max_cut.json", "bad_render_max_cut.json", "render.max_cut: ", "[1, "},
-    {"bad_render_seed.json", "bad_render_seed.json", "render.seed: ", "4294967295"},
+     "must be a number from 0 to 1"},
+    {"bad_render_max_cut.json", "bad_render_max_cut.json", "render.max_cut: ",
+     "must be an integer from 1 to 4294967295"},
+    {"bad_render_seed.json", "bad_render_seed.json", "render.seed: ", "must be an integer from 0 to 4294967295"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Fixtures, SceneLoaderBadInput, ::testing::ValuesIn(kBadInputs),
@@ -408,6 +462,82 @@ INSTANTIATE_TEST_SUITE_P(Fixtures, SceneLoaderBadInput, ::testing::ValuesIn(kBad
                              for (char& ch : name) ch = std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
                              return name;
                          });
+
+// The limits are per light type and only refuse what a float cannot hold.
+TEST(SceneLoader, LightTotalsAreKeptPerTypeUpToFloatMax) {
+    const Scene scene = load_scene(kFixtures / "large_totals.json");
+    EXPECT_EQ(scene.count_lights(gpu::kLightPoint), 2u);
+    EXPECT_EQ(scene.count_lights(gpu::kLightDirectional), 1u);
+    EXPECT_FLOAT_EQ(scene.lights[2].x, 3e38f);
+}
+
+// ---------------------------------------------------------------------------
+// Render block: the ranges and texts of lightcuts/settings.h, as the CLI
+// ---------------------------------------------------------------------------
+
+// minimal.json with the given "render" block, in a fresh directory.
+fs::path scene_with_render(const TempDir& dir, const std::string& render) {
+    fs::copy_file(kFixtures / "tri.obj", dir.path() / "tri.obj", fs::copy_options::overwrite_existing);
+    return dir.write("render.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "tri.obj"}],
+ "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}],
+ "render": )" + render + "}\n");
+}
+
+struct BadSetting {
+    const char* key;
+    const char* json;  // the value as written in the file
+    double value;      // the same value, for setting_problem
+};
+
+void PrintTo(const BadSetting& c, std::ostream* os) { *os << c.key << " = " << c.json; }
+
+class RenderSettingRange : public ::testing::TestWithParam<BadSetting> {};
+
+TEST_P(RenderSettingRange, RefusedWithTheSettingsText) {
+    const BadSetting& c = GetParam();
+    TempDir dir;
+    const fs::path file = scene_with_render(dir, std::string(R"({")") + c.key + R"(": )" + c.json + "}");
+    const std::string message = input_error_of([&] { load_scene(file); });
+    const std::string problem = setting_problem(c.key, c.value);
+    ASSERT_FALSE(problem.empty());
+    EXPECT_EQ(message, file.lexically_normal().string() + ": render." + c.key + ": " + problem);
+}
+
+const BadSetting kBadSettings[] = {
+    {"spp", "65537", 65537.0},
+    {"spp", "2.5", 2.5},
+    {"max_cut", "0", 0.0},
+    {"relative_error", "1.5", 1.5},
+    {"relative_error", "-0.1", -0.1},
+    {"seed", "4294967296", 4294967296.0},
+};
+
+INSTANTIATE_TEST_SUITE_P(Cases, RenderSettingRange, ::testing::ValuesIn(kBadSettings),
+                         [](const ::testing::TestParamInfo<BadSetting>& info) {
+                             return std::string(info.param.key) + "_" + std::to_string(info.index);
+                         });
+
+TEST(SceneLoader, RenderSettingsAcceptTheFullRange) {
+    TempDir dir;
+    const Scene scene = load_scene(scene_with_render(
+        dir, R"({"method": "brute", "spp": 65536, "relative_error": 1, "max_cut": 4000000000, "seed": 0})"));
+    EXPECT_EQ(scene.render.spp, 65536u);
+    EXPECT_FLOAT_EQ(scene.render.relative_error, 1.0f);
+    EXPECT_EQ(scene.render.max_cut, 4000000000u);
+    EXPECT_EQ(scene.render.seed, 0u);
+}
+
+TEST(SceneLoader, RenderSettingProblemTextMatchesTheCommandLine) {
+    TempDir dir;
+    const fs::path file = scene_with_render(dir, R"({"spp": 65537})");
+    EXPECT_EQ(input_error_of([&] { load_scene(file); }),
+              file.lexically_normal().string() + ": render.spp: must be an integer from 1 to 65536");
+    // A type error stays the JSON reader's.
+    const fs::path typed = scene_with_render(dir, R"({"spp": "4"})");
+    EXPECT_EQ(input_error_of([&] { load_scene(typed); }),
+              typed.lexically_normal().string() + ": render.spp: expected a number, got string");
+}
 
 TEST(SceneLoader, MissingSceneFileIsAnInputError) {
     const std::string message = input_error_of([] { load_scene(kFixtures / "nonexistent.json"); });
@@ -483,6 +613,10 @@ const CsvError kCsvErrors[] = {
     {"inf", "1,2,3,4,5,6\n-inf,2,3,4,5,6\n", "line 2: ", "is not finite"},
     {"overflow", "1,2,3,4,5,1e999\n", "line 1: ", "out of range"},
     {"negative", "1,2,3,4,-5,6\n", "line 1: ", "column 5 (g): intensity must not be negative"},
+    {"total_overflow", "0,0,0,0,0,3e38\n1,1,1,0,0,1\n2,2,2,0,0,3e38\n", "line 3: ",
+     "total blue intensity of the point lights exceeds the float range (3.4e38)"},
+    {"far_apart", "0,2e38,0,1,1,1\n0,0,0,1,1,1\n0,-2e38,0,1,1,1\n", "line 3: ",
+     "extent along y exceeds the float range (3.4e38)"},
 };
 
 INSTANTIATE_TEST_SUITE_P(Cases, PointsCsvError, ::testing::ValuesIn(kCsvErrors),

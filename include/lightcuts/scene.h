@@ -41,7 +41,9 @@ struct Scene {
     std::filesystem::path file;                  // the scene file it came from
     std::size_t degenerate_triangles_dropped = 0;
 
-    // Bounds of the geometry and the point lights (empty box if neither).
+    // Bounds of the triangles only, not of the lights (a zero box at the
+    // origin if there are none). They scale the inverse-square clamp, so a
+    // light far outside the geometry must not widen them (update_bounds).
     glm::vec3 bounds_min{0.0f};
     glm::vec3 bounds_max{0.0f};
 
@@ -50,13 +52,19 @@ struct Scene {
 
 // Loads a scene from JSON (docs/scene-format.md). Throws InputError naming
 // the file and the field on any problem; never returns a half-loaded scene.
+// Also refuses what would overflow the renderer's float sums: a per-type,
+// per-channel light intensity total above FLT_MAX, or a box around the
+// geometry and the point lights whose extent along an axis exceeds FLT_MAX.
 Scene load_scene(const std::filesystem::path& file);
 
 // Parses "x,y,z,r,g,b" lines into point lights (optional header line, '#'
-// comments). Throws InputError naming the file and line number.
+// comments). Throws InputError naming the file and line number, also for the
+// first line where the lights' total intensity or extent overflows a float.
 std::vector<gpu::Light> load_points_csv(const std::filesystem::path& file);
 
-// Recomputes scene.bounds_min/max from triangles and point lights.
+// Recomputes scene.bounds_min/max from the triangles alone (lights are left
+// out). Throws InputError naming scene.file and the triangle when a vertex or
+// the extent along an axis is not finite as a float.
 void update_bounds(Scene& scene);
 
 }  // namespace lc

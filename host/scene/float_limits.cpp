@@ -1,0 +1,49 @@
+// Overflow checks for the float sums and boxes the renderer builds (float_limits.h).
+#include "float_limits.h"
+
+namespace lc::loader {
+namespace {
+
+constexpr const char* kAxisNames[] = {"x", "y", "z"};
+constexpr const char* kChannelNames[] = {"red", "green", "blue"};
+constexpr const char* kFloatRange = "the float range (3.4e38)";
+
+}  // namespace
+
+std::string extent_problem(const Box& box) {
+    if (box.empty()) return {};
+    for (int a = 0; a < 3; ++a) {
+        if (!fits_float(box.lo[a]) || !fits_float(box.hi[a])) {
+            return std::string("the ") + kAxisNames[a] + " coordinate is outside " + kFloatRange;
+        }
+        if (!fits_float(box.hi[a] - box.lo[a])) {
+            return std::string("the extent along ") + kAxisNames[a] + " exceeds " + kFloatRange;
+        }
+    }
+    return {};
+}
+
+LightLimits::Problem LightLimits::add(const gpu::Light& light) {
+    const bool point = light.type == gpu::kLightPoint;
+    if (light.type < gpu::kLightTypeCount) {
+        glm::dvec3& total = totals_[light.type];
+        total += glm::dvec3(light.r, light.g, light.b);
+        for (int c = 0; c < 3; ++c) {
+            if (fits_float(total[c])) continue;
+            return {Fault::total, std::string("total ") + kChannelNames[c] +
+                                      (point ? " intensity of the point lights exceeds "
+                                             : " irradiance of the directional lights exceeds ") +
+                                      kFloatRange};
+        }
+    }
+    // A directional light has a direction, not a position: no box to grow.
+    if (!point) return {};
+    const glm::dvec3 p(light.x, light.y, light.z);
+    if (!fits_float(p)) return {Fault::position, "position is not finite"};
+    box_.grow(p);
+    std::string problem = extent_problem(box_);
+    if (problem.empty()) return {};
+    return {Fault::position, "too far from the geometry and the other lights: " + problem};
+}
+
+}  // namespace lc::loader

@@ -1,0 +1,65 @@
+// What the renderer adds up in 32-bit floats must stay finite there.
+//
+// Every value in a scene is a finite float on its own, but the light tree
+// sums intensities per light type and unites light boxes, and the distance
+// clamp takes the diagonal of the scene bounds: two lights of 2e38 make an
+// infinite root intensity, coordinates near ±1e38 an infinite extent and then
+// NaN. The loader sums and unites in double as it reads, and refuses the input
+// where a float would overflow, naming the value that tipped it over.
+#pragma once
+
+#include <array>
+#include <limits>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "../../shaders/shared/types.h"
+
+namespace lc::loader {
+
+inline constexpr double kFloatMax = std::numeric_limits<float>::max();
+
+// Finite and within ±FLT_MAX (false for NaN).
+inline bool fits_float(double v) { return v >= -kFloatMax && v <= kFloatMax; }
+inline bool fits_float(glm::dvec3 p) { return fits_float(p.x) && fits_float(p.y) && fits_float(p.z); }
+
+// An axis-aligned box in double; empty until the first point. glm::min and
+// glm::max skip NaN, so check points with fits_float before growing.
+struct Box {
+    glm::dvec3 lo{std::numeric_limits<double>::infinity()};
+    glm::dvec3 hi{-std::numeric_limits<double>::infinity()};
+
+    bool empty() const { return lo.x > hi.x; }
+    void grow(glm::dvec3 p) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+};
+
+// "" when the box's corners and its extent (max - min) along every axis are
+// finite as floats; otherwise which axis is not, for an error message.
+std::string extent_problem(const Box& box);
+
+// Running totals over the lights of a scene, in file order: intensity per
+// light type and colour channel, and the box around the geometry and every
+// point light so far.
+class LightLimits {
+public:
+    explicit LightLimits(const Box& geometry = {}) : box_(geometry) {}
+
+    enum class Fault { none, total, position };
+    struct Problem {
+        Fault fault = Fault::none;
+        std::string text;  // for the InputError; empty when fault is none
+    };
+
+    // Adds one light; reports the first total or extent it pushes past FLT_MAX.
+    Problem add(const gpu::Light& light);
+
+private:
+    Box box_;
+    std::array<glm::dvec3, gpu::kLightTypeCount> totals_{};
+};
+
+}  // namespace lc::loader

@@ -1,0 +1,67 @@
+// MTL entries and JSON overrides to gpu::Material (docs/scene-format.md, "Materials from MTL").
+#include "materials.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tiny_obj_loader.h>
+
+#include "lightcuts/error.h"
+
+namespace lc::loader {
+namespace {
+
+// GGX alpha floor: below this the fp32 NDF peak (1 / (pi alpha^2)) gets large
+// enough that single point-light highlights turn into isolated fireflies.
+constexpr float kMinGgxAlpha = 1e-3f;
+
+}  // namespace
+
+gpu::Material make_material(glm::vec3 kd, glm::vec3 ks, float alpha) {
+    gpu::Material m{};
+    m.kd_r = kd.r;
+    m.kd_g = kd.g;
+    m.kd_b = kd.b;
+    m.ks_r = ks.r;
+    m.ks_g = ks.g;
+    m.ks_b = ks.b;
+    m.alpha = std::clamp(alpha, kMinGgxAlpha, 1.0f);
+    m.flags = (ks.r > 0.0f || ks.g > 0.0f || ks.b > 0.0f) ? gpu::kMaterialHasSpecular : 0u;
+    return m;
+}
+
+gpu::Material default_material() { return make_material(glm::vec3(kDefaultAlbedo), glm::vec3(0.0f), 1.0f); }
+
+gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj_name) {
+    const std::string field = "material '" + mtl.name + "'";
+    const auto rgb = [&](const tinyobj::real_t* v, const char* key) {
+        glm::vec3 c;
+        for (int i = 0; i < 3; ++i) {
+            if (!std::isfinite(v[i]) || v[i] < 0.0 || v[i] > 1.0) {
+                throw InputError(obj_name, field + "." + key,
+                                 "components must be in [0, 1], got " + std::to_string(v[i]));
+            }
+            c[i] = static_cast<float>(v[i]);
+        }
+        return c;
+    };
+    const glm::vec3 kd = rgb(mtl.diffuse, "Kd");
+    const glm::vec3 ks = rgb(mtl.specular, "Ks");
+    // tinyobj leaves roughness at 0 when the MTL has no "Pr", so Pr = 0 means
+    // "not given" and the Blinn-Phong exponent decides (Walter et al. 2007).
+    float alpha = 1.0f;
+    if (mtl.roughness > 0.0) {
+        if (!std::isfinite(mtl.roughness) || mtl.roughness > 1.0) {
+            throw InputError(obj_name, field + ".Pr", "must be in [0, 1]");
+        }
+        alpha = static_cast<float>(mtl.roughness * mtl.roughness);
+    } else {
+        if (!std::isfinite(mtl.shininess) || mtl.shininess < 0.0) {
+            throw InputError(obj_name, field + ".Ns", "must be a finite number >= 0");
+        }
+        alpha = static_cast<float>(std::sqrt(2.0 / (mtl.shininess + 2.0)));
+    }
+    return make_material(kd, ks, alpha);
+}
+
+}  // namespace lc::loader

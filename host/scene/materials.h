@@ -1,0 +1,31 @@
+// Materials as the GPU reads them, from an MTL entry or a JSON override.
+#pragma once
+
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "../../shaders/shared/types.h"
+
+namespace tinyobj {
+struct material_t;
+}
+
+namespace lc::loader {
+
+// Lambert grey for faces that name no material.
+inline constexpr float kDefaultAlbedo = 0.8f;
+// Roughness used by a JSON material override that gives ks but no roughness.
+inline constexpr float kDefaultRoughness = 0.5f;
+
+// kd: Lambert albedo; ks: GGX lobe reflectance (any component > 0 turns the
+// lobe on); alpha: GGX roughness, clamped to [kMinGgxAlpha, 1].
+gpu::Material make_material(glm::vec3 kd, glm::vec3 ks, float alpha);
+
+// The material faces get when they name none.
+gpu::Material default_material();
+
+// One MTL entry. Throws InputError naming obj_name and "material 'NAME'.KEY".
+gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj_name);
+
+}  // namespace lc::loader

@@ -1,0 +1,214 @@
+// load_obj: one OBJ file's faces and materials into the scene (obj_loader.h).
+#include "obj_loader.h"
+
+#include <array>
+#include <cmath>
+#include <string>
+
+#include <tiny_obj_loader.h>
+
+#include "input_file.h"
+#include "lightcuts/error.h"
+#include "materials.h"
+
+namespace lc::loader {
+namespace {
+
+using Corners = std::array<tinyobj::index_t, 3>;
+
+bool is_finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// tinyobj treats a missing .mtl or an unknown usemtl name as a warning and
+// falls back to "no material"; silently grey walls are worse than an error.
+void check_material_warnings(const std::string& warning, const std::string& obj_name) {
+    if (warning.find("Failed to load material file") != std::string::npos ||
+        warning.find("Material file [") != std::string::npos) {
+        // tinyobj's warning reads "Material file [ NAME ] not found ...".
+        std::string library = "material library";
+        if (const auto open = warning.find("[ "), close = warning.find(" ]");
+            open != std::string::npos && close != std::string::npos && close > open) {
+            library = "'" + warning.substr(open + 2, close - open - 2) + "'";
+        }
+        throw InputError(obj_name, "mtllib", library + " not found next to the OBJ");
+    }
+    if (const auto at = warning.find("not found in .mtl"); at != std::string::npos) {
+        const auto begin = warning.rfind('\n', at);
+        const auto from = begin == std::string::npos ? 0 : begin + 1;
+        throw InputError(obj_name, "usemtl",
+                         "tinyobjloader: " + warning.substr(from, at - from) + "not found in .mtl");
+    }
+}
+
+void read_obj(const std::filesystem::path& file, const std::string& obj_name, bool uses_mtl,
+              tinyobj::ObjReader& reader) {
+    tinyobj::ObjReaderConfig config;
+    config.triangulate = true;
+    config.vertex_color = false;
+    if (!reader.ParseFromFile(file.string(), config)) {
+        std::string err = reader.Error();
+        while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+        throw InputError(obj_name, "", "tinyobjloader: " + (err.empty() ? "parse failed" : err));
+    }
+    if (uses_mtl) check_material_warnings(reader.Warning(), obj_name);
+}
+
+// Built only on error: the face loop runs once per triangle.
+std::string face_name(std::size_t face, const tinyobj::shape_t& shape) {
+    return "triangle " + std::to_string(face + 1) +
+           (shape.name.empty() ? std::string() : " of shape '" + shape.name + "'");
+}
+
+// One OBJ's faces into target.scene: indices checked, positions and normals
+// transformed, degenerate triangles dropped, materials mapped. Construction
+// adds the OBJ's materials: either the one override or every MTL material.
+class FaceConverter {
+public:
+    FaceConverter(const tinyobj::ObjReader& reader, const MeshTransform& transform,
+                  const std::optional<gpu::Material>& override_material, MeshTarget& target,
+                  const std::string& obj_name)
+        : attrib_(reader.GetAttrib()), transform_(transform), target_(target), obj_name_(obj_name),
+          override_(override_material.has_value()),
+          mtl_count_(override_ ? 0 : reader.GetMaterials().size()),
+          material_base_(static_cast<std::uint32_t>(target.scene.materials.size())) {
+        if (override_material) {
+            target_.scene.materials.push_back(*override_material);
+            return;
+        }
+        for (const tinyobj::material_t& m : reader.GetMaterials()) {
+            target_.scene.materials.push_back(convert_mtl(m, obj_name_));
+        }
+    }
+
+    // Returns how many of the shape's triangles were kept.
+    std::size_t add_shape(const tinyobj::shape_t& shape) {
+        const tinyobj::mesh_t& mesh = shape.mesh;
+        std::size_t kept = 0;
+        std::size_t first = 0;
+        for (std::size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
+            const std::size_t corners = mesh.num_face_vertices[f];
+            if (corners != 3) {
+                throw InputError(obj_name_, face_name(f, shape),
+                                 "has " + std::to_string(corners) + " corners after triangulation");
+            }
+            const Corners idx{mesh.indices[first], mesh.indices[first + 1], mesh.indices[first + 2]};
+            first += corners;
+            check_indices(idx, f, shape);
+            const int mtl_id = mesh.material_ids.empty() ? -1 : mesh.material_ids[f];
+            kept += add_triangle(idx, mtl_id, f, shape) ? 1 : 0;
+        }
+        return kept;
+    }
+
+private:
+    const tinyobj::attrib_t& attrib_;
+    const MeshTransform& transform_;
+    MeshTarget& target_;
+    const std::string& obj_name_;
+    bool override_;
+    std::size_t mtl_count_;
+    std::uint32_t material_base_;
+
+    // tinyobj only warns about out-of-range indices and keeps them.
+    void check_indices(const Corners& idx, std::size_t f, const tinyobj::shape_t& shape) const {
+        const std::size_t vertex_count = attrib_.vertices.size() / 3;
+        const std::size_t normal_count = attrib_.normals.size() / 3;
+        for (const tinyobj::index_t& i : idx) {
+            if (i.vertex_index < 0 || static_cast<std::size_t>(i.vertex_index) >= vertex_count) {
+                throw InputError(obj_name_, face_name(f, shape),
+                                 "vertex index " + std::to_string(i.vertex_index + 1) + " out of range (" +
+                                     std::to_string(vertex_count) + " vertices)");
+            }
+            if (i.normal_index >= 0 && static_cast<std::size_t>(i.normal_index) >= normal_count) {
+                throw InputError(obj_name_, face_name(f, shape),
+                                 "normal index " + std::to_string(i.normal_index + 1) + " out of range (" +
+                                     std::to_string(normal_count) + " normals)");
+            }
+        }
+    }
+
+    glm::vec3 position(int index) const {
+        const auto k = static_cast<std::size_t>(index) * 3;
+        return glm::vec3(transform_.position * glm::vec4(static_cast<float>(attrib_.vertices[k]),
+                                                         static_cast<float>(attrib_.vertices[k + 1]),
+                                                         static_cast<float>(attrib_.vertices[k + 2]), 1.0f));
+    }
+
+    glm::vec3 normal(int index) const {
+        const auto k = static_cast<std::size_t>(index) * 3;
+        return transform_.normal * glm::vec3(static_cast<float>(attrib_.normals[k]),
+                                             static_cast<float>(attrib_.normals[k + 1]),
+                                             static_cast<float>(attrib_.normals[k + 2]));
+    }
+
+    // The OBJ's vertex normals when all three corners have a usable one; a
+    // zero or broken vertex normal would poison shading, so the face normal
+    // is the honest fallback.
+    std::array<glm::vec3, 3> shading_normals(const Corners& idx, glm::vec3 face_normal) const {
+        const std::array<glm::vec3, 3> flat{face_normal, face_normal, face_normal};
+        std::array<glm::vec3, 3> vn{};
+        for (std::size_t c = 0; c < 3; ++c) {
+            if (idx[c].normal_index < 0) return flat;
+            vn[c] = normal(idx[c].normal_index);
+            const float len = glm::length(vn[c]);
+            if (!(len > 0.0f) || !std::isfinite(len)) return flat;
+            vn[c] /= len;
+        }
+        return vn;
+    }
+
+    std::uint32_t material_of(int mtl_id) {
+        if (override_) return material_base_;
+        if (mtl_id >= 0 && static_cast<std::size_t>(mtl_id) < mtl_count_) {
+            return material_base_ + static_cast<std::uint32_t>(mtl_id);
+        }
+        if (!target_.default_material) {
+            target_.default_material = static_cast<std::uint32_t>(target_.scene.materials.size());
+            target_.scene.materials.push_back(default_material());
+        }
+        return *target_.default_material;
+    }
+
+    // False when the triangle is degenerate and dropped.
+    bool add_triangle(const Corners& idx, int mtl_id, std::size_t f, const tinyobj::shape_t& shape) {
+        const std::array<glm::vec3, 3> v{position(idx[0].vertex_index), position(idx[1].vertex_index),
+                                         position(idx[2].vertex_index)};
+        const glm::vec3 cross = glm::cross(v[1] - v[0], v[2] - v[0]);
+        const float twice_area = glm::length(cross);
+        const bool finite = is_finite(v[0]) && is_finite(v[1]) && is_finite(v[2]) && std::isfinite(twice_area);
+        if (!finite || !(twice_area > 0.0f)) {
+            ++target_.scene.degenerate_triangles_dropped;
+            return false;
+        }
+        for (const glm::vec3& p : v) target_.geometry.grow(glm::dvec3(p));
+        if (const std::string problem = extent_problem(target_.geometry); !problem.empty()) {
+            throw InputError(obj_name_, face_name(f, shape), "too far from the rest of the geometry: " + problem);
+        }
+        // Keep the face normal on the side the OBJ winding says, even when a
+        // mirroring scale has flipped the winding.
+        const glm::vec3 face_normal = cross / twice_area * (transform_.mirrors ? -1.0f : 1.0f);
+        const std::array<glm::vec3, 3> n = shading_normals(idx, face_normal);
+        // After the degenerate check: a dropped face must not add the default material.
+        const std::uint32_t material = material_of(mtl_id);
+        target_.scene.triangles.push_back(gpu::Triangle{v[0].x, v[0].y, v[0].z, v[1].x, v[1].y, v[1].z,
+                                                        v[2].x, v[2].y, v[2].z, material, 0u, 0u});
+        target_.scene.normals.push_back(gpu::TriangleNormals{n[0].x, n[0].y, n[0].z, n[1].x, n[1].y, n[1].z,
+                                                             n[2].x, n[2].y, n[2].z, 0u, 0u, 0u});
+        return true;
+    }
+};
+
+}  // namespace
+
+void load_obj(const std::filesystem::path& file, const MeshTransform& transform,
+              const std::optional<gpu::Material>& override_material, MeshTarget& target) {
+    const std::string obj_name = display(file);
+    tinyobj::ObjReader reader;
+    read_obj(file, obj_name, !override_material, reader);
+
+    FaceConverter faces(reader, transform, override_material, target, obj_name);
+    std::size_t kept = 0;
+    for (const tinyobj::shape_t& shape : reader.GetShapes()) kept += faces.add_shape(shape);
+    if (kept == 0) throw InputError(obj_name, "", "no usable triangles (after dropping degenerate ones)");
+}
+
+}  // namespace lc::loader

@@ -1,0 +1,36 @@
+// Wavefront OBJ/MTL meshes (through tinyobjloader) into the scene's triangles.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+#include <glm/glm.hpp>
+
+#include "float_limits.h"
+#include "lightcuts/scene.h"
+
+namespace lc::loader {
+
+// A mesh's placement: p' = position * p; normals go through the inverse transpose.
+struct MeshTransform {
+    glm::mat4 position{1.0f};
+    glm::mat3 normal{1.0f};
+    bool mirrors = false;  // odd number of negative scales flips winding
+};
+
+// The scene under construction, as the meshes see it.
+struct MeshTarget {
+    Scene& scene;
+    Box geometry;  // around every triangle kept so far, in double
+    std::optional<std::uint32_t> default_material;  // index, added on first use
+};
+
+// Appends the OBJ's triangles (transformed; degenerate ones dropped and
+// counted) and its MTL materials, or the one override material, to
+// target.scene. Throws InputError naming the OBJ and the place in it; also
+// when the geometry so far would be too large for floats (float_limits.h).
+void load_obj(const std::filesystem::path& file, const MeshTransform& transform,
+              const std::optional<gpu::Material>& override_material, MeshTarget& target);
+
+}  // namespace lc::loader
