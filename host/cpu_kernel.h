@@ -38,6 +38,7 @@ struct ShadeKernel {
     const Material* materials = nullptr;
     const Light* lights = nullptr;
     const LightNode* light_nodes = nullptr;
+    const float* environment = nullptr;  // RGB texels of the environment map
     CutEntry* heap = nullptr;
     // Highest heap slot written + 1 since the caller last reset it: tells how
     // many slots a cut needed (the GPU keeps only the first K in shared memory).
@@ -55,6 +56,7 @@ struct ShadeKernel {
 #define LC_MATERIAL(i) materials[i]
 #define LC_LIGHT(i) lights[i]
 #define LC_LIGHT_NODE(i) light_nodes[i]
+#define LC_ENVIRONMENT_TEXEL(i) vec3(environment[3u * (i)], environment[3u * (i) + 1u], environment[3u * (i) + 2u])
 #define LC_HEAP_LOAD(i) heap[i]
 #define LC_HEAP_STORE(i, e) (heap_high_water = max(heap_high_water, (i) + 1u), heap[i] = (e))
 #include "shared/trace.h"
@@ -67,6 +69,7 @@ struct ShadeKernel {
 #undef LC_MATERIAL
 #undef LC_LIGHT
 #undef LC_LIGHT_NODE
+#undef LC_ENVIRONMENT_TEXEL
 #undef LC_HEAP_LOAD
 #undef LC_HEAP_STORE
 };
@@ -80,6 +83,7 @@ inline ShadeKernel make_shade_kernel(const PreparedScene& p, CutEntry* heap) {
     k.materials = p.scene.materials.data();
     k.lights = p.tree.lights.data();
     k.light_nodes = p.tree.nodes.data();
+    k.environment = p.scene.environment.rgb.data();
     k.heap = heap;
     return k;
 }

@@ -36,7 +36,10 @@ PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, bool
     std::uint64_t cut_sum = 0;
     for (std::uint32_t s = 0; s < frame.spp; ++s) {
         cpu::ShadeKernel::SurfacePoint sp;
-        if (!k.lc_camera_hit(frame, x, y, s, sp)) continue;
+        glm::vec3 seen;
+        const bool hit = k.lc_camera_sample(frame, x, y, s, sp, seen);
+        sum += seen;
+        if (!hit) continue;
         cpu::ShadeKernel::ShadeStats ss{0u, 0u, 0u};
         sum += lightcuts ? k.lc_shade_lightcuts(sp, frame, ss)
                          : k.lc_shade_brute(sp, frame.light_count, frame.min_distance2, ss);

@@ -28,7 +28,7 @@ struct Totals {
 
 class Splitter {
 public:
-    Splitter(const EnvironmentMap& map, std::vector<gpu::Light>& out) : map_(map), out_(out) {
+    Splitter(const Environment& map, std::vector<gpu::Light>& out) : map_(map), out_(out) {
         // Exact solid angle of a texel of each row: (2 pi / W)(cos top - cos bottom).
         row_solid_angle_.resize(map.height);
         for (std::uint32_t y = 0; y < map.height; ++y)
@@ -100,7 +100,7 @@ private:
         out_.push_back(l);
     }
 
-    const EnvironmentMap& map_;
+    const Environment& map_;
     std::vector<gpu::Light>& out_;
     std::vector<double> row_solid_angle_;
 };
@@ -115,7 +115,7 @@ void environment_direction(float u, float v, float out[3]) {
     out[2] = float(-std::sin(theta) * std::cos(phi));
 }
 
-std::vector<gpu::Light> environment_lights(const EnvironmentMap& map, std::uint32_t count) {
+std::vector<gpu::Light> environment_lights(const Environment& map, std::uint32_t count) {
     std::vector<gpu::Light> lights;
     if (map.width == 0 || map.height == 0 || count == 0) return lights;
     lights.reserve(count);

@@ -6,19 +6,15 @@
 #include <span>
 #include <vector>
 
+#include "lightcuts/scene.h"
 #include "shared/types.h"
 
 namespace lc {
 
-// A lat-long RGB radiance map (docs/scene-format.md): for a unit world
-// direction d (+Y up), u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi,
-// column floor(u W), row floor(v H), row 0 at the top.
-struct EnvironmentMap {
-    std::uint32_t width = 0, height = 0;
-    std::vector<float> rgb;  // row-major, three floats per texel, already scaled
-};
-
-// The unit direction through texel position (u, v) in [0, 1]^2.
+// The map is lat-long (docs/scene-format.md): for a unit world direction d
+// (+Y up), u = 0.5 + atan2(d.x, -d.z) / (2 pi), v = acos(d.y) / pi, column
+// floor(u W), row floor(v H), row 0 at the top.
+// The unit direction through map position (u, v) in [0, 1]^2.
 void environment_direction(float u, float v, float out[3]);
 
 // `count` directional lights chosen by stratified importance sampling of
@@ -29,6 +25,6 @@ void environment_direction(float u, float v, float out[3]);
 // direction of its part and carries the part's irradiance (the integral of
 // L over its solid angle), so the lights' total is the map's. A texel that
 // gets several samples splits into a stratified grid of directions.
-std::vector<gpu::Light> environment_lights(const EnvironmentMap& map, std::uint32_t count);
+std::vector<gpu::Light> environment_lights(const Environment& map, std::uint32_t count);
 
 }  // namespace lc

@@ -48,7 +48,8 @@ static_assert(offsetof(GBufferTexel, material) == 36);
 static_assert(sizeof(CutEntry) == 20);
 static_assert(offsetof(CutEntry, unit_r) == 8);
 
-static_assert(sizeof(FrameParams) == 120);
+static_assert(sizeof(FrameParams) == 136);
+static_assert(offsetof(FrameParams, env_width) == 120);
 static_assert(offsetof(FrameParams, min_distance2) == 12);
 static_assert(offsetof(FrameParams, relative_error) == 28);
 static_assert(offsetof(FrameParams, max_cut) == 44);

@@ -4,6 +4,10 @@
 #include <cmath>
 #include <limits>
 
+#include <chrono>
+
+#include "area_lights.h"
+#include "environment_lights.h"
 #include "lightcuts/render.h"
 
 namespace lc {
@@ -42,7 +46,24 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
     PreparedScene prepared;
     prepared.has_occluders = !all_coplanar(scene.triangles);
     prepared.bvh = build_bvh(scene.triangles, scene.normals);
-    prepared.tree = build_light_tree(scene.lights, seed);
+    // Walter 2005 §5: area lights and the environment become many point and
+    // directional lights, in the one tree with the scene's own.
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<gpu::Light> lights = scene.lights;
+    const std::vector<gpu::Light> area =
+        sample_area_lights(scene.triangles, scene.materials, scene.render.area_light_samples, seed);
+    const std::vector<gpu::Light> sky = environment_lights(scene.environment, scene.environment.directions);
+    lights.insert(lights.end(), area.begin(), area.end());
+    lights.insert(lights.end(), sky.begin(), sky.end());
+    prepared.area_lights = area.size();
+    prepared.environment_lights = sky.size();
+    prepared.light_sampling_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    for (const gpu::Light& l : lights) {
+        const std::uint32_t type = l.type & gpu::kLightTypeMask;
+        prepared.has_oriented |= type == gpu::kLightSpot || type == gpu::kLightOriented;
+    }
+    prepared.tree = build_light_tree(lights, seed);
     for (const auto& m : scene.materials)
         prepared.has_specular |= (m.flags & gpu::kMaterialHasSpecular) != 0u;
     // The geometry's size alone (Scene::bounds), in double: a far-away
@@ -79,6 +100,8 @@ gpu::FrameParams make_frame_params(const PreparedScene& prepared, const RenderOp
     f.light_count = static_cast<std::uint32_t>(prepared.tree.lights.size());
     for (std::uint32_t t = 0; t < gpu::kLightTypeCount; ++t) f.roots[t] = prepared.tree.roots[t];
     f.loop_probe_rounds = 2;
+    f.env_width = prepared.scene.environment.width;
+    f.env_height = prepared.scene.environment.height;
     f.tile_x = f.tile_y = 0;
     f.tile_width = f.width;
     f.tile_height = f.height;

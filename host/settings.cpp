@@ -25,6 +25,8 @@ std::string setting_problem(std::string_view key, double value) {
     if (key == kSettingMaxCut) return integer_problem(value, 1, kMaxU32);
     if (key == kSettingSeed) return integer_problem(value, 0, kMaxU32);
     if (key == kSettingWidth || key == kSettingHeight) return integer_problem(value, 1, kMaxImageSide);
+    if (key == kSettingAreaLightSamples || key == kSettingDirections)
+        return integer_problem(value, 1, kMaxLightSamples);
     if (key == kSettingRelativeError) {
         if (!(value >= 0.0 && value <= double(kMaxRelativeError)))
             return "must be a number from 0 to " + std::to_string(kMaxRelativeError).substr(0, 3);

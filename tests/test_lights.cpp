@@ -242,7 +242,7 @@ TEST(AreaLight, SquareEmitterMatchesTheClosedForm) {
 // albedo rho: every point has radiance rho * L (the upper hemisphere's
 // cosine-weighted solid angle is pi).
 TEST(EnvironmentLight, ConstantSkyGivesAlbedoTimesRadiance) {
-    EnvironmentMap map;
+    Environment map;
     map.width = 64;
     map.height = 32;
     map.rgb.assign(std::size_t(map.width) * map.height * 3, 1.5f);
@@ -260,7 +260,7 @@ TEST(EnvironmentLight, ConstantSkyGivesAlbedoTimesRadiance) {
 // A map black but for one small texel acts as the directional light from
 // that texel's direction, carrying its irradiance L * solid angle.
 TEST(EnvironmentLight, SingleTexelIsADirectionalLight) {
-    EnvironmentMap map;
+    Environment map;
     map.width = 256;
     map.height = 128;
     map.rgb.assign(std::size_t(map.width) * map.height * 3, 0.0f);

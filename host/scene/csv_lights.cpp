@@ -1,5 +1,5 @@
-// The points_csv reader: a hand-written parser over the whole file in memory
-// (10^6 lines in well under a second; docs/scene-format.md).
+// The points_csv and spots_csv readers: a hand-written parser over the whole
+// file in memory (10^6 lines in well under a second; docs/scene-format.md).
 #include "csv_lights.h"
 
 #include <algorithm>
@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "input_file.h"
+#include "light_records.h"
 #include "lightcuts/error.h"
 #include "lightcuts/scene.h"
 
@@ -18,8 +19,21 @@ namespace lc {
 namespace loader {
 namespace {
 
-constexpr std::size_t kColumns = 6;
-constexpr std::array<const char*, kColumns> kColumnNames{"x", "y", "z", "r", "g", "b"};
+constexpr std::size_t kMaxColumns = 11;
+
+// One kind of CSV: its columns, and which of them are intensities (>= 0).
+struct Format {
+    std::size_t columns;
+    std::array<const char*, kMaxColumns> names;
+    std::size_t first_intensity;
+    const char* spelled;  // for "expected N comma-separated numbers ..."
+};
+
+constexpr Format kPoints{6, {"x", "y", "z", "r", "g", "b"}, 3, "x,y,z,r,g,b"};
+constexpr Format kSpots{11,
+                        {"x", "y", "z", "dx", "dy", "dz", "r", "g", "b", "inner_cone_degrees", "outer_cone_degrees"},
+                        6,
+                        "x,y,z,dx,dy,dz,r,g,b,inner_cone_degrees,outer_cone_degrees"};
 
 bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
 
@@ -52,9 +66,9 @@ FieldStatus parse_float(std::string_view text, float& out) {
 }
 
 // A content line's comma-separated fields, trimmed; count goes on past the
-// first six so that the error can say how many there were.
+// last column so that the error can say how many there were.
 struct Fields {
-    std::array<std::string_view, kColumns> text{};
+    std::array<std::string_view, kMaxColumns> text{};
     std::size_t count = 0;
 };
 
@@ -63,7 +77,7 @@ Fields split_fields(std::string_view line) {
     for (std::size_t start = 0;;) {
         const std::size_t comma = line.find(',', start);
         const std::size_t length = comma == std::string_view::npos ? std::string_view::npos : comma - start;
-        if (fields.count < kColumns) fields.text[fields.count] = trim(line.substr(start, length));
+        if (fields.count < kMaxColumns) fields.text[fields.count] = trim(line.substr(start, length));
         ++fields.count;
         if (comma == std::string_view::npos) return fields;
         start = comma + 1;
@@ -73,7 +87,7 @@ Fields split_fields(std::string_view line) {
 // A header is only the first content line, and only if nothing in it is a
 // number, so that a typo in the first data line is still an error.
 bool is_header(const Fields& fields) {
-    for (std::size_t i = 0; i < std::min(fields.count, kColumns); ++i) {
+    for (std::size_t i = 0; i < std::min(fields.count, kMaxColumns); ++i) {
         float ignored = 0.0f;
         if (parse_float(fields.text[i], ignored) != FieldStatus::not_a_number) return false;
     }
@@ -82,46 +96,57 @@ bool is_header(const Fields& fields) {
 
 std::string line_field(std::size_t line) { return "line " + std::to_string(line); }
 
-[[noreturn]] void fail_column(const std::string& file, std::size_t line, std::size_t i,
+[[noreturn]] void fail_column(const Format& format, const std::string& file, std::size_t line, std::size_t i,
                               const std::string& problem) {
     throw InputError(file, line_field(line),
-                     "column " + std::to_string(i + 1) + " (" + kColumnNames[i] + "): " + problem);
+                     "column " + std::to_string(i + 1) + " (" + format.names[i] + "): " + problem);
 }
 
 std::string quoted(std::string_view text, const char* problem) {
     return std::string("'").append(text).append("' ").append(problem);
 }
 
-gpu::Light parse_light(const Fields& fields, const std::string& file, std::size_t line) {
-    if (fields.count != kColumns) {
-        throw InputError(file, line_field(line), "expected 6 comma-separated numbers x,y,z,r,g,b, found " +
-                                          std::to_string(fields.count) + " fields");
+// A row's numbers, each finite, intensities not negative.
+std::array<float, kMaxColumns> parse_row(const Format& format, const Fields& fields, const std::string& file,
+                                         std::size_t line) {
+    if (fields.count != format.columns) {
+        throw InputError(file, line_field(line),
+                         "expected " + std::to_string(format.columns) + " comma-separated numbers " +
+                             format.spelled + ", found " + std::to_string(fields.count) + " fields");
     }
-    // Messages are built only on error: this runs six times per line of a
+    // Messages are built only on error: this runs per field of a
     // million-line file.
-    std::array<float, kColumns> v{};
-    for (std::size_t i = 0; i < kColumns; ++i) {
+    std::array<float, kMaxColumns> v{};
+    for (std::size_t i = 0; i < format.columns; ++i) {
         const std::string_view text = fields.text[i];
         switch (parse_float(text, v[i])) {
-            case FieldStatus::not_a_number: fail_column(file, line, i, quoted(text, "is not a number"));
+            case FieldStatus::not_a_number: fail_column(format, file, line, i, quoted(text, "is not a number"));
             case FieldStatus::out_of_range:
-                fail_column(file, line, i, quoted(text, "is out of range for a 32-bit float"));
+                fail_column(format, file, line, i, quoted(text, "is out of range for a 32-bit float"));
             case FieldStatus::ok: break;
         }
-        if (!std::isfinite(v[i])) fail_column(file, line, i, quoted(text, "is not finite"));
-        if (i >= 3 && v[i] < 0.0f) fail_column(file, line, i, "intensity must not be negative");
+        if (!std::isfinite(v[i])) fail_column(format, file, line, i, quoted(text, "is not finite"));
+        if (i >= format.first_intensity && i < format.first_intensity + 3 && v[i] < 0.0f)
+            fail_column(format, file, line, i, "intensity must not be negative");
     }
-    return gpu::Light{v[0], v[1], v[2], v[3], v[4], v[5], gpu::kLightPoint, 0u};
+    return v;
 }
 
-}  // namespace
+gpu::Light make_light(const Format& format, const std::array<float, kMaxColumns>& v, const std::string& file,
+                      std::size_t line) {
+    if (&format == &kPoints) return point_light({v[0], v[1], v[2]}, {v[3], v[4], v[5]});
+    LightProblem problem;
+    const gpu::Light l = spot_light({v[0], v[1], v[2]}, {v[3], v[4], v[5]}, {v[6], v[7], v[8]}, v[9], v[10], problem);
+    if (problem) throw InputError(file, line_field(line), problem.field + ": " + problem.problem);
+    return l;
+}
 
-std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file, LightLimits& limits) {
+std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::path& file, LightLimits& limits) {
     const std::string name = display(file);
     const std::string text = read_input_file(file);
     std::vector<gpu::Light> lights;
-    // ~30 bytes per line is typical; reserving avoids regrowth for 10^6 lights.
-    lights.reserve(text.size() / 32 + 1);
+    // ~30 bytes per point line is typical; reserving avoids regrowth for 10^6 lights.
+    lights.reserve(text.size() / (format.columns * 5) + 1);
 
     const std::string_view all(text);
     std::size_t line_number = 0;
@@ -141,13 +166,23 @@ std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file, Light
         seen_content = true;
         if (first_content && is_header(fields)) continue;
 
-        const gpu::Light light = parse_light(fields, name, line_number);
+        const gpu::Light light = make_light(format, parse_row(format, fields, name, line_number), name, line_number);
         if (const LightLimits::Problem p = limits.add(light); p.fault != LightLimits::Fault::none) {
             throw InputError(name, line_field(line_number), p.text);
         }
         lights.push_back(light);
     }
     return lights;
+}
+
+}  // namespace
+
+std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file, LightLimits& limits) {
+    return read_csv(kPoints, file, limits);
+}
+
+std::vector<gpu::Light> read_spots_csv(const std::filesystem::path& file, LightLimits& limits) {
+    return read_csv(kSpots, file, limits);
 }
 
 }  // namespace loader

@@ -1,4 +1,5 @@
-// CSV files of point lights ("x,y,z,r,g,b" per line).
+// CSV files of lights: points_csv ("x,y,z,r,g,b" per line) and spots_csv
+// ("x,y,z,dx,dy,dz,r,g,b,inner_cone_degrees,outer_cone_degrees").
 #pragma once
 
 #include <filesystem>
@@ -12,5 +13,8 @@ namespace lc::loader {
 // over from the rest of the scene, so that an overflow is reported at the
 // CSV line that caused it.
 std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file, LightLimits& limits);
+
+// The same for spot lights, checked as a JSON spot is (light_records.h).
+std::vector<gpu::Light> read_spots_csv(const std::filesystem::path& file, LightLimits& limits);
 
 }  // namespace lc::loader

@@ -1,6 +1,8 @@
 // Overflow checks for the float sums and boxes the renderer builds (float_limits.h).
 #include "float_limits.h"
 
+#include <iterator>
+
 namespace lc::loader {
 namespace {
 
@@ -24,20 +26,22 @@ std::string extent_problem(const Box& box) {
 }
 
 LightLimits::Problem LightLimits::add(const gpu::Light& light) {
-    const bool point = light.type == gpu::kLightPoint;
-    if (light.type < gpu::kLightTypeCount) {
-        glm::dvec3& total = totals_[light.type];
+    const std::uint32_t type = light.type & gpu::kLightTypeMask;
+    constexpr const char* kTotals[] = {" intensity of the point lights exceeds ",
+                                       " irradiance of the directional lights exceeds ",
+                                       " intensity of the spot lights exceeds ",
+                                       " intensity of the oriented lights exceeds "};
+    static_assert(std::size(kTotals) == gpu::kLightTypeCount);
+    if (type < gpu::kLightTypeCount) {
+        glm::dvec3& total = totals_[type];
         total += glm::dvec3(light.r, light.g, light.b);
         for (int c = 0; c < 3; ++c) {
             if (fits_float(total[c])) continue;
-            return {Fault::total, std::string("total ") + kChannelNames[c] +
-                                      (point ? " intensity of the point lights exceeds "
-                                             : " irradiance of the directional lights exceeds ") +
-                                      kFloatRange};
+            return {Fault::total, std::string("total ") + kChannelNames[c] + kTotals[type] + kFloatRange};
         }
     }
     // A directional light has a direction, not a position: no box to grow.
-    if (!point) return {};
+    if (type == gpu::kLightDirectional) return {};
     const glm::dvec3 p(light.x, light.y, light.z);
     if (!fits_float(p)) return {Fault::position, "position is not finite"};
     box_.grow(p);

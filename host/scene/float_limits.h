@@ -14,7 +14,7 @@
 
 #include <glm/glm.hpp>
 
-#include "../../shaders/shared/types.h"
+#include "shared/types.h"
 
 namespace lc::loader {
 

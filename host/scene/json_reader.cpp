@@ -103,6 +103,11 @@ std::string JsonReader::string(const json& j, const std::string& path) const {
     return j.get<std::string>();
 }
 
+bool JsonReader::boolean(const json& j, const std::string& path) const {
+    if (!j.is_boolean()) fail(path, std::string("expected true or false, got ") + j.type_name());
+    return j.get<bool>();
+}
+
 glm::vec3 JsonReader::vec3(const json& j, const std::string& path) const {
     if (!j.is_array() || j.size() != 3) {
         fail(path, std::string("expected an array of 3 numbers, got ") +

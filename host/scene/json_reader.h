@@ -53,6 +53,7 @@ public:
     std::uint32_t unsigned_int(const json& j, const std::string& path, std::uint32_t lo,
                                std::uint32_t hi) const;
     std::string string(const json& j, const std::string& path) const;
+    bool boolean(const json& j, const std::string& path) const;
     glm::vec3 vec3(const json& j, const std::string& path) const;
     // RGB quantities (intensity, irradiance, reflectance): each in [0, max_component].
     glm::vec3 colour(const json& j, const std::string& path, float max_component) const;

@@ -30,6 +30,15 @@ gpu::Material make_material(glm::vec3 kd, glm::vec3 ks, float alpha) {
     return m;
 }
 
+void set_emission(gpu::Material& m, glm::vec3 radiance, bool both_sides) {
+    m.emission_r = radiance.r;
+    m.emission_g = radiance.g;
+    m.emission_b = radiance.b;
+    m.flags &= ~(gpu::kMaterialEmissive | gpu::kMaterialEmitsBothSides);
+    if (radiance.r > 0.0f || radiance.g > 0.0f || radiance.b > 0.0f)
+        m.flags |= gpu::kMaterialEmissive | (both_sides ? gpu::kMaterialEmitsBothSides : 0u);
+}
+
 gpu::Material default_material() { return make_material(glm::vec3(kDefaultAlbedo), glm::vec3(0.0f), 1.0f); }
 
 gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj_name) {
@@ -46,6 +55,14 @@ gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj
         return c;
     };
     const glm::vec3 kd = rgb(mtl.diffuse, "Kd");
+    glm::vec3 ke;
+    for (int i = 0; i < 3; ++i) {
+        if (!std::isfinite(mtl.emission[i]) || mtl.emission[i] < 0.0 || mtl.emission[i] > 3.4e38) {
+            throw InputError(obj_name, field + ".Ke",
+                             "components must be finite and >= 0, got " + std::to_string(mtl.emission[i]));
+        }
+        ke[i] = static_cast<float>(mtl.emission[i]);
+    }
     const glm::vec3 ks = rgb(mtl.specular, "Ks");
     // tinyobj leaves roughness at 0 when the MTL has no "Pr", so Pr = 0 means
     // "not given" and the Blinn-Phong exponent decides (Walter et al. 2007).
@@ -61,7 +78,9 @@ gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj
         }
         alpha = static_cast<float>(std::sqrt(2.0 / (mtl.shininess + 2.0)));
     }
-    return make_material(kd, ks, alpha);
+    gpu::Material m = make_material(kd, ks, alpha);
+    set_emission(m, ke, false);
+    return m;
 }
 
 }  // namespace lc::loader

@@ -5,7 +5,7 @@
 
 #include <glm/glm.hpp>
 
-#include "../../shaders/shared/types.h"
+#include "shared/types.h"
 
 namespace tinyobj {
 struct material_t;
@@ -22,10 +22,15 @@ inline constexpr float kDefaultRoughness = 0.5f;
 // lobe on); alpha: GGX roughness, clamped to [kMinGgxAlpha, 1].
 gpu::Material make_material(glm::vec3 kd, glm::vec3 ks, float alpha);
 
+// Adds emitted radiance (W/(sr m^2)), one-sided along the geometric normal
+// unless both_sides; black emission leaves the material as it is.
+void set_emission(gpu::Material& m, glm::vec3 radiance, bool both_sides);
+
 // The material faces get when they name none.
 gpu::Material default_material();
 
-// One MTL entry. Throws InputError naming obj_name and "material 'NAME'.KEY".
+// One MTL entry (Ke is its emission, one-sided). Throws InputError naming
+// obj_name and "material 'NAME'.KEY".
 gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj_name);
 
 }  // namespace lc::loader

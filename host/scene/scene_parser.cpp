@@ -20,6 +20,9 @@
 #include "float_limits.h"
 #include "input_file.h"
 #include "json_reader.h"
+#include "light_records.h"
+#include "lightcuts/error.h"
+#include "lightcuts/image.h"
 #include "lightcuts/settings.h"
 #include "materials.h"
 #include "obj_loader.h"
@@ -44,8 +47,9 @@ public:
         parse_camera(in_.require(root, "", "camera"));
         // Meshes before lights: the lights' extent is checked against the geometry.
         parse_meshes(in_.require(root, "", "meshes"));
-        parse_lights(in_.require(root, "", "lights"));
+        if (const json* l = JsonReader::find(root, "lights")) parse_lights(*l);
         if (const json* r = JsonReader::find(root, "render")) parse_render(*r);
+        require_some_light();
         update_bounds(scene_);
         return std::move(scene_);
     }
@@ -95,7 +99,8 @@ private:
     void parse_render(const json& j) {
         const std::string path = "render";
         in_.expect_object(j, path);
-        in_.check_keys(j, path, {kSettingMethod, kSettingSpp, kSettingRelativeError, kSettingMaxCut, kSettingSeed});
+        in_.check_keys(j, path, {kSettingMethod, kSettingSpp, kSettingRelativeError, kSettingMaxCut, kSettingSeed,
+                                 kSettingAreaLightSamples});
         RenderSettings& r = scene_.render;
         if (const json* v = JsonReader::find(j, kSettingMethod)) {
             const std::string field = join_key(path, kSettingMethod);
@@ -114,6 +119,7 @@ private:
         if (const auto v = setting(kSettingRelativeError)) r.relative_error = static_cast<float>(*v);
         if (const auto v = setting(kSettingMaxCut)) r.max_cut = static_cast<std::uint32_t>(*v);
         if (const auto v = setting(kSettingSeed)) r.seed = static_cast<std::uint32_t>(*v);
+        if (const auto v = setting(kSettingAreaLightSamples)) r.area_light_samples = static_cast<std::uint32_t>(*v);
     }
 
     // -- meshes -------------------------------------------------------------
@@ -149,7 +155,7 @@ private:
 
     gpu::Material parse_material_override(const json& j, const std::string& path) const {
         in_.expect_object(j, path);
-        in_.check_keys(j, path, {"kd", "ks", "roughness"});
+        in_.check_keys(j, path, {"kd", "ks", "roughness", "emission", "emission_two_sided"});
         glm::vec3 kd{kDefaultAlbedo}, ks{0.0f};
         float roughness = kDefaultRoughness;
         if (const json* v = JsonReader::find(j, "kd")) kd = in_.colour(*v, path + ".kd", 1.0f);
@@ -157,7 +163,14 @@ private:
         if (const json* v = JsonReader::find(j, "roughness")) {
             roughness = in_.number_in(*v, path + ".roughness", 0.0f, 1.0f, true, false);
         }
-        return make_material(kd, ks, roughness * roughness);
+        gpu::Material m = make_material(kd, ks, roughness * roughness);
+        glm::vec3 emission{0.0f};
+        if (const json* v = JsonReader::find(j, "emission"))
+            emission = in_.colour(*v, path + ".emission", std::numeric_limits<float>::max());
+        bool two_sided = false;
+        if (const json* v = JsonReader::find(j, "emission_two_sided")) two_sided = in_.boolean(*v, path + ".emission_two_sided");
+        set_emission(m, emission, two_sided);
+        return m;
     }
 
     void parse_meshes(const json& j) {
@@ -189,7 +202,17 @@ private:
         in_.expect_array(j, "lights");
         limits_ = LightLimits(meshes_.geometry);
         for (std::size_t i = 0; i < j.size(); ++i) parse_light(j[i], join_index("lights", i));
-        if (scene_.lights.empty()) in_.fail("lights", "the scene has no lights (after loading CSV files)");
+    }
+
+    // Lights may come from the lights array, emissive surfaces or an
+    // environment; a scene with none of them renders black, which is a
+    // mistake, not a picture.
+    void require_some_light() const {
+        if (!scene_.lights.empty() || scene_.environment.present()) return;
+        for (const gpu::Material& m : scene_.materials)
+            if ((m.flags & gpu::kMaterialEmissive) != 0u) return;
+        in_.fail("lights", "the scene has no light: no lights (after loading CSV files), no emissive "
+                           "material and no environment");
     }
 
     // A total that overflows is the list's fault, not one entry's; a position
@@ -201,34 +224,107 @@ private:
         scene_.lights.push_back(light);
     }
 
+    void add_checked(const gpu::Light& light, const LightProblem& problem, const std::string& path) {
+        if (problem) in_.fail(path + "." + problem.field, problem.problem);
+        add_light(light, path);
+    }
+
+    glm::vec3 intensity(const json& j, const std::string& path, const char* key) const {
+        return in_.colour(in_.require(j, path, key), path + "." + key, std::numeric_limits<float>::max());
+    }
+
     void parse_light(const json& j, const std::string& path) {
         in_.expect_object(j, path);
         const std::string type = in_.string(in_.require(j, path, "type"), path + ".type");
-        constexpr float kMaxFloat = std::numeric_limits<float>::max();
+        LightProblem problem;
         if (type == "point") {
             in_.check_keys(j, path, {"type", "position", "intensity"});
             const glm::vec3 p = in_.vec3(in_.require(j, path, "position"), path + ".position");
-            const glm::vec3 c = in_.colour(in_.require(j, path, "intensity"), path + ".intensity", kMaxFloat);
-            add_light({p.x, p.y, p.z, c.r, c.g, c.b, gpu::kLightPoint, 0u}, path);
+            add_light(point_light(p, intensity(j, path, "intensity")), path);
         } else if (type == "directional") {
             in_.check_keys(j, path, {"type", "direction", "irradiance"});
             const glm::vec3 d = in_.vec3(in_.require(j, path, "direction"), path + ".direction");
-            const float len = glm::length(d);
-            if (!(len > 0.0f) || !std::isfinite(len)) in_.fail(path + ".direction", "must not be zero-length");
-            const glm::vec3 c = in_.colour(in_.require(j, path, "irradiance"), path + ".irradiance", kMaxFloat);
-            // The file gives the way light travels; shading wants the way to the light.
-            const glm::vec3 to_light = -d / len;
-            add_light({to_light.x, to_light.y, to_light.z, c.r, c.g, c.b, gpu::kLightDirectional, 0u}, path);
-        } else if (type == "points_csv") {
+            add_checked(directional_light(d, intensity(j, path, "irradiance"), problem), problem, path);
+        } else if (type == "spot") {
+            parse_spot(j, path);
+        } else if (type == "points_csv" || type == "spots_csv") {
             in_.check_keys(j, path, {"type", "file"});
-            const std::string field = path + ".file";
-            const fs::path csv = resolve(in_.string(in_.require(j, path, "file"), field));
-            std::error_code ec;
-            if (!fs::is_regular_file(csv, ec)) in_.fail(field, "file not found: " + display(csv));
-            const std::vector<gpu::Light> loaded = read_points_csv(csv, limits_);
+            const fs::path csv = existing_file(j, path, "file");
+            const std::vector<gpu::Light> loaded =
+                type == "points_csv" ? read_points_csv(csv, limits_) : read_spots_csv(csv, limits_);
             scene_.lights.insert(scene_.lights.end(), loaded.begin(), loaded.end());
+        } else if (type == "environment") {
+            parse_environment(j, path);
         } else {
-            in_.fail(path + ".type", "unknown light type \"" + type + "\" (expected point, directional or points_csv)");
+            in_.fail(path + ".type", "unknown light type \"" + type +
+                                         "\" (expected point, directional, spot, points_csv, spots_csv or environment)");
+        }
+    }
+
+    fs::path existing_file(const json& j, const std::string& path, const char* key) const {
+        const std::string field = path + "." + key;
+        const fs::path file = resolve(in_.string(in_.require(j, path, key), field));
+        std::error_code ec;
+        if (!fs::is_regular_file(file, ec)) in_.fail(field, "file not found: " + display(file));
+        return file;
+    }
+
+    void parse_spot(const json& j, const std::string& path) {
+        in_.check_keys(j, path, {"type", "position", "direction", "intensity", "inner_cone_degrees",
+                                 "outer_cone_degrees"});
+        const glm::vec3 p = in_.vec3(in_.require(j, path, "position"), path + ".position");
+        const glm::vec3 d = in_.vec3(in_.require(j, path, "direction"), path + ".direction");
+        const float inner = in_.number(in_.require(j, path, "inner_cone_degrees"), path + ".inner_cone_degrees");
+        const float outer = in_.number(in_.require(j, path, "outer_cone_degrees"), path + ".outer_cone_degrees");
+        LightProblem problem;
+        const gpu::Light l = spot_light(p, d, intensity(j, path, "intensity"), inner, outer, problem);
+        add_checked(l, problem, path);
+    }
+
+    // {"type": "environment", "file": "sky.exr" | "color": [r, g, b],
+    //  "scale": 1, "directions": 3000}; at most one per scene.
+    void parse_environment(const json& j, const std::string& path) {
+        in_.check_keys(j, path, {"type", "file", "color", "scale", "directions"});
+        if (scene_.environment.present()) in_.fail(path, "a scene has at most one environment");
+        const bool has_file = JsonReader::find(j, "file") != nullptr;
+        if (has_file == (JsonReader::find(j, "color") != nullptr))
+            in_.fail(path, "needs exactly one of \"file\" (a lat-long OpenEXR) and \"color\"");
+        Environment env;
+        if (has_file) {
+            const fs::path exr = existing_file(j, path, "file");
+            const Image map = read_exr(exr);
+            env.width = map.width;
+            env.height = map.height;
+            env.rgb = map.rgb;
+            check_radiance(env.rgb, display(exr), env.width);
+        } else {
+            const glm::vec3 c = intensity(j, path, "color");
+            env.width = env.height = 1;
+            env.rgb = {c.r, c.g, c.b};
+        }
+        float scale = 1.0f;
+        if (const json* v = JsonReader::find(j, "scale"))
+            scale = in_.number_in(*v, path + ".scale", 0.0f, std::numeric_limits<float>::max(), true, false);
+        for (float& value : env.rgb) {
+            value *= scale;
+            if (!std::isfinite(value)) in_.fail(path + ".scale", "makes the map's radiance overflow a float");
+        }
+        if (const json* v = JsonReader::find(j, kSettingDirections)) {
+            const std::string field = path + "." + std::string(kSettingDirections);
+            const double n = in_.number_value(*v, field);
+            if (const std::string p = setting_problem(kSettingDirections, n); !p.empty()) in_.fail(field, p);
+            env.directions = static_cast<std::uint32_t>(n);
+        }
+        scene_.environment = std::move(env);
+    }
+
+    // Every texel finite and not negative, or the map's file and pixel named.
+    static void check_radiance(const std::vector<float>& rgb, const std::string& file, std::uint32_t width) {
+        for (std::size_t i = 0; i < rgb.size(); ++i) {
+            if (std::isfinite(rgb[i]) && rgb[i] >= 0.0f) continue;
+            const std::size_t texel = i / 3;
+            throw InputError(file, "pixel (" + std::to_string(texel % width) + ", " + std::to_string(texel / width) + ")",
+                             std::string("radiance must be finite and not negative, got ") + std::to_string(rgb[i]));
         }
     }
 };

@@ -25,6 +25,12 @@ struct PreparedScene {
     float min_distance2 = 0.0f;  // clamp of the inverse-square falloff
     bool has_specular = false;   // any material with a GGX lobe
     bool has_occluders = true;   // false: no triangle can block a light
+    bool has_oriented = false;   // any spot or oriented light (emission cones matter)
+    // Lights made from emissive triangles and from the environment (they are
+    // in the tree, after the scene's own lights), and the time that took.
+    std::size_t area_lights = 0;
+    std::size_t environment_lights = 0;
+    double light_sampling_seconds = 0.0;
 };
 
 // Takes ownership of the scene; builds the BVH and the light tree.

@@ -29,6 +29,18 @@ struct RenderSettings {
     float relative_error = 0.02f;   // lightcuts: refine while bound > this * estimate
     std::uint32_t max_cut = 1000;   // lightcuts: largest cut per shaded point
     std::uint32_t seed = 1;         // pixel jitter and light-tree representatives
+    // Point samples the emissive triangles become, in all (area_lights.h).
+    std::uint32_t area_light_samples = 65536;
+};
+
+// An environment: lat-long RGB radiance, +Y up (docs/scene-format.md). A
+// constant sky is a 1 x 1 map. Lights the scene as `directions` directional
+// lights and is what camera rays that leave the scene see.
+struct Environment {
+    std::uint32_t width = 0, height = 0;  // 0: no environment
+    std::vector<float> rgb;               // row 0 at the top, the scene's scale applied
+    std::uint32_t directions = 3000;
+    bool present() const { return width > 0 && height > 0; }
 };
 
 struct Scene {
@@ -37,6 +49,7 @@ struct Scene {
     std::vector<gpu::TriangleNormals> normals;   // parallel to triangles
     std::vector<gpu::Material> materials;
     std::vector<gpu::Light> lights;              // all types, in file order
+    Environment environment;
     RenderSettings render;
     std::filesystem::path file;                  // the scene file it came from
     std::size_t degenerate_triangles_dropped = 0;

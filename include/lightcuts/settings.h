@@ -13,6 +13,7 @@ namespace lc {
 inline constexpr std::uint32_t kMaxSpp = 65536;        // camera rays per pixel
 inline constexpr std::uint32_t kMaxImageSide = 16384;  // width and height
 inline constexpr float kMaxRelativeError = 1.0f;       // lightcuts threshold, as a fraction
+inline constexpr std::uint32_t kMaxLightSamples = 1u << 24;  // area-light samples, environment directions
 // max_cut may be any positive 32-bit value: the cut heap is sized by the
 // light tree, never by max_cut (a cut cannot outgrow the tree).
 
@@ -25,6 +26,8 @@ inline constexpr std::string_view kSettingMaxCut = "max_cut";
 inline constexpr std::string_view kSettingSeed = "seed";
 inline constexpr std::string_view kSettingWidth = "width";
 inline constexpr std::string_view kSettingHeight = "height";
+inline constexpr std::string_view kSettingAreaLightSamples = "area_light_samples";
+inline constexpr std::string_view kSettingDirections = "directions";  // of an environment
 
 // What is wrong with `value` for the numeric setting `key` (one of the
 // kSetting* names above, not method), or "" when it is valid. Integer

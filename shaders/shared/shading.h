@@ -6,6 +6,7 @@
 //   LC_MATERIAL(i)   -> Material
 //   LC_NORMALS(i)    -> TriangleNormals
 //   LC_LIGHT(i)      -> Light
+//   LC_ENVIRONMENT_TEXEL(i) -> vec3 (radiance of environment texel i)
 // and the feature switches kEnableGgx, kEnableShadows and kEnableOriented
 // (specialization constants on the GPU, so a scene without GGX materials,
 // without occluders or without spot and oriented lights gets a kernel
@@ -76,16 +77,51 @@ SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) 
     return sp;
 }
 
-// A camera sample's first hit: sample `s` of pixel (x, y) traced into the
-// scene. False when the ray leaves the scene.
-bool lc_camera_hit(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp) {
+// Radiance of the environment towards direction d (+Y up, lat-long map of
+// docs/scene-format.md; black without one).
+vec3 lc_environment_radiance(FrameParams f, vec3 d) {
+    if (f.env_width == 0u || f.env_height == 0u) return vec3(0.0f);
+    float u = 0.5f + atan(d.x, -d.z) * (0.5f / kPi);
+    float v = acos(clamp(d.y, -1.0f, 1.0f)) * (1.0f / kPi);
+    uint col = min(uint(max(u, 0.0f) * float(f.env_width)), f.env_width - 1u);
+    uint row = min(uint(max(v, 0.0f) * float(f.env_height)), f.env_height - 1u);
+    return LC_ENVIRONMENT_TEXEL(row * f.env_width + col);
+}
+
+// Radiance a triangle emits towards -ray_dir: its material's emission on
+// the side its geometric normal (counter-clockwise winding) points to, or on
+// both sides.
+vec3 lc_surface_emission(uint tri_index, vec3 ray_dir) {
+    Triangle tri = LC_TRIANGLE(tri_index);
+    Material m = LC_MATERIAL(tri.material);
+    if ((m.flags & kMaterialEmissive) == 0u) return vec3(0.0f);
+    vec3 ng = cross(lc_tri_v1(tri) - lc_tri_v0(tri), lc_tri_v2(tri) - lc_tri_v0(tri));
+    bool front = dot(ng, ray_dir) < 0.0f;
+    if (!front && (m.flags & kMaterialEmitsBothSides) == 0u) return vec3(0.0f);
+    return vec3(m.emission_r, m.emission_g, m.emission_b);
+}
+
+// A camera sample: sample `s` of pixel (x, y) traced into the scene. `seen`
+// is what the ray sees without any light: the surface's emission, or the
+// environment where the ray leaves the scene (then the result is false).
+bool lc_camera_sample(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp, LC_OUT(vec3) seen) {
     vec3 dir = lc_camera_ray_dir(f, lc_pixel_sample(x, y, s, f.spp, f.seed));
     vec3 org = vec3(f.cam_pos_x, f.cam_pos_y, f.cam_pos_z);
     float t, b1, b2;
     uint tri = lc_trace_closest(org, dir, kRayInfinity, t, b1, b2);
-    if (tri == kInvalidIndex) return false;
+    if (tri == kInvalidIndex) {
+        seen = lc_environment_radiance(f, dir);
+        return false;
+    }
     sp = lc_surface_point(tri, b1, b2, dir);
+    seen = lc_surface_emission(tri, dir);
     return true;
+}
+
+// lc_camera_sample without what the ray sees directly.
+bool lc_camera_hit(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp) {
+    vec3 seen;
+    return lc_camera_sample(f, x, y, s, sp, seen);
 }
 
 // Statistics of one shaded point.

@@ -165,6 +165,8 @@ struct FrameParams {
     uint tile_width, tile_height;
     uint sample_index;            // which of the spp samples this pass renders
     uint loop_probe_rounds;       // always 2: see lc_loops_were_cut_short (shaders/kernel.glsl)
+    uint env_width, env_height;   // environment map seen by rays that leave; 0 x 0: black
+    uint pad0, pad1;
 };
 
 #ifdef __cplusplus

@@ -1,0 +1,34 @@
+// Light records from what a scene file gives, with the checks the JSON
+// lights and the CSV rows share, so both refuse the same values with the
+// same words.
+#pragma once
+
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "shared/types.h"
+
+namespace lc::loader {
+
+// What is wrong with a light's values: the field (relative to the light:
+// "direction", "inner_cone_degrees", ...) and the problem; both empty when
+// the light is fine.
+struct LightProblem {
+    std::string field;
+    std::string problem;
+    explicit operator bool() const { return !problem.empty(); }
+};
+
+gpu::Light point_light(glm::vec3 position, glm::vec3 intensity);
+
+// `travel` is the way the light travels (non-zero); stored towards the light.
+gpu::Light directional_light(glm::vec3 travel, glm::vec3 irradiance, LightProblem& problem);
+
+// glTF-style spot: `direction` (non-zero, normalised here) is the axis it
+// shines along, intensity is on the axis, half-angles in degrees with
+// 0 <= inner <= outer <= 90.
+gpu::Light spot_light(glm::vec3 position, glm::vec3 direction, glm::vec3 intensity, float inner_degrees,
+                      float outer_degrees, LightProblem& problem);
+
+}  // namespace lc::loader
