@@ -35,12 +35,13 @@ LC_CONST uint kSpecWorkgroupSize = 0u;    // local_size_x
 LC_CONST uint kSpecEnableGgx = 1u;        // any material has a GGX lobe
 LC_CONST uint kSpecEnableShadows = 2u;    // any triangle can block a light
 LC_CONST uint kSpecHeapShared = 3u;       // K: cut-heap slots per invocation in shared memory
-LC_CONST uint kSpecHeapCapacity = 4u;     // all cut-heap slots per invocation, max(max_cut, 2)
+LC_CONST uint kSpecHeapCapacity = 4u;     // all cut-heap slots per invocation,
+                                          // LightTree::cut_heap_capacity(max_cut)
 LC_CONST uint kSpecSpillStride = 5u;      // invocations the spill buffer is laid out for
 
 // PixelStats.flags
-LC_CONST uint kPixelHeapOverflow = 1u;  // a heap outgrew its capacity (a bug: cannot happen
-                                        // while cuts stay within max(max_cut, 2) clusters)
+LC_CONST uint kPixelHeapOverflow = 1u;  // a heap outgrew its capacity (a bug: the capacity
+                                        // bounds every cut the tree and max_cut allow)
 LC_CONST uint kPixelLoopLimit = 2u;     // the driver cut the invocation's loops short
 LC_CONST uint kPixelCutUnfinished = 4u; // refinement went on past the pass's last dispatch (a bug)
 

@@ -57,13 +57,13 @@ constexpr std::uint32_t kFirstRefineBudget = 128;
 // heap's spill buffer in between.
 class Lightcuts final : public ShadingMethod {
 public:
-    Lightcuts(const gpu::FrameParams& frame, const Tuning& tuning,
+    Lightcuts(const gpu::FrameParams& frame, const LightTree& tree, const Tuning& tuning,
               std::uint32_t shared_memory_bytes)
         : max_cut_(frame.max_cut) {
-        // Walter 2005 §4 keeps a max-heap of up to max(max_cut, 2) clusters
-        // per shaded point. The first K slots live in shared memory, as many
-        // as fit a whole workgroup.
-        heap_.capacity = std::max(frame.max_cut, 2u);
+        // Walter 2005 §4 keeps a max-heap of the refinable clusters of the
+        // cut; the tree bounds its size, whatever max_cut says. The first K
+        // slots live in shared memory, as many as fit a whole workgroup.
+        heap_.capacity = tree.cut_heap_capacity(frame.max_cut);
         const std::uint32_t k_max =
             shared_memory_bytes / (gpu::kWorkgroupSize * std::uint32_t(sizeof(gpu::CutEntry)));
         if (k_max == 0)
@@ -71,6 +71,11 @@ public:
                                      std::to_string(shared_memory_bytes) +
                                      " bytes) for the cut heap");
         heap_.shared = std::min(k_max, heap_.capacity);
+        // A refinement adds one cluster to the cut and takes one interior
+        // node off the heap for good, so a cut never sees more refinements
+        // than either allows.
+        const std::uint64_t interior = tree.nodes.size() - tree.lights.size();
+        max_refinements_ = std::uint32_t(std::min<std::uint64_t>(frame.max_cut, interior));
         if (tuning.refinements_per_dispatch > 0) budget_ = tuning.refinements_per_dispatch;
     }
 
@@ -87,10 +92,10 @@ public:
     TileBuffer cut_state() const override { return {"cut state", sizeof(gpu::CutState), ""}; }
     bool reports_cuts() const override { return true; }
 
-    // A cut grows by one cluster per refinement, so max_cut / budget + 1
-    // dispatches of `budget` refinements finish every cut.
+    // max_refinements / budget + 1 dispatches of `budget` refinements each
+    // finish every cut (the last one also finds it final).
     std::uint32_t dispatch_count() const override {
-        return budget_ == gpu::kUnlimitedRefinements ? 1 : max_cut_ / budget_ + 1;
+        return budget_ == gpu::kUnlimitedRefinements ? 1 : max_refinements_ / budget_ + 1;
     }
 
     void set_push_constants(std::uint32_t d, gpu::PushConstants& push) const override {
@@ -109,6 +114,7 @@ public:
 private:
     std::uint32_t max_cut_;
     HeapLayout heap_;
+    std::uint32_t max_refinements_ = 0;
     std::uint32_t budget_ = gpu::kUnlimitedRefinements;  // refinements per dispatch
 };
 
@@ -116,10 +122,10 @@ private:
 
 std::unique_ptr<ShadingMethod> make_shading_method(const RenderOptions& options,
                                                    const gpu::FrameParams& frame,
-                                                   const LightTree& /*tree*/, const Tuning& tuning,
+                                                   const LightTree& tree, const Tuning& tuning,
                                                    std::uint32_t shared_memory_bytes) {
     if (options.method == "lightcuts")
-        return std::make_unique<Lightcuts>(frame, tuning, shared_memory_bytes);
+        return std::make_unique<Lightcuts>(frame, tree, tuning, shared_memory_bytes);
     return std::make_unique<BruteForce>(frame, tuning);
 }
 

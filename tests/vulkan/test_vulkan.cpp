@@ -197,7 +197,7 @@ TEST_F(Vulkan, WorkSplitOverDispatchesMatchesCpu) {
     }
 }
 
-// max_cut 1 keeps two roots: the heap capacity is max(max_cut, 2).
+// max_cut 1 keeps both roots, so the cut (and its heap) has two clusters.
 TEST_F(Vulkan, TinyMaxCutMatchesCpu) {
     PreparedScene p = prepare_scene(random_scene(51, 50, 2, 24, 20), 5);
     RenderOptions o = options("lightcuts", 24, 20);
@@ -248,22 +248,6 @@ TEST_F(Vulkan, ShippedRoomSceneMatchesCpu) {
         EXPECT_GT(g.stats.seconds_shading, 0.0);
         EXPECT_GT(g.stats.seconds_primary, 0.0);
         EXPECT_FALSE(g.stats.buffer_bytes.empty());
-    }
-}
-
-// A cut heap that cannot fit a single workgroup's spill region is refused
-// with a message naming the buffer, its size and the limit.
-TEST_F(Vulkan, OversizedHeapIsRefusedClearly) {
-    PreparedScene p = prepare_scene(random_scene(61, 8, 0, 8, 8), 1);
-    RenderOptions o = options("lightcuts", 8, 8);
-    o.max_cut = 2'000'000'000u;
-    try {
-        gpu(p, o);
-        FAIL() << "expected an exception";
-    } catch (const std::runtime_error& e) {
-        const std::string what = e.what();
-        EXPECT_NE(what.find("heap spill"), std::string::npos) << what;
-        EXPECT_NE(what.find("bytes"), std::string::npos) << what;
     }
 }
 
