@@ -129,11 +129,13 @@ void TileScheduler::read_back(const Tile& tile, RenderResult& result) const {
         const glm::vec3 sum(sums[3 * i], sums[3 * i + 1], sums[3 * i + 2]);
         result.image.set(x, y, sum / float(frame_.spp));
         const gpu::PixelStats& ps = pixel_stats[i];
-        out.shadow_rays += ps.shadow_rays;
+        out.shadow_rays += gpu::count64(ps.shadow_rays_lo, ps.shadow_rays_hi);
         out.max_cut_pixels += ps.max_cut_samples;
         out.heap_spill_pixels += ps.spill_samples;
+        // The CPU reference's rounding of the mean, so equal cuts compare equal.
         if (method_.reports_cuts())
-            out.cut_size[std::size_t(y) * frame_.width + x] = float(ps.cut_size_sum) / float(spp);
+            out.cut_size[std::size_t(y) * frame_.width + x] =
+                float(double(gpu::count64(ps.cut_size_lo, ps.cut_size_hi)) / spp);
     }
 }
 

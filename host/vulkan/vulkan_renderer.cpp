@@ -24,7 +24,11 @@ static_assert(sizeof(gpu::PushConstants) == 124);
 static_assert(offsetof(gpu::PushConstants, light_first) == gpu::kPushLightFirstOffset);
 static_assert(offsetof(gpu::PushConstants, cut_flags) == gpu::kPushCutFlagsOffset);
 static_assert(offsetof(gpu::PushConstants, refine_budget) == gpu::kPushRefineBudgetOffset);
+// The std430 layouts of bindings.glsl's records: 4-byte scalars only.
 static_assert(sizeof(gpu::PixelStats) == 32);
+static_assert(offsetof(gpu::PixelStats, shadow_rays_lo) == 8);
+static_assert(offsetof(gpu::PixelStats, max_cut_samples) == 16);
+static_assert(offsetof(gpu::PixelStats, flags) == 24);
 static_assert(sizeof(gpu::CutState) == 48);
 
 RenderResult render(const Context& ctx, const PreparedScene& prepared,

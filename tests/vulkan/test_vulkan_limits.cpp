@@ -1,5 +1,5 @@
-// The Vulkan path at its limits: a max_cut far beyond the tree and a heap
-// too large for any buffer.
+// The Vulkan path at its limits: a max_cut far beyond the tree, a heap too
+// large for any buffer, and per-pixel counters past 2^32.
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "bindings.glsl"
+#include "render_setup.h"
 #include "test_util.h"
 #include "vulkan_test_support.h"
 
@@ -59,6 +60,61 @@ TEST_F(Vulkan, HeapLargerThanABufferIsRefusedClearly) {
         const std::string what = e.what();
         EXPECT_NE(what.find("buffer 'heap spill' needs 281598720 bytes"), std::string::npos) << what;
         EXPECT_NE(what.find("219999 heap slots per pixel"), std::string::npos) << what;
+    }
+}
+
+// Start every pixel's 64-bit counters at `start` (lo/hi words), run one
+// real pass of the shading kernel on top, and return the counters.
+std::vector<gpu::PixelStats> pass_over(vk::RenderSetup& setup, const gpu::FrameParams& frame,
+                                       const std::vector<gpu::PixelStats>* start) {
+    const std::uint32_t pixels = frame.width * frame.height;
+    VkCommandBuffer cmd = setup.submitter.begin();
+    if (start)
+        // The pass's first barrier makes this transfer visible to the kernels.
+        setup.ctx.fn().vkCmdUpdateBuffer(cmd, setup.resources.pixel_stats().get(), 0,
+                                         pixels * sizeof(gpu::PixelStats), start->data());
+    setup.pass.record(cmd, frame, /*first=*/start == nullptr, /*last=*/true);
+    setup.submitter.submit_and_wait();
+    // The pass made the counters host-readable; its fence has signalled.
+    const gpu::PixelStats* out = setup.resources.pixel_stats_sums();
+    return {out, out + pixels};
+}
+
+// A pixel's cut sizes and shadow rays, summed over samples, pass 2^32 with
+// 10^6 lights and 4295 samples: too much to render here. So each kernel
+// runs one pass from zero, then one pass from counters a few counts below
+// 2^32 (a pre-filled stats buffer), and the second must end exactly the
+// first's counts above the start, carried into the high word.
+TEST_F(Vulkan, PixelCountersCarryPast32Bits) {
+    const PreparedScene p = prepare_scene(random_scene(63, 40, 1, 8, 8), 1);
+    const std::uint64_t start = (std::uint64_t(5) << 32) | 0xFFFFFFF8u;  // 8 below a carry
+    for (const char* method : {"brute", "lightcuts"}) {
+        SCOPED_TRACE(method);
+        RenderOptions o = options(method, 8, 8);
+        o.relative_error = 0.0f;
+        VulkanOptions v;
+        v.validation = true;
+        vk::MessageLog log;
+        vk::Context ctx(v, &log);
+        const gpu::FrameParams frame = vk::frame_params(ctx, p, o);
+        vk::RenderSetup setup(ctx, p, o, frame, {});
+        const std::vector<gpu::PixelStats> base = pass_over(setup, frame, nullptr);
+        std::vector<gpu::PixelStats> from(base.size(), gpu::PixelStats{});
+        for (gpu::PixelStats& ps : from) {
+            ps.cut_size_lo = ps.shadow_rays_lo = std::uint32_t(start);
+            ps.cut_size_hi = ps.shadow_rays_hi = std::uint32_t(start >> 32);
+        }
+        const std::vector<gpu::PixelStats> after = pass_over(setup, frame, &from);
+        std::size_t carried = 0;
+        for (std::size_t i = 0; i < base.size(); ++i) {
+            const std::uint64_t rays = gpu::count64(base[i].shadow_rays_lo, base[i].shadow_rays_hi);
+            const std::uint64_t cut = gpu::count64(base[i].cut_size_lo, base[i].cut_size_hi);
+            EXPECT_EQ(gpu::count64(after[i].shadow_rays_lo, after[i].shadow_rays_hi), start + rays);
+            EXPECT_EQ(gpu::count64(after[i].cut_size_lo, after[i].cut_size_hi), start + cut);
+            carried += rays >= 8 ? 1 : 0;
+        }
+        EXPECT_GT(carried, base.size() / 2) << "the pass should carry at most pixels";
+        EXPECT_EQ(log.count(), 0u);
     }
 }
 
