@@ -57,6 +57,7 @@ double TileScheduler::render_tile(const Tile& tile, RenderResult& result) {
         const std::uint32_t cut_short = loop_limited_pixels(tile);
         if (cut_short == 0) break;
         split_finer(tile, cut_short);
+        result.stats.loop_limit_retries += 1;
         samples_done_ -= std::uint64_t(tile.pixels()) * frame_.spp;
     }
     read_back(tile, result);

@@ -29,7 +29,7 @@ public:
 
     // Renders the whole image into result.image and adds to result.stats:
     // shadow rays, max-cut and spill counts, cut sizes (when the method
-    // reports them) and GPU stage times.
+    // reports them), GPU stage times and loop-limit retries.
     void render(RenderResult& result);
 
 private:

@@ -1,5 +1,6 @@
 // The Vulkan path at its limits: a max_cut far beyond the tree, a heap too
-// large for any buffer, and per-pixel counters past 2^32.
+// large for any buffer, per-pixel counters past 2^32, and the automatic
+// re-split of the work when lavapipe cuts the kernels' loops short.
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -15,6 +16,7 @@
 namespace lc {
 namespace {
 
+using vulkan_test::expect_brute_matches;
 using vulkan_test::expect_lightcuts_matches;
 using vulkan_test::options;
 using vulkan_test::random_scene;
@@ -116,6 +118,56 @@ TEST_F(Vulkan, PixelCountersCarryPast32Bits) {
         EXPECT_GT(carried, base.size() / 2) << "the pass should carry at most pixels";
         EXPECT_EQ(log.count(), 0u);
     }
+}
+
+// lavapipe (llvmpipe) silently ends an invocation's loops after 65535
+// iterations; the kernels notice, and the renderer splits the work finer
+// and renders the tile again, without any tuning asking for it. Other
+// devices have no such limit and render in one dispatch per stage.
+void expect_resplit_on_llvmpipe(const RenderStats& stats) {
+    std::printf("[ measured ] %s: %u loop-limit retries\n", stats.device.c_str(),
+                stats.loop_limit_retries);
+    if (stats.device.find("llvmpipe") != std::string::npos) {
+        EXPECT_GT(stats.loop_limit_retries, 0u);
+    }
+}
+
+// 70000 unshadowed lights: 70000 iterations of the brute-force loop alone.
+TEST_F(Vulkan, LoopLimitSplitsBruteForceAutomatically) {
+    Scene s;
+    s.materials = {test::lambert({0.6f, 0.5f, 0.4f})};
+    test::add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
+    s.lights = test::random_point_lights(70000, {-2, 0.5f, -2}, {2, 2, 2}, 10.0f, 64);
+    s.camera = test::camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 50.0f, 4, 4);
+    update_bounds(s);
+    const PreparedScene p = prepare_scene(std::move(s), 1);
+    ASSERT_FALSE(p.has_occluders);
+    const RenderOptions o = options("brute", 4, 4);
+    const RenderResult g = gpu(p, o);
+    expect_brute_matches(p, o, g, vulkan_test::kBruteSplitRelative);
+    expect_resplit_on_llvmpipe(g.stats);
+}
+
+// Cuts refined down to every one of 4000 lights: each refinement loops over
+// heap levels and a shadow ray's BVH nodes, about twice the limit in all
+// (1600 lights already pass it).
+TEST_F(Vulkan, LoopLimitSplitsLightcutsAutomatically) {
+    Scene s;
+    s.materials = {test::lambert({0.6f, 0.5f, 0.4f})};
+    test::add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
+    test::add_box(s, {-1.0f, 0.0f, -1.0f}, {-0.3f, 0.6f, -0.3f}, 0);
+    test::add_box(s, {0.4f, 0.0f, 0.2f}, {0.9f, 0.4f, 0.8f}, 0);
+    test::add_box(s, {-0.5f, 0.8f, 0.5f}, {0.0f, 1.0f, 1.0f}, 0);
+    s.lights = test::random_point_lights(4000, {-2, 0.5f, -2}, {2, 2, 2}, 10.0f, 65);
+    s.camera = test::camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 50.0f, 4, 4);
+    update_bounds(s);
+    const PreparedScene p = prepare_scene(std::move(s), 1);
+    RenderOptions o = options("lightcuts", 4, 4);
+    o.relative_error = 0.0f;
+    o.max_cut = 100000;
+    const RenderResult g = gpu(p, o);
+    expect_lightcuts_matches(p, o, g);
+    expect_resplit_on_llvmpipe(g.stats);
 }
 
 }  // namespace
