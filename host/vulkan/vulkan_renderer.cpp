@@ -118,6 +118,9 @@ RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& o
         if (log.count() == 0) throw;
         std::string message = e.what();
         for (const std::string& m : log.messages()) message += "\n  validation " + m;
+        // With no driver at all the loader's own messages are in the log;
+        // callers still need to tell "no device" from a failure.
+        if (dynamic_cast<const NoVulkanDevice*>(&e)) throw NoVulkanDevice(message);
         throw std::runtime_error(message);
     }
     if (log.count() > 0) {

@@ -8,6 +8,7 @@
 
 #include "cpu_kernel.h"
 #include "test_util.h"
+#include "vulkan/require_vulkan.h"
 
 namespace lc::vulkan_test {
 
@@ -49,9 +50,11 @@ void expect_shadow_rays_match(const RenderStats& g, const RenderStats& c, const 
 }  // namespace
 
 void Vulkan::SetUp() {
-    if (!vulkan_present())
+    if (!vulkan_present()) {
+        if (test::vulkan_required()) GTEST_FAIL() << test::kNoVulkanButRequired;
         GTEST_SKIP() << "no Vulkan device (the loader lists none); the GPU tests need one, "
-                        "lavapipe (mesa-vulkan-drivers) is enough";
+                        "lavapipe (mesa-vulkan-drivers) is enough; LC_REQUIRE_VULKAN=1 fails instead";
+    }
     messages_before_ = vk::validation_message_total();
 }
 

@@ -1,5 +1,5 @@
 // What the Vulkan tests share: the fixture (validation on, any message
-// fails; no Vulkan device skips), the
+// fails; no Vulkan device skips, or fails under LC_REQUIRE_VULKAN=1), the
 // comparisons against the CPU reference with their measured tolerances,
 // and seeded random scenes.
 //
