@@ -57,13 +57,6 @@ void check_scene_order(const std::vector<SceneArray>& scene) {
             "kBindingBvhNodes .. kBindingLightNodes (shaders/bindings.glsl)");
 }
 
-// "light_tree_nodes" -> "light tree nodes": the buffer's debug name.
-std::string buffer_name(const char* array_name) {
-    std::string name = array_name;
-    std::replace(name.begin(), name.end(), '_', ' ');
-    return name;
-}
-
 std::string mib(VkDeviceSize bytes) {
     char text[32];
     std::snprintf(text, sizeof text, "%.1f MiB", double(bytes) / double(1 << 20));
@@ -121,7 +114,8 @@ Buffer GpuResources::upload(const SceneArray& array) {
     const std::vector<unsigned char> zero_element(array.count == 0 ? array.element_bytes : 0);
     const void* source = array.count == 0 ? zero_element.data() : array.data;
     const VkDeviceSize bytes = array.count == 0 ? array.element_bytes : array.bytes();
-    const std::string name = buffer_name(array.name);
+    // The array's own name, so that the report lists each array once.
+    const std::string name = array.name;
     Buffer buffer = storage_buffer(name, bytes, MemoryUse::kDevice, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     if (buffer.mapped()) {
         std::memcpy(buffer.mapped(), source, bytes);
