@@ -115,6 +115,7 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
     const double pixels = double(r.width) * double(r.height);
     r.shadow_rays_per_pixel = pixels > 0.0 ? double(s.shadow_rays) / pixels : 0.0;
     r.rays_per_second = double(s.camera_rays + s.shadow_rays) / std::max(s.seconds_total, 1e-9);
+    r.loop_limit_retries = s.loop_limit_retries;
     r.buffer_bytes = scene_buffer_bytes(prepared);
     for (const auto& [name, bytes] : s.buffer_bytes) {
         auto same = std::find_if(r.buffer_bytes.begin(), r.buffer_bytes.end(),
@@ -135,6 +136,9 @@ std::string report_text(const RenderReport& r) {
                    black.c_str(), r.bvh_nodes, r.seconds.bvh_build);
     text += format("  render %.3f s, %.0f rays (%.2f Mrays/s), %.1f shadow rays per pixel\n", r.seconds.render,
                    double(r.camera_rays + r.shadow_rays), r.rays_per_second * 1e-6, r.shadow_rays_per_pixel);
+    if (r.loop_limit_retries)
+        text += format("  %u tile(s) rendered again with the work split finer (the driver cut long loops short)\n",
+                       r.loop_limit_retries);
     if (r.lightcuts) text += lightcuts_text(r, *r.lightcuts);
     return text;
 }
@@ -162,6 +166,7 @@ std::string report_json(const RenderReport& r) {
         {"shadow_rays", r.shadow_rays},
         {"shadow_rays_per_pixel", r.shadow_rays_per_pixel},
         {"rays_per_second", r.rays_per_second},
+        {"loop_limit_retries", r.loop_limit_retries},
         {"buffer_bytes", buffers},
     };
     if (r.lightcuts) j["lightcuts"] = lightcuts_json(*r.lightcuts);

@@ -35,24 +35,40 @@ LC_CONST uint kSpecWorkgroupSize = 0u;    // local_size_x
 LC_CONST uint kSpecEnableGgx = 1u;        // any material has a GGX lobe
 LC_CONST uint kSpecEnableShadows = 2u;    // any triangle can block a light
 LC_CONST uint kSpecHeapShared = 3u;       // K: cut-heap slots per invocation in shared memory
-LC_CONST uint kSpecHeapCapacity = 4u;     // all cut-heap slots per invocation, max(max_cut, 2)
+LC_CONST uint kSpecHeapCapacity = 4u;     // all cut-heap slots per invocation,
+                                          // LightTree::cut_heap_capacity(max_cut)
 LC_CONST uint kSpecSpillStride = 5u;      // invocations the spill buffer is laid out for
 
 // PixelStats.flags
-LC_CONST uint kPixelHeapOverflow = 1u;  // a heap outgrew its capacity (a bug: cannot happen
-                                        // while cuts stay within max(max_cut, 2) clusters)
+LC_CONST uint kPixelHeapOverflow = 1u;  // a heap outgrew its capacity (a bug: the capacity
+                                        // bounds every cut the tree and max_cut allow)
 LC_CONST uint kPixelLoopLimit = 2u;     // the driver cut the invocation's loops short
 LC_CONST uint kPixelCutUnfinished = 4u; // refinement went on past the pass's last dispatch (a bug)
 
-// Per tile pixel, summed over the samples of the pixel (32 bytes).
+// Per tile pixel, summed over the samples of the pixel (32 bytes). The two
+// sums that can pass 2^32 (10^6 lights times 4295 samples do) are 64-bit
+// counts kept as lo/hi word pairs, added to with lc_count_add, so no device
+// needs shaderInt64; the host joins them with count64. Sample counts stay
+// below kMaxSpp and fit one word.
 struct PixelStats {
-    uint cut_size_sum;      // lightcuts: clusters in the final cuts
-    uint shadow_rays;
+    uint cut_size_lo, cut_size_hi;        // lightcuts: clusters in the final cuts
+    uint shadow_rays_lo, shadow_rays_hi;
     uint max_cut_samples;   // samples whose refinement stopped at max_cut
     uint spill_samples;     // samples whose heap grew past kHeapShared slots
     uint flags;             // kPixel* bits, or-ed over samples
-    uint pad0, pad1, pad2;
+    uint pad0;
 };
+
+#ifdef __cplusplus
+inline std::uint64_t count64(uint lo, uint hi) { return std::uint64_t(hi) << 32 | lo; }
+#else
+// (lo, hi) += v, carrying into the high word.
+void lc_count_add(inout uint lo, inout uint hi, uint v) {
+    uint carry;
+    lo = uaddCarry(lo, v, carry);
+    hi += carry;
+}
+#endif
 
 // A Lightcuts cut in the making, kept in global memory between the
 // dispatches of one sample when the refinement is spread over several

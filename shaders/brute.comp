@@ -21,6 +21,6 @@ void main() {
     stats.hit_max_cut = 0u;
     vec3 c = lc_shade_brute(lc_texel_surface(g), frame.light_count, frame.min_distance2, stats);
     lc_accumulate(i, c);
-    pixel_stats[i].shadow_rays += stats.shadow_rays;
+    lc_count_add(pixel_stats[i].shadow_rays_lo, pixel_stats[i].shadow_rays_hi, stats.shadow_rays);
     if (lc_loops_were_cut_short()) pixel_stats[i].flags |= kPixelLoopLimit;
 }

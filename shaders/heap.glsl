@@ -2,7 +2,9 @@
 // workgroup shared memory; slots K and above spill to a global buffer laid
 // out for the whole tile. K, the capacity and the spill layout are
 // specialization constants chosen by the host from the device's shared
-// memory size, the workgroup size and max_cut.
+// memory size, the workgroup size and the capacity, which is
+// LightTree::cut_heap_capacity(max_cut): the tree's interior nodes, never
+// more than the cut, so a huge max_cut over a small tree costs nothing.
 //
 // The global buffer has room for all kHeapCapacity slots of every
 // invocation: slots below K are where the shared part is saved while a

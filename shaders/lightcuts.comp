@@ -72,8 +72,8 @@ void main() {
 
     lc_accumulate(i, lc_cut_result(heap_size, leaf_sum));
     PixelStats ps = pixel_stats[i];
-    ps.cut_size_sum += stats.cut_size;
-    ps.shadow_rays += stats.shadow_rays;
+    lc_count_add(ps.cut_size_lo, ps.cut_size_hi, stats.cut_size);
+    lc_count_add(ps.shadow_rays_lo, ps.shadow_rays_hi, stats.shadow_rays);
     ps.max_cut_samples += stats.hit_max_cut;
     ps.spill_samples += g_heap_spilled ? 1u : 0u;
     if (g_heap_overflow) ps.flags |= kPixelHeapOverflow;

@@ -70,6 +70,8 @@ struct RenderStats {
     std::uint64_t max_cut_pixels = 0;       // samples where refinement hit max_cut
     std::uint64_t heap_spill_pixels = 0;    // GPU: samples whose heap spilled to global memory
     std::uint32_t heap_capacity_shared = 0; // GPU: heap slots per invocation in shared memory
+    std::uint32_t loop_limit_retries = 0;   // GPU: tiles rendered again with the work split over
+                                            // more dispatches (the driver cut loops short)
     std::vector<float> cut_size;      // per pixel, mean over samples (lightcuts only)
     std::vector<std::pair<std::string, std::uint64_t>> buffer_bytes;
 };

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "vulkan/require_vulkan.h"
+
 namespace lc::stress {
 namespace {
 
@@ -306,12 +308,15 @@ std::optional<RenderResult> render_vulkan_if_available(const PreparedScene& p, c
     v.validation = true;  // any validation message makes render_vulkan throw
     try {
         return render_vulkan(p, o, v);
-    } catch (const NoVulkanDevice&) {
+    } catch (const NoVulkanDevice& e) {
+        if (test::vulkan_required()) ADD_FAILURE() << test::kNoVulkanButRequired << ": " << e.what();
         return std::nullopt;
     }
 #else
     (void)p;
     (void)o;
+    if (test::vulkan_required())
+        ADD_FAILURE() << "LC_REQUIRE_VULKAN=1, but this build has no Vulkan path (lc_vulkan)";
     return std::nullopt;
 #endif
 }

@@ -88,7 +88,8 @@ CpuRenders run_cpu_checks(const PreparedScene& p, const RenderOptions& lightcuts
 
 // The Vulkan half: renders on the Vulkan device with validation on. Empty
 // when this build has no Vulkan path or no Vulkan device exists (the caller
-// skips); any other failure (a validation message included) throws.
+// skips; under LC_REQUIRE_VULKAN=1 the test has failed already); any other
+// failure (a validation message included) throws.
 std::optional<RenderResult> render_vulkan_if_available(const PreparedScene& p, const RenderOptions& o);
 
 // Writes image, reference and error map under <build>/test-output/stress/.

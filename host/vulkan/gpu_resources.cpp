@@ -1,0 +1,272 @@
+#include "gpu_resources.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+
+#include "vk_check.h"
+
+namespace lc::vk {
+
+namespace {
+
+// No single buffer is made larger than this even where the device would
+// allow it: tiles just get smaller.
+constexpr VkDeviceSize kBufferBudget = VkDeviceSize(256) << 20;
+// The largest tile when neither the limits nor the tuning say otherwise.
+constexpr std::uint32_t kMaxTilePixels = 1u << 20;
+
+// What the kernels declare at each scene binding (shaders/kernel.glsl), in
+// binding order: scene_arrays() must hand over exactly these, in this order.
+struct SceneBinding {
+    std::uint32_t binding;
+    const char* array_name;
+    std::size_t element_bytes;
+};
+constexpr SceneBinding kSceneBindings[] = {
+    {gpu::kBindingBvhNodes, "bvh_nodes", sizeof(gpu::BvhNode)},
+    {gpu::kBindingTriangles, "triangles", sizeof(gpu::Triangle)},
+    {gpu::kBindingNormals, "normals", sizeof(gpu::TriangleNormals)},
+    {gpu::kBindingMaterials, "materials", sizeof(gpu::Material)},
+    {gpu::kBindingLights, "lights", sizeof(gpu::Light)},
+    {gpu::kBindingLightNodes, "light_tree_nodes", sizeof(gpu::LightNode)},
+};
+constexpr bool scene_bindings_in_order() {
+    for (std::uint32_t i = 0; i < std::size(kSceneBindings); ++i)
+        if (kSceneBindings[i].binding != gpu::kBindingBvhNodes + i) return false;
+    return kSceneBindings[std::size(kSceneBindings) - 1].binding == gpu::kBindingLightNodes &&
+           gpu::kBindingGBuffer == gpu::kBindingLightNodes + 1;
+}
+static_assert(scene_bindings_in_order());
+static_assert(gpu::kBindingRadiance == gpu::kBindingGBuffer + 1 &&
+              gpu::kBindingPixelStats == gpu::kBindingGBuffer + 2 &&
+              gpu::kBindingHeapSpill == gpu::kBindingGBuffer + 3 &&
+              gpu::kBindingCutState == gpu::kBindingGBuffer + 4 &&
+              gpu::kBindingCount == gpu::kBindingGBuffer + 5,
+              "GpuResources::TileIndex follows the per-tile bindings");
+
+void check_scene_order(const std::vector<SceneArray>& scene) {
+    bool ok = scene.size() == std::size(kSceneBindings);
+    for (std::size_t i = 0; ok && i < scene.size(); ++i)
+        ok = std::strcmp(scene[i].name, kSceneBindings[i].array_name) == 0 &&
+             scene[i].element_bytes == kSceneBindings[i].element_bytes;
+    if (!ok)
+        throw std::logic_error(
+            "scene_arrays() no longer lists the arrays in the order of the bindings "
+            "kBindingBvhNodes .. kBindingLightNodes (shaders/bindings.glsl)");
+}
+
+std::string mib(VkDeviceSize bytes) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f MiB", double(bytes) / double(1 << 20));
+    return text;
+}
+
+}  // namespace
+
+GpuResources::GpuResources(const Context& ctx, Submitter& submitter,
+                           const std::vector<SceneArray>& scene, const ShadingMethod& method,
+                           std::uint64_t image_pixels, std::uint32_t max_tile_pixels)
+    : ctx_(ctx), submitter_(submitter) {
+    const VkPhysicalDeviceLimits& limits = ctx.properties().limits;
+    max_buffer_ = std::min<VkDeviceSize>(limits.maxStorageBufferRange, ctx.max_allocation_size());
+    upload_scene(scene);
+    const std::vector<TileBuffer> buffers = tile_buffers(method);
+    fit_tiles(buffers, image_pixels, max_tile_pixels);
+    create_tile_buffers(buffers);
+    create_descriptors();
+    create_pipeline_layout();
+}
+
+void GpuResources::check_fits(const std::string& name, VkDeviceSize bytes) const {
+    const VkPhysicalDeviceLimits& limits = ctx_.properties().limits;
+    const char* limit_name = nullptr;
+    VkDeviceSize limit = 0;
+    if (bytes > limits.maxStorageBufferRange) {
+        limit_name = "maxStorageBufferRange";
+        limit = limits.maxStorageBufferRange;
+    } else if (bytes > ctx_.max_allocation_size()) {
+        limit_name = "maxMemoryAllocationSize";
+        limit = ctx_.max_allocation_size();
+    }
+    if (limit_name)
+        throw std::runtime_error("scene does not fit the Vulkan device " + ctx_.device_name() +
+                                 ": buffer '" + name + "' needs " + std::to_string(bytes) +
+                                 " bytes (" + mib(bytes) + "), more than its " + limit_name +
+                                 " of " + std::to_string(limit) + " bytes (" + mib(limit) + ")");
+}
+
+Buffer GpuResources::storage_buffer(const std::string& name, VkDeviceSize bytes, MemoryUse use,
+                                    VkBufferUsageFlags extra_usage) {
+    check_fits(name, bytes);
+    VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | extra_usage;
+    Buffer buffer(ctx_.device(), ctx_.memory(), bytes, usage, use, name);
+    buffer_bytes_.emplace_back(name, bytes);
+    return buffer;
+}
+
+// Device-local buffer holding the array: written through the mapping where
+// the device memory is host-visible (lavapipe, integrated GPUs), through a
+// staging buffer and a copy otherwise. An empty array gets one zeroed
+// element so that every binding has a buffer.
+Buffer GpuResources::upload(const SceneArray& array) {
+    const std::vector<unsigned char> zero_element(array.count == 0 ? array.element_bytes : 0);
+    const void* source = array.count == 0 ? zero_element.data() : array.data;
+    const VkDeviceSize bytes = array.count == 0 ? array.element_bytes : array.bytes();
+    // The array's own name, so that the report lists each array once.
+    const std::string name = array.name;
+    Buffer buffer = storage_buffer(name, bytes, MemoryUse::kDevice, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    if (buffer.mapped()) {
+        std::memcpy(buffer.mapped(), source, bytes);
+        return buffer;
+    }
+    Buffer staging(ctx_.device(), ctx_.memory(), bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                   MemoryUse::kUpload, name + " staging");
+    std::memcpy(staging.mapped(), source, bytes);
+    VkCommandBuffer cmd = submitter_.begin();
+    VkBufferCopy region{0, 0, bytes};
+    ctx_.fn().vkCmdCopyBuffer(cmd, staging.get(), buffer.get(), 1, &region);
+    // The kernels read what the copy wrote.
+    auto barrier = vk_struct<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+    barrier.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+    ctx_.fn().vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0,
+                                   nullptr, 0, nullptr);
+    submitter_.submit_and_wait();  // the staging buffer dies at the end of this function
+    return buffer;
+}
+
+void GpuResources::upload_scene(const std::vector<SceneArray>& scene) {
+    check_scene_order(scene);
+    for (const SceneArray& array : scene) scene_.push_back(upload(array));
+}
+
+std::vector<TileBuffer> GpuResources::tile_buffers(const ShadingMethod& method) const {
+    std::vector<TileBuffer> buffers(kTileBufferCount);
+    buffers[kGBuffer] = {"g-buffer", sizeof(gpu::GBufferTexel), ""};
+    buffers[kRadiance] = {"radiance", 3 * sizeof(float), ""};
+    buffers[kPixelStats] = {"pixel stats", sizeof(gpu::PixelStats), ""};
+    buffers[kHeapSpill] = method.heap_spill();
+    buffers[kCutState] = method.cut_state();
+    return buffers;
+}
+
+// The largest tile, in whole workgroups, whose per-tile buffers each fit
+// the device's limits and kBufferBudget.
+void GpuResources::fit_tiles(const std::vector<TileBuffer>& buffers, std::uint64_t image_pixels,
+                             std::uint32_t max_tile_pixels) {
+    const VkDeviceSize per_buffer = std::min(max_buffer_, kBufferBudget);
+    VkDeviceSize fit = kMaxTilePixels;
+    const TileBuffer* largest = &buffers[0];
+    for (const TileBuffer& b : buffers) {
+        if (b.bytes_per_pixel > 0) fit = std::min(fit, per_buffer / b.bytes_per_pixel);
+        if (b.bytes_per_pixel > largest->bytes_per_pixel) largest = &b;
+    }
+    fit = fit / gpu::kWorkgroupSize * gpu::kWorkgroupSize;
+    if (fit == 0)
+        throw std::runtime_error(
+            "scene does not fit the Vulkan device " + ctx_.device_name() + ": buffer '" +
+            largest->name + "' needs " +
+            std::to_string(largest->bytes_per_pixel * gpu::kWorkgroupSize) +
+            " bytes for one workgroup" + (largest->why.empty() ? "" : " (" + largest->why + ")") +
+            ", more than the " + std::to_string(per_buffer) + " bytes one buffer may use");
+
+    std::uint64_t max_pixels = std::min<std::uint64_t>(fit, image_pixels);
+    if (max_tile_pixels > 0) max_pixels = std::min<std::uint64_t>(max_pixels, max_tile_pixels);
+    tiles_.max_pixels = std::uint32_t(std::max<std::uint64_t>(max_pixels, 1));
+    tiles_.invocations = (tiles_.max_pixels + gpu::kWorkgroupSize - 1) / gpu::kWorkgroupSize *
+                         gpu::kWorkgroupSize;
+}
+
+void GpuResources::create_tile_buffers(const std::vector<TileBuffer>& buffers) {
+    // One element where a method does not use a buffer: every binding needs one.
+    const VkDeviceSize unused_bytes[kTileBufferCount] = {0, 0, 0, sizeof(gpu::CutEntry),
+                                                         sizeof(gpu::CutState)};
+    constexpr VkBufferUsageFlags kFillAndCopy =
+        VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    for (int i = 0; i < kTileBufferCount; ++i) {
+        const TileBuffer& b = buffers[std::size_t(i)];
+        const VkDeviceSize bytes =
+            b.bytes_per_pixel > 0 ? tiles_.invocations * b.bytes_per_pixel : unused_bytes[i];
+        const bool output = i == kRadiance || i == kPixelStats;
+        tile_[i] = storage_buffer(b.name, bytes, MemoryUse::kDevice, output ? kFillAndCopy : 0);
+    }
+    if (!radiance().mapped() || !pixel_stats().mapped()) {
+        radiance_readback_ = storage_buffer("radiance read-back", radiance().size(),
+                                            MemoryUse::kReadback, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+        stats_readback_ = storage_buffer("pixel stats read-back", pixel_stats().size(),
+                                         MemoryUse::kReadback, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    }
+}
+
+const float* GpuResources::radiance_sums() const {
+    const Buffer& b = needs_readback_copies() ? radiance_readback_ : radiance();
+    return static_cast<const float*>(b.mapped());
+}
+
+const gpu::PixelStats* GpuResources::pixel_stats_sums() const {
+    const Buffer& b = needs_readback_copies() ? stats_readback_ : pixel_stats();
+    return static_cast<const gpu::PixelStats*>(b.mapped());
+}
+
+void GpuResources::create_descriptors() {
+    VkDevice device = ctx_.device().get();
+    const VolkDeviceTable& vkd = ctx_.fn();
+    VkDescriptorSetLayoutBinding bindings[gpu::kBindingCount];
+    for (std::uint32_t b = 0; b < gpu::kBindingCount; ++b)
+        bindings[b] = {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+    auto layout_info = vk_struct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
+    layout_info.bindingCount = gpu::kBindingCount;
+    layout_info.pBindings = bindings;
+    VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
+    VK_CHECK(vkd.vkCreateDescriptorSetLayout(device, &layout_info, nullptr, &set_layout));
+    set_layout_ = own<DescriptorSetLayout>(ctx_.device(), set_layout, "kernel buffers layout");
+
+    VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, gpu::kBindingCount};
+    auto pool_info = vk_struct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
+    pool_info.maxSets = 1;
+    pool_info.poolSizeCount = 1;
+    pool_info.pPoolSizes = &pool_size;
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    VK_CHECK(vkd.vkCreateDescriptorPool(device, &pool_info, nullptr, &pool));
+    descriptor_pool_ = own<DescriptorPool>(ctx_.device(), pool, "descriptor pool");
+
+    auto alloc_info = vk_struct<VkDescriptorSetAllocateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO);
+    alloc_info.descriptorPool = pool;
+    alloc_info.descriptorSetCount = 1;
+    alloc_info.pSetLayouts = &set_layout;
+    VK_CHECK(vkd.vkAllocateDescriptorSets(device, &alloc_info, &descriptor_set_));
+    ctx_.device().set_name(descriptor_set_, "kernel buffers");
+
+    VkDescriptorBufferInfo infos[gpu::kBindingCount];
+    VkWriteDescriptorSet writes[gpu::kBindingCount];
+    for (std::uint32_t b = 0; b < gpu::kBindingCount; ++b) {
+        const Buffer& buffer = b < gpu::kBindingGBuffer ? scene_[b] : tile_[b - gpu::kBindingGBuffer];
+        infos[b] = {buffer.get(), 0, VK_WHOLE_SIZE};
+        writes[b] = vk_struct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
+        writes[b].dstSet = descriptor_set_;
+        writes[b].dstBinding = b;
+        writes[b].descriptorCount = 1;
+        writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        writes[b].pBufferInfo = &infos[b];
+    }
+    vkd.vkUpdateDescriptorSets(device, gpu::kBindingCount, writes, 0, nullptr);
+}
+
+void GpuResources::create_pipeline_layout() {
+    VkDescriptorSetLayout set_layout = set_layout_.get();
+    VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(gpu::PushConstants)};
+    auto pipeline_layout_info = vk_struct<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
+    pipeline_layout_info.setLayoutCount = 1;
+    pipeline_layout_info.pSetLayouts = &set_layout;
+    pipeline_layout_info.pushConstantRangeCount = 1;
+    pipeline_layout_info.pPushConstantRanges = &push;
+    VkPipelineLayout pipeline_layout = VK_NULL_HANDLE;
+    VK_CHECK(ctx_.fn().vkCreatePipelineLayout(ctx_.device().get(), &pipeline_layout_info, nullptr,
+                                              &pipeline_layout));
+    pipeline_layout_ = own<PipelineLayout>(ctx_.device(), pipeline_layout, "kernel layout");
+}
+
+}  // namespace lc::vk

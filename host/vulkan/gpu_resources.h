@@ -1,0 +1,90 @@
+// The buffers the kernels read and write and the one descriptor set that
+// binds them (shaders/bindings.glsl): the scene's arrays, uploaded once, and
+// the per-tile buffers, sized for the largest tile the device's buffer
+// limits allow. Also the pipeline layout every kernel shares.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "bindings.glsl"
+#include "lightcuts/render.h"
+#include "shading_method.h"
+#include "vk_commands.h"
+#include "vk_context.h"
+
+namespace lc::vk {
+
+// Size of the per-tile buffers.
+struct TileLayout {
+    std::uint32_t max_pixels = 0;   // largest tile the buffers hold
+    std::uint32_t invocations = 0;  // max_pixels rounded up to whole workgroups
+};
+
+class GpuResources {
+public:
+    // Uploads `scene` (scene_arrays() order: bindings kBindingBvhNodes ..
+    // kBindingLightNodes), sizes and creates the per-tile buffers for
+    // `method` and an image of `image_pixels` (tiles of at most
+    // `max_tile_pixels`, 0: no cap), and binds everything. Throws naming
+    // the buffer, its size and the device limit when something cannot fit.
+    GpuResources(const Context& ctx, Submitter& submitter, const std::vector<SceneArray>& scene,
+                 const ShadingMethod& method, std::uint64_t image_pixels,
+                 std::uint32_t max_tile_pixels);
+
+    const TileLayout& tiles() const { return tiles_; }
+    VkDescriptorSet descriptor_set() const { return descriptor_set_; }
+    VkPipelineLayout pipeline_layout() const { return pipeline_layout_.get(); }
+
+    // Per-tile outputs: zeroed before a tile's first sample.
+    const Buffer& radiance() const { return tile_[kRadiance]; }
+    const Buffer& pixel_stats() const { return tile_[kPixelStats]; }
+    // Device memory the host cannot map: the last pass of a tile copies the
+    // outputs to these read-back buffers (empty otherwise).
+    const Buffer& radiance_readback() const { return radiance_readback_; }
+    const Buffer& stats_readback() const { return stats_readback_; }
+    bool needs_readback_copies() const { return radiance_readback_.get() != VK_NULL_HANDLE; }
+    // Where the host reads a tile's outputs once its last pass has finished.
+    const float* radiance_sums() const;
+    const gpu::PixelStats* pixel_stats_sums() const;
+
+    // Every buffer created, in creation order (RenderStats::buffer_bytes).
+    const std::vector<std::pair<std::string, std::uint64_t>>& buffer_bytes() const {
+        return buffer_bytes_;
+    }
+
+private:
+    // Per-tile buffers, in binding order from kBindingGBuffer.
+    enum TileIndex { kGBuffer, kRadiance, kPixelStats, kHeapSpill, kCutState, kTileBufferCount };
+
+    Buffer storage_buffer(const std::string& name, VkDeviceSize bytes, MemoryUse use,
+                          VkBufferUsageFlags extra_usage = 0);
+    void check_fits(const std::string& name, VkDeviceSize bytes) const;
+    Buffer upload(const SceneArray& array);
+    void upload_scene(const std::vector<SceneArray>& scene);
+    std::vector<TileBuffer> tile_buffers(const ShadingMethod& method) const;
+    void fit_tiles(const std::vector<TileBuffer>& buffers, std::uint64_t image_pixels,
+                   std::uint32_t max_tile_pixels);
+    void create_tile_buffers(const std::vector<TileBuffer>& buffers);
+    void create_descriptors();
+    void create_pipeline_layout();
+
+    const Context& ctx_;
+    Submitter& submitter_;
+    VkDeviceSize max_buffer_ = 0;  // min(maxStorageBufferRange, maxMemoryAllocationSize)
+    TileLayout tiles_;
+    std::vector<std::pair<std::string, std::uint64_t>> buffer_bytes_;
+
+    // Destroyed in reverse: layouts and descriptors before the buffers.
+    std::vector<Buffer> scene_;                 // bindings kBindingBvhNodes ..
+    Buffer tile_[kTileBufferCount];             // bindings kBindingGBuffer ..
+    Buffer radiance_readback_, stats_readback_;
+    DescriptorSetLayout set_layout_;
+    DescriptorPool descriptor_pool_;
+    VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;
+    PipelineLayout pipeline_layout_;
+};
+
+}  // namespace lc::vk

@@ -1,0 +1,82 @@
+#include "kernels.h"
+
+#include <stdint.h>  // the generated SPIR-V headers use ::uint32_t
+
+#include <algorithm>
+#include <cstddef>
+#include <string>
+
+#include "spirv/primary.h"
+#include "vk_check.h"
+
+namespace lc::vk {
+
+namespace {
+
+// Values of the kernels' specialization constants (shaders/bindings.glsl).
+struct SpecData {
+    std::uint32_t workgroup_size;
+    VkBool32 enable_ggx;
+    VkBool32 enable_shadows;
+    std::uint32_t heap_shared;
+    std::uint32_t heap_capacity;
+    std::uint32_t spill_stride;
+};
+
+Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const KernelCode& code,
+                          const SpecData& spec) {
+    VkDevice device = ctx.device().get();
+    const VolkDeviceTable& vkd = ctx.fn();
+    const std::string name = code.name;
+    auto module_info = vk_struct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
+    module_info.codeSize = code.bytes;
+    module_info.pCode = code.words;
+    VkShaderModule module_handle = VK_NULL_HANDLE;
+    VK_CHECK(vkd.vkCreateShaderModule(device, &module_info, nullptr, &module_handle));
+    ShaderModule module = own<ShaderModule>(ctx.device(), module_handle, name + " module");
+
+    const VkSpecializationMapEntry entries[] = {
+        {gpu::kSpecWorkgroupSize, offsetof(SpecData, workgroup_size), sizeof(std::uint32_t)},
+        {gpu::kSpecEnableGgx, offsetof(SpecData, enable_ggx), sizeof(VkBool32)},
+        {gpu::kSpecEnableShadows, offsetof(SpecData, enable_shadows), sizeof(VkBool32)},
+        {gpu::kSpecHeapShared, offsetof(SpecData, heap_shared), sizeof(std::uint32_t)},
+        {gpu::kSpecHeapCapacity, offsetof(SpecData, heap_capacity), sizeof(std::uint32_t)},
+        {gpu::kSpecSpillStride, offsetof(SpecData, spill_stride), sizeof(std::uint32_t)},
+    };
+    VkSpecializationInfo spec_info{};
+    spec_info.mapEntryCount = std::uint32_t(std::size(entries));
+    spec_info.pMapEntries = entries;
+    spec_info.dataSize = sizeof spec;
+    spec_info.pData = &spec;
+
+    auto info = vk_struct<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
+    info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    info.stage.module = module.get();
+    info.stage.pName = "main";
+    info.stage.pSpecializationInfo = &spec_info;
+    info.layout = layout;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    VK_CHECK(vkd.vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline));
+    return own<Pipeline>(ctx.device(), pipeline, name);
+}
+
+}  // namespace
+
+Kernels::Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMethod& method,
+                 const KernelSwitches& switches) {
+    const HeapLayout heap = method.heap();
+    SpecData spec{};
+    spec.workgroup_size = gpu::kWorkgroupSize;
+    spec.enable_ggx = switches.ggx;
+    spec.enable_shadows = switches.shadows;
+    // Kernels without a heap do not declare its constants; any valid value does.
+    spec.heap_shared = std::max(heap.shared, 1u);
+    spec.heap_capacity = std::max(heap.capacity, 1u);
+    spec.spill_stride = switches.spill_stride;
+    primary_ = compute_pipeline(
+        ctx, layout, {lc_spirv_primary, sizeof lc_spirv_primary, "primary.comp (camera rays)"}, spec);
+    shading_ = compute_pipeline(ctx, layout, method.kernel(), spec);
+}
+
+}  // namespace lc::vk

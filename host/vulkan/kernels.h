@@ -1,0 +1,32 @@
+// The two compute pipelines of a render: camera rays (primary.comp) and the
+// shading method's kernel, both specialised for the scene and the device
+// (specialization constants of shaders/bindings.glsl).
+#pragma once
+
+#include <cstdint>
+
+#include "shading_method.h"
+#include "vk_context.h"
+
+namespace lc::vk {
+
+// Values of the specialization constants that do not come from the method.
+struct KernelSwitches {
+    bool ggx = true;                 // compile the GGX lobe in
+    bool shadows = true;             // compile shadow rays in
+    std::uint32_t spill_stride = 1;  // invocations the heap spill buffer is laid out for
+};
+
+class Kernels {
+public:
+    Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMethod& method,
+            const KernelSwitches& switches);
+
+    VkPipeline primary() const { return primary_.get(); }
+    VkPipeline shading() const { return shading_.get(); }
+
+private:
+    Pipeline primary_, shading_;
+};
+
+}  // namespace lc::vk

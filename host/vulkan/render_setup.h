@@ -1,0 +1,43 @@
+// Everything one Vulkan render builds on a device, in the order each part
+// needs the others. render_vulkan runs a TileScheduler over it; kernel-level
+// tests record passes on it directly.
+#pragma once
+
+#include <memory>
+
+#include "gpu_resources.h"
+#include "kernels.h"
+#include "shading_method.h"
+#include "tile_pass.h"
+#include "vk_commands.h"
+#include "vk_context.h"
+#include "vulkan_renderer.h"
+
+namespace lc::vk {
+
+// The frame constants of a render: validates the options (throws
+// std::invalid_argument) and checks that the device offers the push
+// constants the kernels need.
+gpu::FrameParams frame_params(const Context& ctx, const PreparedScene& prepared,
+                              const RenderOptions& options);
+
+// Members are built top to bottom and destroyed bottom to top, after the
+// destructor has waited for the device: no submission outlives the buffers
+// it uses, even when an exception unwinds mid-render.
+struct RenderSetup {
+    RenderSetup(const Context& context, const PreparedScene& prepared,
+                const RenderOptions& options, const gpu::FrameParams& frame, const Tuning& tuning);
+    ~RenderSetup();
+    RenderSetup(const RenderSetup&) = delete;
+    RenderSetup& operator=(const RenderSetup&) = delete;
+
+    const Context& ctx;
+    Submitter submitter;
+    Timestamps timestamps;
+    std::unique_ptr<ShadingMethod> method;
+    GpuResources resources;
+    Kernels kernels;
+    TilePass pass;
+};
+
+}  // namespace lc::vk

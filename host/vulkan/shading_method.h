@@ -1,0 +1,73 @@
+// A shading method as the Vulkan path sees it: its kernel, the per-pixel
+// buffers and cut heap it needs, and how one sample's shading of a tile
+// splits into dispatches. The tile pass runs any method with one dispatch
+// loop; the tile scheduler asks the method to split its work finer when the
+// driver cut the kernels' loops short (docs/vulkan.md, "Work split").
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bindings.glsl"
+#include "lightcuts/render.h"
+#include "vulkan_renderer.h"
+
+namespace lc::vk {
+
+// A kernel's SPIR-V (embedded at build time) and its pipeline's debug name.
+struct KernelCode {
+    const std::uint32_t* words = nullptr;
+    std::size_t bytes = 0;
+    const char* name = "";
+};
+
+// Cut-heap slots per invocation (shaders/heap.glsl): the first `shared` in
+// workgroup shared memory, up to `capacity` in the spill buffer. Zero for a
+// method without a heap.
+struct HeapLayout {
+    std::uint32_t shared = 0;
+    std::uint32_t capacity = 0;
+};
+
+// A per-tile buffer and its bytes per tile pixel; `why` explains the size
+// when the buffer cannot fit a single workgroup.
+struct TileBuffer {
+    std::string name;
+    std::uint64_t bytes_per_pixel = 0;
+    std::string why;
+};
+
+class ShadingMethod {
+public:
+    virtual ~ShadingMethod() = default;
+
+    virtual KernelCode kernel() const = 0;
+    virtual HeapLayout heap() const { return {}; }
+    // Bytes per tile pixel of the heap spill and cut state buffers (0: not
+    // used; the binding still gets a one-element buffer).
+    virtual TileBuffer heap_spill() const { return {"heap spill", 0, ""}; }
+    virtual TileBuffer cut_state() const { return {"cut state", 0, ""}; }
+    // True when the method's cut sizes go into RenderStats::cut_size.
+    virtual bool reports_cuts() const { return false; }
+
+    // Dispatches one sample's shading takes with the current split.
+    virtual std::uint32_t dispatch_count() const = 0;
+    // Fills in what dispatch `d` of dispatch_count() does; `push` holds the
+    // tile's frame constants on entry.
+    virtual void set_push_constants(std::uint32_t d, gpu::PushConstants& push) const = 0;
+    // The driver cut an invocation's loops short: give each dispatch less
+    // work. False when the work is already split as finely as it can be.
+    virtual bool split_finer() = 0;
+};
+
+// "brute" or "lightcuts" (options.method, already validated).
+// `shared_memory_bytes` is the device's maxComputeSharedMemorySize.
+std::unique_ptr<ShadingMethod> make_shading_method(const RenderOptions& options,
+                                                   const gpu::FrameParams& frame,
+                                                   const LightTree& tree, const Tuning& tuning,
+                                                   std::uint32_t shared_memory_bytes);
+
+}  // namespace lc::vk

@@ -1,0 +1,143 @@
+#include "tile_scheduler.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace lc::vk {
+
+TileScheduler::TileScheduler(std::string device_name, Submitter& submitter, TilePass& pass,
+                             ShadingMethod& method, const GpuResources& resources,
+                             const gpu::FrameParams& frame, double target_dispatch_ms,
+                             bool progress)
+    : device_name_(std::move(device_name)),
+      submitter_(submitter),
+      pass_(pass),
+      method_(method),
+      resources_(resources),
+      frame_(frame),
+      target_dispatch_ms_(target_dispatch_ms),
+      progress_(progress) {}
+
+// Tiles: bands of rows, each cut into tiles of about `budget` pixels. The
+// budget adapts so one dispatch takes about target_dispatch_ms (growing at
+// most 2x per tile, as the next tile may be harder): starting small keeps
+// the first dispatch short on any device.
+void TileScheduler::render(RenderResult& result) {
+    const std::uint32_t width = frame_.width, height = frame_.height;
+    const std::uint32_t max_pixels = resources_.tiles().max_pixels;
+    samples_total_ = std::uint64_t(width) * height * frame_.spp;
+    double budget = std::min<double>(4 * gpu::kWorkgroupSize, max_pixels);
+    for (std::uint32_t y0 = 0; y0 < height;) {
+        const std::uint32_t band = std::min<std::uint32_t>(
+            height - y0, std::max<std::uint32_t>(1, std::uint32_t(std::sqrt(budget))));
+        for (std::uint32_t x0 = 0; x0 < width;) {
+            std::uint32_t w = std::max<std::uint32_t>(1, std::uint32_t(budget / band));
+            w = std::min({w, width - x0, std::max<std::uint32_t>(1, max_pixels / band)});
+            const double ms = render_tile({x0, y0, w, band}, result);
+            budget = next_budget(budget, double(w) * band, ms);
+            x0 += w;
+        }
+        y0 += band;
+    }
+    progress_.finish();
+}
+
+double TileScheduler::next_budget(double budget, double pixels, double slowest_ms) const {
+    const double wanted =
+        slowest_ms > 0.0 ? pixels * target_dispatch_ms_ / slowest_ms : 4 * budget;
+    budget = std::clamp(wanted, budget / 4, budget * 2);
+    return std::clamp(budget, 1.0, double(resources_.tiles().max_pixels));
+}
+
+double TileScheduler::render_tile(const Tile& tile, RenderResult& result) {
+    double slowest_ms = 0.0;
+    for (;;) {
+        slowest_ms = std::max(slowest_ms, render_samples(tile, result.stats));
+        const std::uint32_t cut_short = loop_limited_pixels(tile);
+        if (cut_short == 0) break;
+        split_finer(tile, cut_short);
+        result.stats.loop_limit_retries += 1;
+        samples_done_ -= std::uint64_t(tile.pixels()) * frame_.spp;
+    }
+    read_back(tile, result);
+    return slowest_ms;
+}
+
+double TileScheduler::render_samples(const Tile& tile, RenderStats& stats) {
+    gpu::FrameParams frame = frame_;
+    frame.tile_x = tile.x0;
+    frame.tile_y = tile.y0;
+    frame.tile_width = tile.width;
+    frame.tile_height = tile.height;
+    double slowest_ms = 0.0;
+    for (std::uint32_t s = 0; s < frame_.spp; ++s) {
+        frame.sample_index = s;
+        const PassTiming t = pass_.run(submitter_, frame, s == 0, s + 1 == frame_.spp);
+        stats.seconds_primary += t.seconds_primary;
+        stats.seconds_shading += t.seconds_shading;
+        slowest_ms = std::max(slowest_ms, t.slowest_dispatch_ms);
+        samples_done_ += tile.pixels();
+        progress_.update(samples_total_ ? double(samples_done_) / double(samples_total_) : 1.0);
+    }
+    return slowest_ms;
+}
+
+std::uint32_t TileScheduler::loop_limited_pixels(const Tile& tile) const {
+    // The flags of the tile's last pass, whose fence has signalled.
+    const gpu::PixelStats* pixel_stats = resources_.pixel_stats_sums();
+    std::uint32_t cut_short = 0;
+    for (std::uint32_t i = 0; i < tile.pixels(); ++i) {
+        const std::uint32_t flags = pixel_stats[i].flags;
+        // A loop cut short leaves anything behind: that is retried first.
+        if (flags & gpu::kPixelLoopLimit) {
+            cut_short += 1;
+            continue;
+        }
+        if (flags & (gpu::kPixelHeapOverflow | gpu::kPixelCutUnfinished))
+            throw std::logic_error(
+                std::string("Lightcuts kernel: ") +
+                (flags & gpu::kPixelHeapOverflow ? "heap outgrew its capacity"
+                                                 : "cut unfinished after the last dispatch") +
+                " at pixel (" + std::to_string(tile.x0 + i % tile.width) + ", " +
+                std::to_string(tile.y0 + i / tile.width) + ")");
+    }
+    return cut_short;
+}
+
+// lavapipe ends an invocation's loops after 65535 iterations in all. The
+// work per invocation then shrinks (brute force: fewer lights per dispatch;
+// Lightcuts: fewer refinements per dispatch) and the tile starts again.
+void TileScheduler::split_finer(const Tile& tile, std::uint32_t cut_short) {
+    if (method_.split_finer()) return;
+    throw std::runtime_error(
+        "the Vulkan device " + device_name_ + " cut the kernels' loops short at " +
+        std::to_string(cut_short) + " pixel(s) of tile (" + std::to_string(tile.x0) + ", " +
+        std::to_string(tile.y0) + ", " + std::to_string(tile.width) + "x" +
+        std::to_string(tile.height) +
+        ") even for the smallest split of the work (llvmpipe/lavapipe stops every "
+        "shader invocation after 65535 loop iterations)");
+}
+
+void TileScheduler::read_back(const Tile& tile, RenderResult& result) const {
+    // The tile's sums, readable since its last pass's fence signalled.
+    const float* sums = resources_.radiance_sums();
+    const gpu::PixelStats* pixel_stats = resources_.pixel_stats_sums();
+    const double spp = double(frame_.spp);
+    RenderStats& out = result.stats;
+    for (std::uint32_t i = 0; i < tile.pixels(); ++i) {
+        const std::uint32_t x = tile.x0 + i % tile.width, y = tile.y0 + i / tile.width;
+        const glm::vec3 sum(sums[3 * i], sums[3 * i + 1], sums[3 * i + 2]);
+        result.image.set(x, y, sum / float(frame_.spp));
+        const gpu::PixelStats& ps = pixel_stats[i];
+        out.shadow_rays += gpu::count64(ps.shadow_rays_lo, ps.shadow_rays_hi);
+        out.max_cut_pixels += ps.max_cut_samples;
+        out.heap_spill_pixels += ps.spill_samples;
+        // The CPU reference's rounding of the mean, so equal cuts compare equal.
+        if (method_.reports_cuts())
+            out.cut_size[std::size_t(y) * frame_.width + x] =
+                float(double(gpu::count64(ps.cut_size_lo, ps.cut_size_hi)) / spp);
+    }
+}
+
+}  // namespace lc::vk

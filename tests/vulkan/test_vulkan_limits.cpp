@@ -1,0 +1,174 @@
+// The Vulkan path at its limits: a max_cut far beyond the tree, a heap too
+// large for any buffer, per-pixel counters past 2^32, and the automatic
+// re-split of the work when lavapipe cuts the kernels' loops short.
+#include <algorithm>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "bindings.glsl"
+#include "render_setup.h"
+#include "test_util.h"
+#include "vulkan_test_support.h"
+
+namespace lc {
+namespace {
+
+using vulkan_test::expect_brute_matches;
+using vulkan_test::expect_lightcuts_matches;
+using vulkan_test::options;
+using vulkan_test::random_scene;
+using vulkan_test::Vulkan;
+
+std::uint64_t buffer_bytes(const RenderStats& stats, const std::string& name) {
+    for (const auto& [buffer, bytes] : stats.buffer_bytes)
+        if (buffer == name) return bytes;
+    ADD_FAILURE() << "no buffer '" << name << "'";
+    return 0;
+}
+
+// The cut heap holds interior nodes of the tree, so its capacity is
+// LightTree::cut_heap_capacity(max_cut), not max_cut: a max_cut of 4e9 over
+// 8 lights takes 7 slots per pixel (it was refused when the heap took
+// max_cut slots).
+TEST_F(Vulkan, HugeMaxCutTakesAHeapSizedByTheTree) {
+    PreparedScene p = prepare_scene(random_scene(61, 8, 0, 8, 8), 1);
+    RenderOptions o = options("lightcuts", 8, 8);
+    o.max_cut = 4'000'000'000u;
+    o.relative_error = 0.0f;  // refine every cluster whose bound is not zero
+    const RenderResult g = gpu(p, o);
+    expect_lightcuts_matches(p, o, g);
+    ASSERT_EQ(p.tree.cut_heap_capacity(o.max_cut), 7u);
+    EXPECT_EQ(buffer_bytes(g.stats, "heap spill"), 7u * sizeof(gpu::CutEntry) * 64);  // one workgroup
+}
+
+// A tree whose cut heap cannot fit one workgroup's spill region in a single
+// buffer (220000 lights: 219999 slots x 20 bytes x 64 invocations, past the
+// 256 MiB a buffer may use) is refused with the buffer, its size and the
+// limit named.
+TEST_F(Vulkan, HeapLargerThanABufferIsRefusedClearly) {
+    Scene s = random_scene(62, 0, 0, 8, 8);
+    s.lights = test::random_point_lights(220000, {-3, 0.5f, -3}, {3, 3, 3}, 20.0f, 62);
+    update_bounds(s);
+    PreparedScene p = prepare_scene(std::move(s), 1);
+    RenderOptions o = options("lightcuts", 8, 8);
+    o.max_cut = 4'000'000'000u;
+    try {
+        gpu(p, o);
+        FAIL() << "expected an exception";
+    } catch (const std::runtime_error& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("buffer 'heap spill' needs 281598720 bytes"), std::string::npos) << what;
+        EXPECT_NE(what.find("219999 heap slots per pixel"), std::string::npos) << what;
+    }
+}
+
+// Start every pixel's 64-bit counters at `start` (lo/hi words), run one
+// real pass of the shading kernel on top, and return the counters.
+std::vector<gpu::PixelStats> pass_over(vk::RenderSetup& setup, const gpu::FrameParams& frame,
+                                       const std::vector<gpu::PixelStats>* start) {
+    const std::uint32_t pixels = frame.width * frame.height;
+    VkCommandBuffer cmd = setup.submitter.begin();
+    if (start)
+        // The pass's first barrier makes this transfer visible to the kernels.
+        setup.ctx.fn().vkCmdUpdateBuffer(cmd, setup.resources.pixel_stats().get(), 0,
+                                         pixels * sizeof(gpu::PixelStats), start->data());
+    setup.pass.record(cmd, frame, /*first=*/start == nullptr, /*last=*/true);
+    setup.submitter.submit_and_wait();
+    // The pass made the counters host-readable; its fence has signalled.
+    const gpu::PixelStats* out = setup.resources.pixel_stats_sums();
+    return {out, out + pixels};
+}
+
+// A pixel's cut sizes and shadow rays, summed over samples, pass 2^32 with
+// 10^6 lights and 4295 samples: too much to render here. So each kernel
+// runs one pass from zero, then one pass from counters a few counts below
+// 2^32 (a pre-filled stats buffer), and the second must end exactly the
+// first's counts above the start, carried into the high word.
+TEST_F(Vulkan, PixelCountersCarryPast32Bits) {
+    const PreparedScene p = prepare_scene(random_scene(63, 40, 1, 8, 8), 1);
+    const std::uint64_t start = (std::uint64_t(5) << 32) | 0xFFFFFFF8u;  // 8 below a carry
+    for (const char* method : {"brute", "lightcuts"}) {
+        SCOPED_TRACE(method);
+        RenderOptions o = options(method, 8, 8);
+        o.relative_error = 0.0f;
+        VulkanOptions v;
+        v.validation = true;
+        vk::MessageLog log;
+        vk::Context ctx(v, &log);
+        const gpu::FrameParams frame = vk::frame_params(ctx, p, o);
+        vk::RenderSetup setup(ctx, p, o, frame, {});
+        const std::vector<gpu::PixelStats> base = pass_over(setup, frame, nullptr);
+        std::vector<gpu::PixelStats> from(base.size(), gpu::PixelStats{});
+        for (gpu::PixelStats& ps : from) {
+            ps.cut_size_lo = ps.shadow_rays_lo = std::uint32_t(start);
+            ps.cut_size_hi = ps.shadow_rays_hi = std::uint32_t(start >> 32);
+        }
+        const std::vector<gpu::PixelStats> after = pass_over(setup, frame, &from);
+        std::size_t carried = 0;
+        for (std::size_t i = 0; i < base.size(); ++i) {
+            const std::uint64_t rays = gpu::count64(base[i].shadow_rays_lo, base[i].shadow_rays_hi);
+            const std::uint64_t cut = gpu::count64(base[i].cut_size_lo, base[i].cut_size_hi);
+            EXPECT_EQ(gpu::count64(after[i].shadow_rays_lo, after[i].shadow_rays_hi), start + rays);
+            EXPECT_EQ(gpu::count64(after[i].cut_size_lo, after[i].cut_size_hi), start + cut);
+            carried += rays >= 8 ? 1 : 0;
+        }
+        EXPECT_GT(carried, base.size() / 2) << "the pass should carry at most pixels";
+        EXPECT_EQ(log.count(), 0u);
+    }
+}
+
+// lavapipe (llvmpipe) silently ends an invocation's loops after 65535
+// iterations; the kernels notice, and the renderer splits the work finer
+// and renders the tile again, without any tuning asking for it. Other
+// devices have no such limit and render in one dispatch per stage.
+void expect_resplit_on_llvmpipe(const RenderStats& stats) {
+    std::printf("[ measured ] %s: %u loop-limit retries\n", stats.device.c_str(),
+                stats.loop_limit_retries);
+    if (stats.device.find("llvmpipe") != std::string::npos) {
+        EXPECT_GT(stats.loop_limit_retries, 0u);
+    }
+}
+
+// 70000 unshadowed lights: 70000 iterations of the brute-force loop alone.
+TEST_F(Vulkan, LoopLimitSplitsBruteForceAutomatically) {
+    Scene s;
+    s.materials = {test::lambert({0.6f, 0.5f, 0.4f})};
+    test::add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
+    s.lights = test::random_point_lights(70000, {-2, 0.5f, -2}, {2, 2, 2}, 10.0f, 64);
+    s.camera = test::camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 50.0f, 4, 4);
+    update_bounds(s);
+    const PreparedScene p = prepare_scene(std::move(s), 1);
+    ASSERT_FALSE(p.has_occluders);
+    const RenderOptions o = options("brute", 4, 4);
+    const RenderResult g = gpu(p, o);
+    expect_brute_matches(p, o, g, vulkan_test::kBruteSplitRelative);
+    expect_resplit_on_llvmpipe(g.stats);
+}
+
+// Cuts refined down to every one of 4000 lights: each refinement loops over
+// heap levels and a shadow ray's BVH nodes, about twice the limit in all
+// (1600 lights already pass it).
+TEST_F(Vulkan, LoopLimitSplitsLightcutsAutomatically) {
+    Scene s;
+    s.materials = {test::lambert({0.6f, 0.5f, 0.4f})};
+    test::add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
+    test::add_box(s, {-1.0f, 0.0f, -1.0f}, {-0.3f, 0.6f, -0.3f}, 0);
+    test::add_box(s, {0.4f, 0.0f, 0.2f}, {0.9f, 0.4f, 0.8f}, 0);
+    test::add_box(s, {-0.5f, 0.8f, 0.5f}, {0.0f, 1.0f, 1.0f}, 0);
+    s.lights = test::random_point_lights(4000, {-2, 0.5f, -2}, {2, 2, 2}, 10.0f, 65);
+    s.camera = test::camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 50.0f, 4, 4);
+    update_bounds(s);
+    const PreparedScene p = prepare_scene(std::move(s), 1);
+    RenderOptions o = options("lightcuts", 4, 4);
+    o.relative_error = 0.0f;
+    o.max_cut = 100000;
+    const RenderResult g = gpu(p, o);
+    expect_lightcuts_matches(p, o, g);
+    expect_resplit_on_llvmpipe(g.stats);
+}
+
+}  // namespace
+}  // namespace lc

@@ -1,0 +1,91 @@
+// What the Vulkan tests share: the fixture (validation on, any message
+// fails; no Vulkan device skips, or fails under LC_REQUIRE_VULKAN=1), the
+// comparisons against the CPU reference with their measured tolerances,
+// and seeded random scenes.
+//
+// Tolerances. The kernels are the same source on both sides
+// (shaders/shared/*.h), but the GPU compiler may contract a*b+c into one
+// FMA and has its own sqrt/inversesqrt/acos, while the CPU build rounds
+// every operation; brute force split over light ranges (docs/vulkan.md)
+// also adds the ranges' sums instead of one sum. So values differ by a few
+// ulps per operation, and a bound on the refinement threshold can flip a
+// cluster of a cut. Each tolerance below was set at about 3x the largest
+// difference measured on lavapipe (llvmpipe, LLVM 15) over every test that
+// uses it; the tests print what they measure ("[ measured ]" lines).
+// Re-measure before changing one.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "lightcuts/image.h"
+#include "lightcuts/render.h"
+#include "vulkan_renderer.h"
+
+namespace lc::vulkan_test {
+
+// Brute force, every pixel: |gpu - cpu| <= kBruteRelative * |cpu| + floor
+// per channel (floor = 1e-6 of the image's mean value, the rounding of a sum
+// whose terms are of that size). Measured at most 7.5e-6 (shipped room;
+// random scenes 2.7e-6).
+constexpr double kBruteRelative = 2e-5;
+// Brute force over 70000 lights that the driver's loop limit split into
+// light ranges, whose sums are added in another order. Measured 1.1e-5.
+constexpr double kBruteSplitRelative = 3.5e-5;
+// Lightcuts: pixels whose cut size differs from the CPU's, as a fraction of
+// the image. Measured 3 of 2304 (0.13%, shipped room), none elsewhere.
+// Such a pixel may differ by up to the error threshold; it is only counted.
+constexpr double kCutsDifferFraction = 0.004;
+// Lightcuts, every pixel whose cut is the same: as kBruteRelative.
+// Measured at most 6.3e-5 (shipped room; random scenes 1.9e-5).
+constexpr double kLightcutsRelative = 2e-4;
+// Shadow rays counted: |gpu - cpu| <= kShadowRaysRelative * cpu + 1.
+// Measured 3.4e-6 (1 of 291159, shipped room, lightcuts), equal elsewhere.
+constexpr double kShadowRaysRelative = 1e-5;
+// The same device with kernel features forced on that the scene does not
+// need: measured identical images; a few ulps allowed.
+constexpr double kFeatureSwitchRelative = 3e-7;
+
+class Vulkan : public ::testing::Test {
+protected:
+    void SetUp() override;
+    void TearDown() override;
+
+    // render_vulkan with validation on.
+    static RenderResult gpu(const PreparedScene& p, const RenderOptions& o,
+                            const vk::Tuning& tuning = {});
+
+private:
+    std::uint64_t messages_before_ = 0;
+};
+
+// Largest difference of `image` from `reference` over every pixel and
+// channel, as |a - r| / (|r| + floor), floor as for kBruteRelative; pixels
+// with skip[i] set are left out. Prints it, and writes the images and an
+// error map to build/test-output/vulkan/ when it is above `tolerance`.
+double max_relative_difference(const Image& image, const Image& reference,
+                               const std::string& label, double tolerance,
+                               const std::vector<bool>& skip = {});
+
+// The GPU render `g` against render_cpu of the same scene and options.
+void expect_brute_matches(const PreparedScene& p, const RenderOptions& o, const RenderResult& g,
+                          double relative = kBruteRelative);
+void expect_lightcuts_matches(const PreparedScene& p, const RenderOptions& o,
+                              const RenderResult& g);
+
+std::size_t pixels_with_different_cut(const RenderStats& a, const RenderStats& b);
+// Samples whose Lightcuts heap needs more than `shared_slots` slots (CPU).
+std::uint64_t count_spilling_samples(const PreparedScene& p, const RenderOptions& o,
+                                     std::uint32_t shared_slots);
+
+// Ground plane, random boxes, random point and directional lights, Lambert
+// and GGX materials; seeded.
+Scene random_scene(std::uint32_t seed, std::size_t point_lights, std::size_t directional_lights,
+                   std::uint32_t width, std::uint32_t height);
+RenderOptions options(const std::string& method, std::uint32_t w, std::uint32_t h,
+                      std::uint32_t spp = 1);
+
+}  // namespace lc::vulkan_test
