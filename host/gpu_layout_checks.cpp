@@ -48,8 +48,8 @@ static_assert(offsetof(GBufferTexel, material) == 36);
 static_assert(sizeof(CutEntry) == 20);
 static_assert(offsetof(CutEntry, unit_r) == 8);
 
-static_assert(sizeof(FrameParams) == 136);
-static_assert(offsetof(FrameParams, env_width) == 120);
+static_assert(sizeof(FrameParams) == 112);
+static_assert(offsetof(FrameParams, env_width) == 100);
 static_assert(offsetof(FrameParams, min_distance2) == 12);
 static_assert(offsetof(FrameParams, relative_error) == 28);
 static_assert(offsetof(FrameParams, max_cut) == 44);
@@ -57,8 +57,6 @@ static_assert(offsetof(FrameParams, spp) == 60);
 static_assert(offsetof(FrameParams, width) == 64);
 static_assert(offsetof(FrameParams, roots) == 80);
 static_assert(sizeof(FrameParams::roots) == 4 * kLightTypeCount);
-static_assert(offsetof(FrameParams, tile_x) == 96);
-static_assert(offsetof(FrameParams, sample_index) == 112);
-static_assert(offsetof(FrameParams, loop_probe_rounds) == 116);
+static_assert(offsetof(FrameParams, loop_probe_rounds) == 96);
 
 }  // namespace lc::gpu

@@ -102,10 +102,6 @@ gpu::FrameParams make_frame_params(const PreparedScene& prepared, const RenderOp
     f.loop_probe_rounds = 2;
     f.env_width = prepared.scene.environment.width;
     f.env_height = prepared.scene.environment.height;
-    f.tile_x = f.tile_y = 0;
-    f.tile_width = f.width;
-    f.tile_height = f.height;
-    f.sample_index = 0;
     return f;
 }
 
@@ -120,6 +116,7 @@ std::vector<SceneArray> scene_arrays(const PreparedScene& p) {
         array("materials", p.scene.materials),
         array("lights", p.tree.lights),
         array("light_tree_nodes", p.tree.nodes),
+        array("environment", p.scene.environment.rgb),
     };
 }
 

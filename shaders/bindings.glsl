@@ -23,12 +23,14 @@ LC_CONST uint kBindingNormals = 2u;
 LC_CONST uint kBindingMaterials = 3u;
 LC_CONST uint kBindingLights = 4u;        // leaf order of the light tree
 LC_CONST uint kBindingLightNodes = 5u;
-LC_CONST uint kBindingGBuffer = 6u;       // GBufferTexel per tile pixel
-LC_CONST uint kBindingRadiance = 7u;      // 3 floats per tile pixel, summed over samples
-LC_CONST uint kBindingPixelStats = 8u;    // PixelStats per tile pixel, summed over samples
-LC_CONST uint kBindingHeapSpill = 9u;     // CutEntry slots of every invocation (see heap.glsl)
-LC_CONST uint kBindingCutState = 10u;     // CutState per tile pixel, between Lightcuts dispatches
-LC_CONST uint kBindingCount = 11u;
+LC_CONST uint kBindingEnvironment = 6u;   // RGB floats of the environment map (one black texel if none)
+LC_CONST uint kBindingFrame = 7u;         // one FrameParams
+LC_CONST uint kBindingGBuffer = 8u;       // GBufferTexel per tile pixel
+LC_CONST uint kBindingRadiance = 9u;      // 3 floats per tile pixel, summed over samples
+LC_CONST uint kBindingPixelStats = 10u;   // PixelStats per tile pixel, summed over samples
+LC_CONST uint kBindingHeapSpill = 11u;    // CutEntry slots of every invocation (see heap.glsl)
+LC_CONST uint kBindingCutState = 12u;     // CutState per tile pixel, between Lightcuts dispatches
+LC_CONST uint kBindingCount = 13u;
 
 // Specialization constant ids.
 LC_CONST uint kSpecWorkgroupSize = 0u;    // local_size_x
@@ -38,6 +40,7 @@ LC_CONST uint kSpecHeapShared = 3u;       // K: cut-heap slots per invocation in
 LC_CONST uint kSpecHeapCapacity = 4u;     // all cut-heap slots per invocation,
                                           // LightTree::cut_heap_capacity(max_cut)
 LC_CONST uint kSpecSpillStride = 5u;      // invocations the spill buffer is laid out for
+LC_CONST uint kSpecEnableOriented = 6u;   // any spot or oriented light (emission cones)
 
 // PixelStats.flags
 LC_CONST uint kPixelHeapOverflow = 1u;  // a heap outgrew its capacity (a bug: the capacity
@@ -90,13 +93,14 @@ LC_CONST uint kCutFirstDispatch = 1u;  // start the cut from the roots
 LC_CONST uint kCutLastDispatch = 2u;   // every cut must be final by the end of this one
 LC_CONST uint kUnlimitedRefinements = 0xFFFFFFFFu;
 
-// Push constants of every kernel (124 bytes, within the 128 every device offers).
-LC_CONST uint kPushLightFirstOffset = 112u;
-LC_CONST uint kPushCutFlagsOffset = 116u;
-LC_CONST uint kPushRefineBudgetOffset = 120u;
+// Push constants of every kernel: what changes from dispatch to dispatch
+// (36 bytes; the frame's constants are in the kBindingFrame buffer).
 struct PushConstants {
-    FrameParams frame;
-    uint light_first;       // brute force: first light of this dispatch's range
+    uint tile_x, tile_y;    // first pixel of the dispatched tile
+    uint tile_width, tile_height;
+    uint sample_index;      // which of the spp samples this pass renders
+    uint light_first;       // brute force: this dispatch's range of lights
+    uint light_count;
     uint cut_flags;         // lightcuts: kCut*Dispatch bits
     uint refine_budget;     // lightcuts: refinements per pixel in this dispatch
 };

@@ -12,14 +12,11 @@ layout(local_size_x_id = kSpecWorkgroupSize) in;
 // GGX lobe and the shadow-ray traversal (shared/shading.h reads these).
 layout(constant_id = kSpecEnableGgx) const bool kEnableGgx = true;
 layout(constant_id = kSpecEnableShadows) const bool kEnableShadows = true;
+layout(constant_id = kSpecEnableOriented) const bool kEnableOriented = true;
 
-// PushConstants of bindings.glsl.
-layout(push_constant) uniform Push {
-    FrameParams frame;
-    layout(offset = kPushLightFirstOffset) uint light_first;
-    layout(offset = kPushCutFlagsOffset) uint cut_flags;
-    layout(offset = kPushRefineBudgetOffset) uint refine_budget;
-};
+// PushConstants of bindings.glsl: this dispatch's tile, sample and split.
+layout(push_constant) uniform Push { PushConstants push; };
+layout(std430, binding = kBindingFrame) readonly buffer Frame { FrameParams frame; };
 
 layout(std430, binding = kBindingBvhNodes) readonly buffer BvhNodes { BvhNode bvh_nodes[]; };
 layout(std430, binding = kBindingTriangles) readonly buffer Triangles { Triangle triangles[]; };
@@ -27,6 +24,7 @@ layout(std430, binding = kBindingNormals) readonly buffer Normals { TriangleNorm
 layout(std430, binding = kBindingMaterials) readonly buffer Materials { Material materials[]; };
 layout(std430, binding = kBindingLights) readonly buffer Lights { Light lights[]; };
 layout(std430, binding = kBindingLightNodes) readonly buffer LightNodes { LightNode light_nodes[]; };
+layout(std430, binding = kBindingEnvironment) readonly buffer Environment { float environment[]; };
 layout(std430, binding = kBindingGBuffer) buffer GBuffer { GBufferTexel gbuffer[]; };
 layout(std430, binding = kBindingRadiance) buffer Radiance { float radiance[]; };
 layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_stats[]; };
@@ -36,6 +34,7 @@ layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_sta
 #define LC_MATERIAL(i) materials[i]
 #define LC_NORMALS(i) normals[i]
 #define LC_LIGHT_NODE(i) light_nodes[i]
+#define LC_ENVIRONMENT_TEXEL(i) vec3(environment[3u * (i)], environment[3u * (i) + 1u], environment[3u * (i) + 2u])
 // LC_LIGHT is defined by each kernel (brute force offsets it by light_first).
 
 #include "shared/glsl_compat.h"
@@ -48,7 +47,7 @@ layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_sta
 // invocations of the last workgroup that lie past the tile.
 uint lc_tile_pixel() {
     uint i = gl_GlobalInvocationID.x;
-    return i < frame.tile_width * frame.tile_height ? i : kInvalidIndex;
+    return i < push.tile_width * push.tile_height ? i : kInvalidIndex;
 }
 
 SurfacePoint lc_texel_surface(GBufferTexel g) {

@@ -31,7 +31,7 @@ void main() {
     uint heap_size = 0u;
     vec3 leaf_sum = vec3(0.0f);
     vec3 heap_sum = vec3(0.0f);
-    if ((cut_flags & kCutFirstDispatch) != 0u) {
+    if ((push.cut_flags & kCutFirstDispatch) != 0u) {
         lc_cut_start(sp, m, frame, heap_size, leaf_sum, heap_sum, stats);
     } else {
         CutState s = cut_states[i];
@@ -46,13 +46,13 @@ void main() {
     }
 
     bool final_cut = false;
-    for (uint r = 0u; r < refine_budget && !final_cut; ++r)
+    for (uint r = 0u; r < push.refine_budget && !final_cut; ++r)
         final_cut = !lc_cut_refine(sp, m, frame, heap_size, leaf_sum, heap_sum, stats);
     bool cut_short = lc_loops_were_cut_short();
 
     if (!final_cut) {
         PixelStats ps = pixel_stats[i];
-        if ((cut_flags & kCutLastDispatch) != 0u) ps.flags |= kPixelCutUnfinished;
+        if ((push.cut_flags & kCutLastDispatch) != 0u) ps.flags |= kPixelCutUnfinished;
         if (cut_short) ps.flags |= kPixelLoopLimit;
         if (g_heap_overflow) ps.flags |= kPixelHeapOverflow;
         pixel_stats[i] = ps;
@@ -79,5 +79,5 @@ void main() {
     if (g_heap_overflow) ps.flags |= kPixelHeapOverflow;
     if (cut_short || lc_loops_were_cut_short()) ps.flags |= kPixelLoopLimit;
     pixel_stats[i] = ps;
-    if ((cut_flags & kCutLastDispatch) == 0u) cut_states[i].flags = kCutDone;
+    if ((push.cut_flags & kCutLastDispatch) == 0u) cut_states[i].flags = kCutDone;
 }

@@ -1,4 +1,4 @@
-// Camera rays: one sample (FrameParams.sample_index) of every pixel of the
+// Camera rays: one sample (PushConstants.sample_index) of every pixel of the
 // tile, traced to the closest hit and stored as a G-buffer texel for the
 // shading kernels.
 #version 460
@@ -9,12 +9,17 @@
 void main() {
     uint i = lc_tile_pixel();
     if (i == kInvalidIndex) return;
-    uint x = frame.tile_x + i % frame.tile_width;
-    uint y = frame.tile_y + i / frame.tile_width;
+    uint x = push.tile_x + i % push.tile_width;
+    uint y = push.tile_y + i / push.tile_width;
 
     SurfacePoint sp;
     GBufferTexel g;
-    if (!lc_camera_hit(frame, x, y, frame.sample_index, sp)) {
+    vec3 seen;
+    bool hit = lc_camera_sample(frame, x, y, push.sample_index, sp, seen);
+    // What the camera sees directly (emission, environment) starts the
+    // sample's sum; shading adds the reflected light.
+    lc_accumulate(i, seen);
+    if (!hit) {
         g.px = 0.0f; g.py = 0.0f; g.pz = 0.0f;
         g.nx = 0.0f; g.ny = 0.0f; g.nz = 0.0f;
         g.wo_x = 0.0f; g.wo_y = 0.0f; g.wo_z = 0.0f;

@@ -16,6 +16,7 @@
 
 #include "lightcuts/error.h"
 #include "lightcuts/scene.h"
+#include "test_util.h"
 #include "lightcuts/settings.h"
 
 namespace lc {
@@ -303,13 +304,13 @@ TEST(SceneLoader, BoundsCoverTrianglesOnlyNotLights) {
     expect_near(scene.bounds_max, {1.0f, 1.0f, 0.0f});
 
     Scene empty;
-    empty.lights.push_back(gpu::Light{0, 9, 0, 1, 1, 1, gpu::kLightPoint, 0});
-    empty.lights.push_back(gpu::Light{0, 0, 9, 1, 1, 1, gpu::kLightDirectional, 0});
+    empty.lights.push_back(test::point_light({0, 9, 0}, {1, 1, 1}));
+    empty.lights.push_back(test::directional_light({0, 0, -1}, {1, 1, 1}));
     update_bounds(empty);  // no triangles: the zero box, whatever the lights
     expect_near(empty.bounds_min, glm::vec3(0.0f));
     expect_near(empty.bounds_max, glm::vec3(0.0f));
 
-    scene.lights.push_back(gpu::Light{-10, 0, 0, 1, 1, 1, gpu::kLightPoint, 0});
+    scene.lights.push_back(test::point_light({-10, 0, 0}, {1, 1, 1}));
     update_bounds(scene);
     EXPECT_FLOAT_EQ(scene.bounds_min.x, 0.0f);
 }
@@ -382,7 +383,8 @@ const BadInput kBadInputs[] = {
     // Missing required keys.
     {"bad_missing_camera_position.json", "bad_missing_camera_position.json", "camera.position: ",
      "missing required key"},
-    {"bad_missing_lights.json", "bad_missing_lights.json", ": lights: ", "missing required key"},
+    {"bad_missing_lights.json", "bad_missing_lights.json", ": lights: ", "the scene has no light"},
+    {"bad_no_light_at_all.json", "bad_no_light_at_all.json", ": lights: ", "no emissive material and no environment"},
     {"bad_missing_light_intensity.json", "bad_missing_light_intensity.json", "lights[0].intensity: ",
      "missing required key"},
     // Unknown keys anywhere.
@@ -400,7 +402,22 @@ const BadInput kBadInputs[] = {
      "expected a number"},
     {"bad_type_lights.json", "bad_type_lights.json", ": lights: ", "expected an array"},
     // Unknown light type.
-    {"bad_light_type.json", "bad_light_type.json", "lights[0].type: ", "unknown light type \"spot\""},
+    {"bad_light_type.json", "bad_light_type.json", "lights[0].type: ", "unknown light type \"area\""},
+    // Spot lights, environments and emission (the light model).
+    {"bad_spot_outer.json", "bad_spot_outer.json", "lights[0].outer_cone_degrees: ", "from 0 to 90"},
+    {"bad_spot_inner.json", "bad_spot_inner.json", "lights[0].inner_cone_degrees: ", "from 0 to outer_cone_degrees"},
+    {"bad_spot_direction.json", "bad_spot_direction.json", "lights[0].direction: ", "zero-length"},
+    {"bad_spots_csv.json", "bad_spots.csv", "line 3: ", "outer_cone_degrees: must be from 0 to 90"},
+    {"bad_env_two.json", "bad_env_two.json", "lights[1]: ", "at most one environment"},
+    {"bad_env_both.json", "bad_env_both.json", "lights[0]: ", "exactly one of"},
+    {"bad_env_missing.json", "nonexistent.exr", "lights[0].file: ", "file not found"},
+    {"bad_env_negative.json", "bad_env_negative.json", "lights[0].color[0]: ", "negative"},
+    {"bad_env_directions.json", "bad_env_directions.json", "lights[0].directions: ", "from 1 to 16777216"},
+    {"bad_env_scale.json", "bad_env_scale.json", "lights[0].scale: ", ""},
+    {"bad_env_nan.json", "bad_env_nan.exr", "pixel (1, 0): ", "finite"},
+    {"bad_emission_negative.json", "bad_emission_negative.json", "meshes[0].material.emission[0]: ", "negative"},
+    {"bad_mtl_ke.json", "bad_ke.obj", "material 'glow'.Ke: ", ">= 0"},
+    {"bad_area_samples.json", "bad_area_samples.json", "render.area_light_samples: ", "from 1 to 16777216"},
     // Missing files.
     {"bad_missing_obj.json", "nonexistent.obj", "meshes[1].obj: ", "file not found"},
     {"bad_missing_csv.json", "nonexistent.csv", "lights[1].file: ", "file not found"},
@@ -647,6 +664,40 @@ TEST(PointsCsv, LoadsHundredThousandLines) {
     EXPECT_FLOAT_EQ(last.r, 99999.0f);
     EXPECT_FLOAT_EQ(last.g, 0.5f);
     EXPECT_FLOAT_EQ(last.b, 1e-5f);
+}
+
+
+// Spot, spots_csv, environment, emission from JSON and from MTL Ke, all in
+// one scene, as docs/scene-format.md describes them.
+TEST(SceneLoader, LightModelKeys) {
+    const Scene s = load_scene(kFixtures / "light_kinds.json");
+    ASSERT_EQ(s.lights.size(), 3u);  // the spot and the two CSV spots
+    const gpu::Light& spot = s.lights[0];
+    EXPECT_EQ(spot.type, gpu::kLightSpot);
+    EXPECT_FLOAT_EQ(spot.axis_y, -1.0f);
+    EXPECT_NEAR(spot.cos_inner, std::cos(20.0 * 3.14159265358979 / 180.0), 1e-6);
+    EXPECT_NEAR(spot.cos_outer, std::cos(30.0 * 3.14159265358979 / 180.0), 1e-6);
+    EXPECT_FLOAT_EQ(s.lights[1].axis_y, -1.0f);  // (0, -2, 0) normalised
+    EXPECT_FLOAT_EQ(s.lights[1].g, 2.0f);
+    EXPECT_NEAR(s.lights[2].cos_inner, 0.0f, 1e-6);  // 90 degrees
+    ASSERT_TRUE(s.environment.present());
+    EXPECT_EQ(s.environment.width, 1u);
+    EXPECT_EQ(s.environment.directions, 64u);
+    EXPECT_FLOAT_EQ(s.environment.rgb[2], 0.6f);  // 0.3 scaled by 2
+    ASSERT_EQ(s.materials.size(), 2u);
+    EXPECT_EQ(s.materials[0].flags & (gpu::kMaterialEmissive | gpu::kMaterialEmitsBothSides),
+              gpu::kMaterialEmissive | gpu::kMaterialEmitsBothSides);
+    EXPECT_FLOAT_EQ(s.materials[0].emission_b, 6.0f);
+    EXPECT_EQ(s.materials[1].flags & (gpu::kMaterialEmissive | gpu::kMaterialEmitsBothSides), gpu::kMaterialEmissive);
+    EXPECT_FLOAT_EQ(s.materials[1].emission_r, 3.0f);  // MTL Ke
+    EXPECT_EQ(s.render.area_light_samples, 100u);
+}
+
+// Emissive surfaces are light enough: no "lights" key is needed.
+TEST(SceneLoader, EmissiveSurfacesAloneLightAScene) {
+    const Scene s = load_scene(kFixtures / "emissive_only.json");
+    EXPECT_TRUE(s.lights.empty());
+    EXPECT_NE(s.materials[0].flags & gpu::kMaterialEmissive, 0u);
 }
 
 }  // namespace

@@ -31,12 +31,14 @@ constexpr SceneBinding kSceneBindings[] = {
     {gpu::kBindingMaterials, "materials", sizeof(gpu::Material)},
     {gpu::kBindingLights, "lights", sizeof(gpu::Light)},
     {gpu::kBindingLightNodes, "light_tree_nodes", sizeof(gpu::LightNode)},
+    {gpu::kBindingEnvironment, "environment", sizeof(float)},
+    {gpu::kBindingFrame, "frame", sizeof(gpu::FrameParams)},  // appended by RenderSetup
 };
 constexpr bool scene_bindings_in_order() {
     for (std::uint32_t i = 0; i < std::size(kSceneBindings); ++i)
         if (kSceneBindings[i].binding != gpu::kBindingBvhNodes + i) return false;
-    return kSceneBindings[std::size(kSceneBindings) - 1].binding == gpu::kBindingLightNodes &&
-           gpu::kBindingGBuffer == gpu::kBindingLightNodes + 1;
+    return kSceneBindings[std::size(kSceneBindings) - 1].binding == gpu::kBindingFrame &&
+           gpu::kBindingGBuffer == gpu::kBindingFrame + 1;
 }
 static_assert(scene_bindings_in_order());
 static_assert(gpu::kBindingRadiance == gpu::kBindingGBuffer + 1 &&
@@ -53,8 +55,8 @@ void check_scene_order(const std::vector<SceneArray>& scene) {
              scene[i].element_bytes == kSceneBindings[i].element_bytes;
     if (!ok)
         throw std::logic_error(
-            "scene_arrays() no longer lists the arrays in the order of the bindings "
-            "kBindingBvhNodes .. kBindingLightNodes (shaders/bindings.glsl)");
+            "scene_arrays() and the frame constants no longer list the arrays in the order of the "
+            "bindings kBindingBvhNodes .. kBindingFrame (shaders/bindings.glsl)");
 }
 
 std::string mib(VkDeviceSize bytes) {

@@ -25,8 +25,8 @@ struct TileLayout {
 
 class GpuResources {
 public:
-    // Uploads `scene` (scene_arrays() order: bindings kBindingBvhNodes ..
-    // kBindingLightNodes), sizes and creates the per-tile buffers for
+    // Uploads `scene` (scene_arrays() order, then the frame constants:
+    // bindings kBindingBvhNodes .. kBindingFrame), sizes and creates the per-tile buffers for
     // `method` and an image of `image_pixels` (tiles of at most
     // `max_tile_pixels`, 0: no cap), and binds everything. Throws naming
     // the buffer, its size and the device limit when something cannot fit.

@@ -21,6 +21,7 @@ struct SpecData {
     std::uint32_t heap_shared;
     std::uint32_t heap_capacity;
     std::uint32_t spill_stride;
+    VkBool32 enable_oriented;
 };
 
 Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const KernelCode& code,
@@ -42,6 +43,7 @@ Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const Ker
         {gpu::kSpecHeapShared, offsetof(SpecData, heap_shared), sizeof(std::uint32_t)},
         {gpu::kSpecHeapCapacity, offsetof(SpecData, heap_capacity), sizeof(std::uint32_t)},
         {gpu::kSpecSpillStride, offsetof(SpecData, spill_stride), sizeof(std::uint32_t)},
+        {gpu::kSpecEnableOriented, offsetof(SpecData, enable_oriented), sizeof(VkBool32)},
     };
     VkSpecializationInfo spec_info{};
     spec_info.mapEntryCount = std::uint32_t(std::size(entries));
@@ -74,6 +76,7 @@ Kernels::Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMetho
     spec.heap_shared = std::max(heap.shared, 1u);
     spec.heap_capacity = std::max(heap.capacity, 1u);
     spec.spill_stride = switches.spill_stride;
+    spec.enable_oriented = switches.oriented;
     primary_ = compute_pipeline(
         ctx, layout, {lc_spirv_primary, sizeof lc_spirv_primary, "primary.comp (camera rays)"}, spec);
     shading_ = compute_pipeline(ctx, layout, method.kernel(), spec);

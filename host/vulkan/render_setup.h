@@ -21,6 +21,10 @@ namespace lc::vk {
 gpu::FrameParams frame_params(const Context& ctx, const PreparedScene& prepared,
                               const RenderOptions& options);
 
+// scene_arrays() and then the frame constants: what the kernels read, in
+// binding order.
+std::vector<SceneArray> kernel_arrays(const PreparedScene& prepared, const gpu::FrameParams& frame);
+
 // Members are built top to bottom and destroyed bottom to top, after the
 // destructor has waited for the device: no submission outlives the buffers
 // it uses, even when an exception unwinds mid-render.

@@ -32,7 +32,7 @@ public:
     void set_push_constants(std::uint32_t d, gpu::PushConstants& push) const override {
         const std::uint32_t first = std::min(d * chunk_, light_count_);
         push.light_first = first;
-        push.frame.light_count = std::min(chunk_, light_count_ - first);
+        push.light_count = std::min(chunk_, light_count_ - first);
     }
 
     // Each invocation loops over its range of lights (plus the BVH of each

@@ -31,8 +31,8 @@ void TilePass::barrier(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkAc
     vkd_.vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 1, &b, 0, nullptr, 0, nullptr);
 }
 
-void TilePass::record(VkCommandBuffer cmd, const gpu::FrameParams& frame, bool first, bool last) {
-    const std::uint32_t pixels = frame.tile_width * frame.tile_height;
+void TilePass::record(VkCommandBuffer cmd, const gpu::PushConstants& tile, bool first, bool last) {
+    const std::uint32_t pixels = tile.tile_width * tile.tile_height;
     const std::uint32_t groups = (pixels + gpu::kWorkgroupSize - 1) / gpu::kWorkgroupSize;
     timestamps_.reset(cmd, 2 + method_.dispatch_count());
 
@@ -50,9 +50,9 @@ void TilePass::record(VkCommandBuffer cmd, const gpu::FrameParams& frame, bool f
                 kShaderReadWrite);
     }
 
-    gpu::PushConstants push{};
-    push.frame = frame;
+    gpu::PushConstants push = tile;
     push.light_first = 0;
+    push.light_count = 0;
     push.cut_flags = 0;
     push.refine_budget = gpu::kUnlimitedRefinements;
     VkPipelineLayout layout = resources_.pipeline_layout();
@@ -110,9 +110,9 @@ void TilePass::record_readback(VkCommandBuffer cmd, std::uint32_t pixels) {
             VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
 }
 
-PassTiming TilePass::run(Submitter& submitter, const gpu::FrameParams& frame, bool first,
+PassTiming TilePass::run(Submitter& submitter, const gpu::PushConstants& tile, bool first,
                          bool last) {
-    record(submitter.begin(), frame, first, last);
+    record(submitter.begin(), tile, first, last);
     const auto submitted = std::chrono::steady_clock::now();
     submitter.submit_and_wait();
     const double wall_ms =

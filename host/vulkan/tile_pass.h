@@ -26,13 +26,14 @@ public:
     TilePass(const Context& ctx, const GpuResources& resources, const Kernels& kernels,
              const ShadingMethod& method, Timestamps& timestamps);
 
-    // Records the pass of sample frame.sample_index over the tile that
-    // `frame` names. `first`: the tile's sums start from zero; otherwise the
-    // kernels add to what the buffers hold. `last`: the host reads the sums
-    // after this pass (GpuResources::radiance_sums, pixel_stats_sums).
-    void record(VkCommandBuffer cmd, const gpu::FrameParams& frame, bool first, bool last);
+    // Records the pass of sample tile.sample_index over the tile that `tile`
+    // names (its tile_* fields; the rest is filled per dispatch). `first`:
+    // the tile's sums start from zero; otherwise the kernels add to what the
+    // buffers hold. `last`: the host reads the sums after this pass
+    // (GpuResources::radiance_sums, pixel_stats_sums).
+    void record(VkCommandBuffer cmd, const gpu::PushConstants& tile, bool first, bool last);
     // Records, submits and waits for one pass.
-    PassTiming run(Submitter& submitter, const gpu::FrameParams& frame, bool first, bool last);
+    PassTiming run(Submitter& submitter, const gpu::PushConstants& tile, bool first, bool last);
 
 private:
     void barrier(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkAccessFlags src,

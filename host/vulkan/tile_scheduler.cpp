@@ -65,15 +65,15 @@ double TileScheduler::render_tile(const Tile& tile, RenderResult& result) {
 }
 
 double TileScheduler::render_samples(const Tile& tile, RenderStats& stats) {
-    gpu::FrameParams frame = frame_;
-    frame.tile_x = tile.x0;
-    frame.tile_y = tile.y0;
-    frame.tile_width = tile.width;
-    frame.tile_height = tile.height;
+    gpu::PushConstants push{};
+    push.tile_x = tile.x0;
+    push.tile_y = tile.y0;
+    push.tile_width = tile.width;
+    push.tile_height = tile.height;
     double slowest_ms = 0.0;
     for (std::uint32_t s = 0; s < frame_.spp; ++s) {
-        frame.sample_index = s;
-        const PassTiming t = pass_.run(submitter_, frame, s == 0, s + 1 == frame_.spp);
+        push.sample_index = s;
+        const PassTiming t = pass_.run(submitter_, push, s == 0, s + 1 == frame_.spp);
         stats.seconds_primary += t.seconds_primary;
         stats.seconds_shading += t.seconds_shading;
         slowest_ms = std::max(slowest_ms, t.slowest_dispatch_ms);

@@ -20,10 +20,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // The GLSL push-constant block of shaders/kernel.glsl.
-static_assert(sizeof(gpu::PushConstants) == 124);
-static_assert(offsetof(gpu::PushConstants, light_first) == gpu::kPushLightFirstOffset);
-static_assert(offsetof(gpu::PushConstants, cut_flags) == gpu::kPushCutFlagsOffset);
-static_assert(offsetof(gpu::PushConstants, refine_budget) == gpu::kPushRefineBudgetOffset);
+static_assert(sizeof(gpu::PushConstants) == 36);
+static_assert(offsetof(gpu::PushConstants, sample_index) == 16);
+static_assert(offsetof(gpu::PushConstants, refine_budget) == 32);
 // The std430 layouts of bindings.glsl's records: 4-byte scalars only.
 static_assert(sizeof(gpu::PixelStats) == 32);
 static_assert(offsetof(gpu::PixelStats, shadow_rays_lo) == 8);
@@ -55,6 +54,12 @@ RenderResult render(const Context& ctx, const PreparedScene& prepared,
 
 }  // namespace
 
+std::vector<SceneArray> kernel_arrays(const PreparedScene& prepared, const gpu::FrameParams& frame) {
+    std::vector<SceneArray> arrays = scene_arrays(prepared);
+    arrays.push_back({"frame", &frame, sizeof frame, 1});
+    return arrays;
+}
+
 gpu::FrameParams frame_params(const Context& ctx, const PreparedScene& prepared,
                               const RenderOptions& options) {
     validate_render_options(options);
@@ -74,11 +79,11 @@ RenderSetup::RenderSetup(const Context& context, const PreparedScene& prepared,
       timestamps(context),
       method(make_shading_method(options, frame, prepared.tree, tuning,
                                  context.properties().limits.maxComputeSharedMemorySize)),
-      resources(context, submitter, scene_arrays(prepared), *method,
+      resources(context, submitter, kernel_arrays(prepared, frame), *method,
                 std::uint64_t(frame.width) * frame.height, tuning.max_tile_pixels),
       kernels(context, resources.pipeline_layout(), *method,
-              {tuning.force_ggx || prepared.has_specular,
-               tuning.force_shadows || prepared.has_occluders, resources.tiles().invocations}),
+              {tuning.force_ggx || prepared.has_specular, tuning.force_shadows || prepared.has_occluders,
+               tuning.force_oriented || prepared.has_oriented, resources.tiles().invocations}),
       pass(context, resources, kernels, *method, timestamps) {}
 
 RenderSetup::~RenderSetup() { ctx.fn().vkDeviceWaitIdle(ctx.device().get()); }
@@ -90,6 +95,7 @@ Tuning Tuning::from_environment() {
         const bool all = features.find("all") != std::string::npos;
         tuning.force_ggx = all || features.find("ggx") != std::string::npos;
         tuning.force_shadows = all || features.find("shadows") != std::string::npos;
+        tuning.force_oriented = all || features.find("oriented") != std::string::npos;
     }
     if (const char* v = std::getenv("LC_VK_MAX_TILE_PIXELS"))
         tuning.max_tile_pixels = std::uint32_t(std::strtoul(v, nullptr, 10));

@@ -38,7 +38,7 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed);
 
 // One array the kernels read, as raw bytes. scene_arrays() is the one list
 // of them: the Vulkan renderer uploads it (in this order, which is the order
-// of the bindings kBindingBvhNodes .. kBindingLightNodes) and the CLI
+// of the bindings kBindingBvhNodes .. kBindingEnvironment) and the CLI
 // reports its sizes.
 struct SceneArray {
     const char* name;         // "bvh_nodes", "triangles", ...

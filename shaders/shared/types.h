@@ -148,8 +148,9 @@ struct CutEntry {
     float unit_r, unit_g, unit_b;
 };
 
-// Everything a frame's kernels need besides the buffers (112 bytes). The
-// camera basis vectors are pre-scaled by tan(fov/2) (and aspect for right).
+// Everything a frame's kernels need besides the buffers (112 bytes); one
+// storage buffer on the GPU, the same for every tile and sample. The camera
+// basis vectors are pre-scaled by tan(fov/2) (and aspect for right).
 struct FrameParams {
     float cam_pos_x, cam_pos_y, cam_pos_z;
     float min_distance2;          // inverse-square falloff is clamped here
@@ -161,12 +162,9 @@ struct FrameParams {
     uint spp;
     uint width, height, seed, light_count;
     uint roots[kLightTypeCount];  // root node of each type's tree; kInvalidIndex if absent
-    uint tile_x, tile_y;          // first pixel of the dispatched tile
-    uint tile_width, tile_height;
-    uint sample_index;            // which of the spp samples this pass renders
     uint loop_probe_rounds;       // always 2: see lc_loops_were_cut_short (shaders/kernel.glsl)
     uint env_width, env_height;   // environment map seen by rays that leave; 0 x 0: black
-    uint pad0, pad1;
+    uint pad0;
 };
 
 #ifdef __cplusplus

@@ -75,7 +75,10 @@ std::vector<gpu::PixelStats> pass_over(vk::RenderSetup& setup, const gpu::FrameP
         // The pass's first barrier makes this transfer visible to the kernels.
         setup.ctx.fn().vkCmdUpdateBuffer(cmd, setup.resources.pixel_stats().get(), 0,
                                          pixels * sizeof(gpu::PixelStats), start->data());
-    setup.pass.record(cmd, frame, /*first=*/start == nullptr, /*last=*/true);
+    gpu::PushConstants tile{};
+    tile.tile_width = frame.width;
+    tile.tile_height = frame.height;
+    setup.pass.record(cmd, tile, /*first=*/start == nullptr, /*last=*/true);
     setup.submitter.submit_and_wait();
     // The pass made the counters host-readable; its fence has signalled.
     const gpu::PixelStats* out = setup.resources.pixel_stats_sums();
