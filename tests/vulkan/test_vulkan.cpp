@@ -205,8 +205,9 @@ TEST_F(Vulkan, TinyMaxCutMatchesCpu) {
     expect_lightcuts_matches(p, o, gpu(p, o));
 }
 
-// Specialization constants switch GGX and shadow rays off for scenes that
-// cannot use them; forcing them on must not change the image.
+// Specialization constants switch GGX, shadow rays and the spot/oriented
+// light code off for scenes that cannot use them; forcing them on must not
+// change the image.
 TEST_F(Vulkan, FeatureSwitchesDoNotChangeTheImage) {
     Scene s;
     s.materials = {test::lambert({0.7f, 0.6f, 0.5f})};
@@ -217,9 +218,11 @@ TEST_F(Vulkan, FeatureSwitchesDoNotChangeTheImage) {
     PreparedScene p = prepare_scene(std::move(s), 1);
     ASSERT_FALSE(p.has_specular);
     ASSERT_FALSE(p.has_occluders);
+    ASSERT_FALSE(p.has_oriented);
     vk::Tuning all;
     all.force_ggx = true;
     all.force_shadows = true;
+    all.force_oriented = true;
     for (const char* method : {"brute", "lightcuts"}) {
         RenderOptions o = options(method, 24, 24);
         RenderResult off = gpu(p, o), on = gpu(p, o, all);
