@@ -40,6 +40,7 @@ EmissionCone EmissionCone::of_light(const gpu::Light& light) {
             cone.axis = glm::vec3(light.axis_x, light.axis_y, light.axis_z);
             cone.theta_o = 0.0f;
             cone.theta_e = std::acos(std::clamp(light.cos_outer, -1.0f, 1.0f));
+            cone.falloff_width = std::max(1e-3f, light.cos_inner - light.cos_outer);
             break;
         case gpu::kLightOriented:
             cone.axis = glm::vec3(light.axis_x, light.axis_y, light.axis_z);
@@ -58,6 +59,7 @@ float EmissionCone::cos_beta() const { return std::cos(std::min(theta_o, kPi)); 
 EmissionCone cone_union(const EmissionCone& a, const EmissionCone& b) {
     EmissionCone u;
     u.theta_e = std::max(a.theta_e, b.theta_e);
+    u.falloff_width = std::min(a.falloff_width, b.falloff_width);
     u.two_sided = a.two_sided || b.two_sided;
     if (a.emits_everywhere() || b.emits_everywhere()) return u;
     const float theta_d = angle_between(a.axis, b.axis);

@@ -17,6 +17,9 @@ struct EmissionCone {
     float theta_o = 3.14159265f;       // pi: the axes can point anywhere
     float theta_e = 1.57079633f;
     bool two_sided = false;
+    // Spots: the smallest max(1e-3, cos inner - cos outer) of the lights
+    // (their outer angles are in theta_e). Others: 1.
+    float falloff_width = 1.0f;
 
     // A light that emits everywhere (point and directional lights).
     static EmissionCone everywhere();

@@ -112,14 +112,6 @@ void merge(Build& build, std::uint32_t a, std::uint32_t b) {
     all.push_back(c);
 }
 
-std::uint32_t expand_bits(std::uint32_t v) {
-    v = (v * 0x00010001u) & 0xFF0000FFu;
-    v = (v * 0x00000101u) & 0x0F00F00Fu;
-    v = (v * 0x00000011u) & 0xC30C30C3u;
-    v = (v * 0x00000005u) & 0x49249249u;
-    return v;
-}
-
 // Runs fn(begin, end) over [0, n) on up to hardware_concurrency threads.
 template <typename Fn>
 void parallel_for(std::size_t n, Fn fn) {
@@ -137,21 +129,32 @@ void parallel_for(std::size_t n, Fn fn) {
     for (auto& th : pool) th.join();
 }
 
-// Sorts cluster ids along a 30-bit Morton curve of their box centres.
-void sort_morton(const std::vector<Cluster>& all, std::vector<std::uint32_t>& active) {
+// Interleaves the 10-bit coordinates q[0..dims) into one Morton key.
+std::uint64_t morton_key(const std::uint32_t* q, int dims) {
+    std::uint64_t key = 0;
+    for (int bit = 9; bit >= 0; --bit)
+        for (int d = 0; d < dims; ++d) key = (key << 1) | ((q[d] >> bit) & 1u);
+    return key;
+}
+
+// Sorts cluster ids along a Morton curve of their box centres, in 3D, or
+// in 6D with the emission axis too where the metric has a cone term: the
+// window of partners then holds lights that are near and face alike.
+void sort_morton(const std::vector<Cluster>& all, std::vector<std::uint32_t>& active, bool with_axis) {
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (auto id : active) {
         lo = glm::min(lo, all[id].lo);
         hi = glm::max(hi, all[id].hi);
     }
     glm::vec3 extent = glm::max(hi - lo, glm::vec3(1e-30f));
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> keyed(active.size());
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(active.size());
     for (std::size_t i = 0; i < active.size(); ++i) {
         const Cluster& c = all[active[i]];
-        glm::vec3 t = glm::clamp((0.5f * (c.lo + c.hi) - lo) / extent, 0.0f, 1.0f) * 1023.0f;
-        std::uint32_t code = (expand_bits(std::uint32_t(t.x)) << 2) |
-                             (expand_bits(std::uint32_t(t.y)) << 1) | expand_bits(std::uint32_t(t.z));
-        keyed[i] = {code, active[i]};
+        const glm::vec3 t = glm::clamp((0.5f * (c.lo + c.hi) - lo) / extent, 0.0f, 1.0f) * 1023.0f;
+        const glm::vec3 a = glm::clamp(0.5f * (c.cone.axis + 1.0f), 0.0f, 1.0f) * 1023.0f;
+        const std::uint32_t q[6] = {std::uint32_t(t.x), std::uint32_t(t.y), std::uint32_t(t.z),
+                                    std::uint32_t(a.x), std::uint32_t(a.y), std::uint32_t(a.z)};
+        keyed[i] = {morton_key(q, with_axis ? 6 : 3), active[i]};
     }
     std::sort(keyed.begin(), keyed.end());
     for (std::size_t i = 0; i < keyed.size(); ++i) active[i] = keyed[i].second;
@@ -191,7 +194,7 @@ std::size_t best_partner(const Build& b, const std::vector<std::uint32_t>& activ
 
 // Locally-ordered clustering; returns the root's build id.
 std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
-    sort_morton(build.all, active);
+    sort_morton(build.all, active, build.cone_weight > 0.0);
     std::vector<std::uint32_t> best(active.size());
     std::vector<std::uint32_t> next;
     while (active.size() > 1) {
@@ -302,7 +305,7 @@ void flatten(const std::vector<Cluster>& all, std::span<const gpu::Light> input,
         n.axis_oct = c.axis_packed;
         n.cos_theta_o = c.cone.emits_everywhere() ? -1.0f : std::cos(c.cone.theta_o);
         n.cos_theta_e = std::cos(c.cone.theta_e);
-        n.pad0 = 0;
+        n.falloff_width = c.cone.falloff_width;
         const std::uint32_t node_bits = type_bits | (c.cone.two_sided ? gpu::kNodeTwoSided : 0u);
         if (c.left == gpu::kInvalidIndex) {
             n.left = gpu::kInvalidIndex;
@@ -340,7 +343,8 @@ std::uint32_t LightTree::cut_heap_capacity(std::uint32_t max_cut) const {
     return std::uint32_t(std::max<std::uint64_t>(1, std::min(interior, cut)));
 }
 
-LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t seed, TreeBuilder builder) {
+LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t seed, TreeBuilder builder,
+                           double cone_scale) {
     auto start = std::chrono::steady_clock::now();
     LightTree tree;
     tree.lights.reserve(lights.size());
@@ -374,7 +378,7 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
         // similarity, to the scene's diagonal; here the diagonal of this
         // tree's lights. Lights that emit everywhere have no cone term.
         if (type == gpu::kLightSpot || type == gpu::kLightOriented)
-            build.cone_weight = glm::dot(glm::dvec3(hi - lo), glm::dvec3(hi - lo));
+            build.cone_weight = cone_scale * cone_scale * glm::dot(glm::dvec3(hi - lo), glm::dvec3(hi - lo));
         all.reserve(2 * leaves.size());
         std::uint32_t root = builder == TreeBuilder::kExact ? cluster_exact(build, leaves) : cluster_fast(build, leaves);
         auto base = static_cast<std::uint32_t>(tree.nodes.size());

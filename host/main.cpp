@@ -26,7 +26,7 @@ struct RenderArgs {
     std::string scene, method;
     lc::RenderOutputs outputs;
     lc::DeviceChoice device;
-    std::optional<std::uint32_t> spp, width, height, max_cut, seed;
+    std::optional<std::uint32_t> spp, width, height, max_cut, seed, area_samples;
     std::optional<float> relative_error;
     unsigned threads = 0;
 };
@@ -78,6 +78,7 @@ int run_render(RenderArgs a) {
         std::fprintf(stderr, "warning: %s: dropped %zu degenerate triangles\n", a.scene.c_str(),
                      scene.degenerate_triangles_dropped);
     const lc::RenderOptions options = render_options(a, scene);
+    if (a.area_samples) scene.render.area_light_samples = *a.area_samples;
     lc::validate_render_options(options);
     // Every output is checked and reserved before the render; none is left if any fails.
     lc::OutputSet outputs = lc::reserve_render_outputs(a.outputs, a.scene, options.method);
@@ -127,10 +128,15 @@ int run_info(const std::string& file) {
     std::printf("  materials          %zu\n", scene.materials.size());
     std::printf("  point lights       %zu\n", scene.count_lights(lc::gpu::kLightPoint));
     std::printf("  directional lights %zu\n", scene.count_lights(lc::gpu::kLightDirectional));
+    std::printf("  spot lights        %zu\n", scene.count_lights(lc::gpu::kLightSpot));
+    if (scene.environment.present())
+        std::printf("  environment        %ux%u, %u directions\n", scene.environment.width, scene.environment.height,
+                    scene.environment.directions);
     std::printf("  bounds             [%g %g %g] - [%g %g %g]\n", scene.bounds_min.x, scene.bounds_min.y,
                 scene.bounds_min.z, scene.bounds_max.x, scene.bounds_max.y, scene.bounds_max.z);
     std::printf("  image              %ux%u\n", scene.camera.width, scene.camera.height);
     const lc::PreparedScene prepared = lc::prepare_scene(std::move(scene), 1);
+    std::printf("  area-light samples %zu\n", prepared.area_lights);
     std::printf("  buffers:\n%s", lc::buffer_table(lc::scene_buffer_bytes(prepared)).c_str());
     return 0;
 }
@@ -148,6 +154,9 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
         ->check(setting(lc::kSettingRelativeError));
     render->add_option("--max-cut", r.max_cut, "Lightcuts largest cut (default 1000)")
         ->check(setting(lc::kSettingMaxCut));
+    render->add_option("--area-samples", r.area_samples,
+                       "Point lights the emissive surfaces become, in all (default 65536)")
+        ->check(setting(lc::kSettingAreaLightSamples));
     render->add_option("--seed", r.seed, "Seed for pixel jitter and light-tree representatives")
         ->check(setting(lc::kSettingSeed));
     render->add_option("--threads", r.threads, "CPU threads (0 = all cores)");

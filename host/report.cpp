@@ -108,8 +108,15 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
     r.lights = prepared.tree.lights.size();
     r.bvh_nodes = prepared.bvh.nodes.size();
     r.black_lights = prepared.tree.black_lights;
-    r.seconds = {load_seconds,    prepared.bvh.build_seconds, prepared.tree.build_seconds,
-                 s.seconds_total, s.seconds_primary,          s.seconds_shading};
+    r.area_lights = prepared.area_lights;
+    r.environment_lights = prepared.environment_lights;
+    r.seconds.load = load_seconds;
+    r.seconds.bvh_build = prepared.bvh.build_seconds;
+    r.seconds.light_tree_build = prepared.tree.build_seconds;
+    r.seconds.light_sampling = prepared.light_sampling_seconds;
+    r.seconds.render = s.seconds_total;
+    r.seconds.primary = s.seconds_primary;
+    r.seconds.shading = s.seconds_shading;
     r.camera_rays = s.camera_rays;
     r.shadow_rays = s.shadow_rays;
     const double pixels = double(r.width) * double(r.height);
@@ -134,6 +141,9 @@ std::string report_text(const RenderReport& r) {
         r.black_lights ? format(" (and %zu black, left out of the tree)", r.black_lights) : std::string();
     text += format("  triangles %zu, lights %zu%s, BVH %zu nodes built in %.3f s\n", r.triangles, r.lights,
                    black.c_str(), r.bvh_nodes, r.seconds.bvh_build);
+    if (r.area_lights || r.environment_lights)
+        text += format("  of the lights: %zu area-light samples, %zu environment directions (%.3f s)\n",
+                       r.area_lights, r.environment_lights, r.seconds.light_sampling);
     text += format("  render %.3f s, %.0f rays (%.2f Mrays/s), %.1f shadow rays per pixel\n", r.seconds.render,
                    double(r.camera_rays + r.shadow_rays), r.rays_per_second * 1e-6, r.shadow_rays_per_pixel);
     if (r.loop_limit_retries)
@@ -156,9 +166,12 @@ std::string report_json(const RenderReport& r) {
         {"triangles", r.triangles},
         {"lights", r.lights},
         {"black_lights", r.black_lights},
+        {"area_lights", r.area_lights},
+        {"environment_lights", r.environment_lights},
         {"seconds", {{"load", r.seconds.load},
                      {"bvh_build", r.seconds.bvh_build},
                      {"light_tree_build", r.seconds.light_tree_build},
+                     {"light_sampling", r.seconds.light_sampling},
                      {"render", r.seconds.render},
                      {"primary", r.seconds.primary},
                      {"shading", r.seconds.shading}}},

@@ -43,7 +43,10 @@ enum class TreeBuilder {
 // a given seed (representative choice) whatever the thread count. Cluster
 // intensities are summed in double; the loader has checked that every
 // type's total fits a float.
+// `cone_scale` multiplies c, the weight of the metric's cone term (the
+// diagonal of the tree's lights by default, light_tree.cpp); 0 leaves the
+// term out, to measure what it buys (bench/tree_quality).
 LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t seed,
-                           TreeBuilder builder = TreeBuilder::kFast);
+                           TreeBuilder builder = TreeBuilder::kFast, double cone_scale = 1.0);
 
 }  // namespace lc

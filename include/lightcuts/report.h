@@ -34,8 +34,10 @@ struct RenderReport {
     std::uint32_t width = 0, height = 0, spp = 0;
     std::size_t triangles = 0, lights = 0, bvh_nodes = 0;
     std::size_t black_lights = 0;             // zero-intensity lights left out of the tree
+    std::size_t area_lights = 0;              // samples of the emissive surfaces (in `lights`)
+    std::size_t environment_lights = 0;       // directions of the environment (in `lights`)
     struct Seconds {
-        double load = 0.0, bvh_build = 0.0, light_tree_build = 0.0;
+        double load = 0.0, bvh_build = 0.0, light_tree_build = 0.0, light_sampling = 0.0;
         double render = 0.0, primary = 0.0, shading = 0.0;
     } seconds;
     std::uint64_t camera_rays = 0, shadow_rays = 0;

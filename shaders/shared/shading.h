@@ -328,7 +328,10 @@ float lc_safe_acos(float c) { return acos(clamp(c, -1.0f, 1.0f)); }
 // the sphere, where theta_w is the angle between the cluster's axis and the
 // way from the box centre to x, theta_o the spread of the lights' axes and
 // theta_b the half-angle the box's bounding sphere subtends at x. Nothing is
-// emitted past theta_e; cosine emitters emit at most cos(theta') before.
+// emitted past theta_e; cosine emitters emit at most cos(theta') before, and
+// a spot at most s^2 with s = (cos theta' - cos theta_e) / w, w the
+// cluster's narrowest falloff (each light's s is below that: its outer
+// cosine is at least cos theta_e, its width at least w).
 float lc_emission_bound(LightNode node, vec3 x) {
     if (node.cos_theta_o <= -1.0f) return 1.0f;  // emits everywhere
     vec3 lo = vec3(node.min_x, node.min_y, node.min_z) - x;
@@ -342,8 +345,16 @@ float lc_emission_bound(LightNode node, vec3 x) {
     float theta = lc_safe_acos(cos_w) - lc_safe_acos(node.cos_theta_o) - asin(min(radius / d, 1.0f)) -
                   kAngleSlack;
     theta = max(theta, 0.0f);
-    if (theta >= lc_safe_acos(node.cos_theta_e)) return 0.0f;
-    return lc_node_type(node) == kLightOriented ? min(cos(theta) * kBoundSlack, 1.0f) : 1.0f;
+    float theta_e = lc_safe_acos(node.cos_theta_e);
+    if (theta >= theta_e) return 0.0f;
+    uint type = lc_node_type(node);
+    if (type == kLightOriented) return min(cos(theta) * kBoundSlack, 1.0f);
+    if (type != kLightSpot) return 1.0f;
+    // cos(theta_e + kAngleSlack), a little below the stored cosine, which
+    // went through acos and cos on the host.
+    float s = (cos(theta) - cos(theta_e + kAngleSlack)) / node.falloff_width;
+    s = min(s * kBoundSlack, 1.0f);
+    return s * s;
 }
 
 // Bound of material * geometry * emission (per unit intensity, RGB) over

@@ -125,7 +125,9 @@ struct LightNode {
     uint axis_oct;    // cone axis, octahedral, two snorm16 (lc_decode_axis)
     float cos_theta_o;
     float cos_theta_e;
-    uint pad0;
+    // Spots: the smallest cos(inner) - cos(outer) of the cluster's lights
+    // (at least 1e-3, as in lc_spot_falloff), for a bound on the falloff.
+    float falloff_width;
 };
 
 // Per-pixel surface record written by the camera-ray kernel (48 bytes).
