@@ -5,12 +5,21 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 SCENE ?= scenes/room/room.json
 
-.PHONY: deps build demo test clean
+.PHONY: deps scenes build demo test clean
 
 deps:
 	@./scripts/install-deps.sh
 
-build: deps
+# Generated scene data (not committed): the HDR sky and the gallery's spots.
+scenes: deps scenes/sky/sky.exr scenes/gallery/spots_1e4.csv
+
+scenes/sky/sky.exr: scripts/make_sky.py
+	@python3 scripts/make_sky.py >/dev/null
+
+scenes/gallery/spots_1e4.csv: scripts/make_light_scenes.py
+	@python3 scripts/make_light_scenes.py --spots 10000 --out $@
+
+build: deps scenes
 	@test -f $(BUILD)/CMakeCache.txt || cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release >/dev/null
 	@cmake --build $(BUILD) -j $(JOBS) >$(BUILD)/build.log 2>&1 || { cat $(BUILD)/build.log; exit 1; }
 
