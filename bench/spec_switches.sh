@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # What each Vulkan specialization-constant switch saves: renders a scene that
-# needs neither shadow rays nor the GGX lobe (scenes/plane) with the switches
-# as the scene allows them, and with each one forced on
-# (LC_VK_FORCE_FEATURES), and prints the median GPU shading time of 5 runs
-# after a warm-up.
+# needs neither shadow rays, nor the GGX lobe, nor the spot/oriented light
+# code (scenes/plane) with the switches as the scene allows them, and with
+# each one forced on (LC_VK_FORCE_FEATURES), and prints the median GPU
+# shading time of 5 runs after a warm-up.
 #
 #   bench/spec_switches.sh [SCENE] [SIZE]
 set -euo pipefail
@@ -16,7 +16,7 @@ trap 'rm -rf "$tmp"' EXIT
 
 printf '%-10s %-14s %s\n' method forced "median shading [s] (5 runs)"
 for method in lightcuts brute; do
-  for force in none ggx shadows all; do
+  for force in none ggx shadows oriented all; do
     times=()
     for run in 0 1 2 3 4 5; do
       LC_VK_FORCE_FEATURES="$force" "$exe" render "$scene" -o "$tmp/x.exr" --device vulkan --method "$method" \
