@@ -2,7 +2,7 @@
 // agglomerative clustering under the metric I_C (alpha_C^2 + c^2 (1 - cos
 // beta_C)^2), where I_C is the Rec.709 luminance of the cluster's RGB
 // intensity sum, alpha_C the diagonal of its box and beta_C the spread of
-// the emission axes of its spot or oriented lights (emission_cone.h). One
+// the emission axes of its spot or oriented lights (light_bounds.h). One
 // tree per light type.
 //
 // kFast is locally-ordered clustering (Walter et al. 2008; the PLOC variant
@@ -29,7 +29,7 @@
 
 #include <glm/glm.hpp>
 
-#include "emission_cone.h"
+#include "light_bounds.h"
 
 namespace lc {
 namespace {
@@ -70,22 +70,6 @@ double merge_cost(const Build& b, const Cluster& x, const Cluster& y) {
     return (x.weight + y.weight) * size;
 }
 
-// The point a light occupies in its tree's box: the position of a point,
-// spot or oriented light, the unit direction of a directional light
-// (Walter 2005 §4.1 clusters directional lights as points on the unit
-// sphere). With EmissionCone::of_light, the only places the builder looks
-// at a light's type.
-glm::vec3 tree_point(const gpu::Light& l) {
-    switch (l.type & gpu::kLightTypeMask) {
-        case gpu::kLightPoint:
-        case gpu::kLightDirectional:
-        case gpu::kLightSpot:
-        case gpu::kLightOriented:
-            return {l.x, l.y, l.z};
-        default:
-            throw std::invalid_argument("light tree: unknown light type " + std::to_string(l.type));
-    }
-}
 
 // Merges clusters a and b (build ids) into a new cluster appended to `all`.
 // The representative is one of the children's, chosen with probability
@@ -377,7 +361,9 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
         // Walter 2005 §4.1 sets c, which weighs directional against spatial
         // similarity, to the scene's diagonal; here the diagonal of this
         // tree's lights. Lights that emit everywhere have no cone term.
-        if (type == gpu::kLightSpot || type == gpu::kLightOriented)
+        const bool has_cones = std::any_of(leaves.begin(), leaves.end(),
+                                           [&](std::uint32_t id) { return !all[id].cone.emits_everywhere(); });
+        if (has_cones)
             build.cone_weight = cone_scale * cone_scale * glm::dot(glm::dvec3(hi - lo), glm::dvec3(hi - lo));
         all.reserve(2 * leaves.size());
         std::uint32_t root = builder == TreeBuilder::kExact ? cluster_exact(build, leaves) : cluster_fast(build, leaves);

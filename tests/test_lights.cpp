@@ -8,7 +8,7 @@
 
 #include "cpu_kernel.h"
 #include "area_lights.h"
-#include "emission_cone.h"
+#include "light_bounds.h"
 #include "environment_lights.h"
 #include "test_util.h"
 

@@ -1,7 +1,7 @@
 // Overflow checks for the float sums and boxes the renderer builds (float_limits.h).
 #include "float_limits.h"
 
-#include <iterator>
+#include "light_records.h"
 
 namespace lc::loader {
 namespace {
@@ -27,17 +27,13 @@ std::string extent_problem(const Box& box) {
 
 LightLimits::Problem LightLimits::add(const gpu::Light& light) {
     const std::uint32_t type = light.type & gpu::kLightTypeMask;
-    constexpr const char* kTotals[] = {" intensity of the point lights exceeds ",
-                                       " irradiance of the directional lights exceeds ",
-                                       " intensity of the spot lights exceeds ",
-                                       " intensity of the oriented lights exceeds "};
-    static_assert(std::size(kTotals) == gpu::kLightTypeCount);
     if (type < gpu::kLightTypeCount) {
         glm::dvec3& total = totals_[type];
         total += glm::dvec3(light.r, light.g, light.b);
         for (int c = 0; c < 3; ++c) {
             if (fits_float(total[c])) continue;
-            return {Fault::total, std::string("total ") + kChannelNames[c] + kTotals[type] + kFloatRange};
+            return {Fault::total, std::string("total ") + kChannelNames[c] + " " + light_total_name(type) +
+                                      " exceeds " + kFloatRange};
         }
     }
     // A directional light has a direction, not a position: no box to grow.

@@ -19,6 +19,16 @@ glm::vec3 normalised(glm::vec3 d) {
 
 }  // namespace
 
+const char* light_total_name(std::uint32_t type) {
+    switch (type) {
+        case gpu::kLightPoint: return "intensity of the point lights";
+        case gpu::kLightDirectional: return "irradiance of the directional lights";
+        case gpu::kLightSpot: return "intensity of the spot lights";
+        case gpu::kLightOriented: return "intensity of the oriented lights";
+        default: return "intensity of the lights";
+    }
+}
+
 gpu::Light point_light(glm::vec3 position, glm::vec3 intensity) {
     gpu::Light l{};
     l.x = position.x; l.y = position.y; l.z = position.z;

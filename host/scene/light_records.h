@@ -20,6 +20,10 @@ struct LightProblem {
     explicit operator bool() const { return !problem.empty(); }
 };
 
+// What a light type's r, g, b sum to, in words: "intensity of the point
+// lights", "irradiance of the directional lights", ...
+const char* light_total_name(std::uint32_t type);
+
 gpu::Light point_light(glm::vec3 position, glm::vec3 intensity);
 
 // `travel` is the way the light travels (non-zero); stored towards the light.

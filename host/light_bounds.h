@@ -1,7 +1,11 @@
-// Bounds on the directions a cluster of lights emits into (pbrt-v4's
-// LightBounds cone): every light's axis lies within theta_o of `axis`, and
-// each light emits only within theta_e of its own axis. Built on the host
-// for the light tree's nodes; read by the kernels' lc_emission_bound.
+// What the light tree needs to know of a light (pbrt-v4's LightBounds):
+// where it sits in its tree's box, and the cone of directions it emits
+// into. With the emission switch in shaders/shared/shading.h, the only
+// place the tree looks at a light's type.
+//
+// The cone: every light's axis lies within theta_o of `axis`, and each
+// light emits only within theta_e of its own axis. Built on the host for the
+// light tree's nodes; read by the kernels' lc_emission_bound.
 #pragma once
 
 #include <cstdint>
@@ -32,6 +36,12 @@ struct EmissionCone {
     // c^2 (1 - cos beta)^2.
     float cos_beta() const;
 };
+
+// The point a light occupies in its tree's box: the position of a point,
+// spot or oriented light, the unit direction of a directional light (Walter
+// 2005 §4.1 clusters directional lights as points on the unit sphere).
+// Throws std::invalid_argument for an unknown type.
+glm::vec3 tree_point(const gpu::Light& light);
 
 // The smallest cone (in pbrt-v4's sense) holding both (DirectionCone::Union).
 EmissionCone cone_union(const EmissionCone& a, const EmissionCone& b);

@@ -1,8 +1,10 @@
-// Emission cones of the light tree (host/emission_cone.h).
-#include "emission_cone.h"
+// What the light tree needs to know of a light (host/light_bounds.h).
+#include "light_bounds.h"
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include <glm/gtc/quaternion.hpp>
 
@@ -30,6 +32,18 @@ std::uint32_t encode_octahedral(glm::vec3 v) {
 }
 
 }  // namespace
+
+glm::vec3 tree_point(const gpu::Light& l) {
+    switch (l.type & gpu::kLightTypeMask) {
+        case gpu::kLightPoint:
+        case gpu::kLightDirectional:
+        case gpu::kLightSpot:
+        case gpu::kLightOriented:
+            return {l.x, l.y, l.z};
+        default:
+            throw std::invalid_argument("light tree: unknown light type " + std::to_string(l.type));
+    }
+}
 
 EmissionCone EmissionCone::everywhere() { return EmissionCone{}; }
 
