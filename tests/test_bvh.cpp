@@ -16,6 +16,7 @@
 
 #include "cpu_kernel.h"
 #include "lightcuts/bvh.h"
+#include "test_util.h"
 
 namespace {
 
@@ -183,13 +184,7 @@ void check_invariants(const Scene& s) {
     EXPECT_TRUE(std::all_of(input_seen.begin(), input_seen.end(), [](int c) { return c == 1; }));
 }
 
-vec3 random_unit(std::mt19937& rng) {
-    std::normal_distribution<float> g(0.0f, 1.0f);
-    vec3 d;
-    do d = {g(rng), g(rng), g(rng)};
-    while (glm::dot(d, d) < 1e-6f);
-    return glm::normalize(d);
-}
+using lc::test::random_unit;
 
 // Direction in the hemisphere around n, at least `min_cos` away from grazing.
 vec3 random_in_hemisphere(std::mt19937& rng, vec3 n, float min_cos) {

@@ -15,14 +15,7 @@ namespace {
 
 using Kernel = cpu::ShadeKernel;
 
-glm::vec3 random_unit(std::mt19937& rng) {
-    std::normal_distribution<float> g;
-    glm::vec3 v;
-    do {
-        v = glm::vec3(g(rng), g(rng), g(rng));
-    } while (glm::dot(v, v) < 1e-6f);
-    return glm::normalize(v);
-}
+using test::random_unit;
 
 // Over 2 x 10^5 random cases (cluster box with lights inside, shaded point
 // outside, inside or on the box, normals random or grazing, Lambert or GGX

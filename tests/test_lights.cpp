@@ -18,13 +18,7 @@ namespace {
 using Kernel = cpu::ShadeKernel;
 constexpr float kPi = 3.14159265358979f;
 
-glm::vec3 random_unit(std::mt19937& rng) {
-    std::normal_distribution<float> g;
-    glm::vec3 v;
-    do v = glm::vec3(g(rng), g(rng), g(rng));
-    while (glm::dot(v, v) < 1e-6f);
-    return glm::normalize(v);
-}
+using test::random_unit;
 
 // A Lambert plane at y = 0 (albedo kd, normal +y) and the kernel to shade it.
 struct Plane {

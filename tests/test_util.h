@@ -64,6 +64,15 @@ inline gpu::Light oriented_light(glm::vec3 p, glm::vec3 normal, glm::vec3 intens
 }
 
 // Adds a triangle with its face normal (or the given vertex normals).
+// A uniformly distributed unit vector.
+inline glm::vec3 random_unit(std::mt19937& rng) {
+    std::normal_distribution<float> g;
+    glm::vec3 v;
+    do v = glm::vec3(g(rng), g(rng), g(rng));
+    while (glm::dot(v, v) < 1e-6f);
+    return glm::normalize(v);
+}
+
 // A light tree node with the given box and light type, for bound tests.
 inline gpu::LightNode node_with_box(glm::vec3 lo, glm::vec3 hi, std::uint32_t type) {
     gpu::LightNode n{};

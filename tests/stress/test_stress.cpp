@@ -33,13 +33,7 @@ glm::vec3 uniform_in(std::mt19937& rng, glm::vec3 lo, glm::vec3 hi) {
     return lo + (hi - lo) * glm::vec3(u(rng), u(rng), u(rng));
 }
 
-glm::vec3 random_unit(std::mt19937& rng) {
-    std::normal_distribution<float> g;
-    glm::vec3 v;
-    do v = glm::vec3(g(rng), g(rng), g(rng));
-    while (glm::dot(v, v) < 1e-6f);
-    return glm::normalize(v);
-}
+using test::random_unit;
 
 // An open scene: a 10 x 10 ground plane, two boxes and a sphere; camera
 // above, looking down at the middle.
