@@ -41,6 +41,14 @@ expect_error() {  # expected-substring, then the command's arguments
 expect_error "missing.json: file not found" render "$tmp/missing.json" -o "$tmp/c.exr"
 expect_error "lights" render "$root/tests/data/scenes/bad_empty_lights.json" -o "$tmp/c.exr"
 expect_error "bad_fov.json: camera.fov_y_degrees" render "$root/tests/data/scenes/bad_fov.json" -o "$tmp/c.exr"
+# Each kind of light of the light model: spot, spots CSV, environment, emission.
+expect_error "bad_spot_outer.json: lights[0].outer_cone_degrees" \
+  render "$root/tests/data/scenes/bad_spot_outer.json" -o "$tmp/c.exr"
+expect_error "bad_spots.csv: line 3" render "$root/tests/data/scenes/bad_spots_csv.json" -o "$tmp/c.exr"
+expect_error "bad_env_nan.exr: pixel (1, 0)" render "$root/tests/data/scenes/bad_env_nan.json" -o "$tmp/c.exr"
+expect_error "bad_env_two.json: lights[1]" render "$root/tests/data/scenes/bad_env_two.json" -o "$tmp/c.exr"
+expect_error "bad_ke.obj: material 'glow'.Ke" render "$root/tests/data/scenes/bad_mtl_ke.json" -o "$tmp/c.exr"
+expect_error "--area-samples" render "$root/scenes/room/room.json" -o "$tmp/c.exr" --area-samples 0
 expect_error "folder $tmp/nowhere does not exist" render "$root/scenes/room/room.json" -o "$tmp/nowhere/c.exr"
 expect_error "must end in .exr" render "$root/scenes/room/room.json" -o "$tmp/c.png"
 expect_error "nope.exr" compare "$tmp/a.exr" "$tmp/nope.exr"
