@@ -38,13 +38,23 @@ std::string check_scene_contract(const Scene& s) {
     if (c.width < 1 || c.height < 1 || c.width > 16384 || c.height > 16384) return "image size out of range";
     if (s.triangles.empty()) return "no triangles";
     if (s.normals.size() != s.triangles.size()) return "normals not parallel to triangles";
-    if (s.lights.empty()) return "no lights";
+    bool emissive = false;
+    for (const auto& m : s.materials) emissive |= (m.flags & gpu::kMaterialEmissive) != 0u;
+    if (s.lights.empty() && !emissive && !s.environment.present()) return "no light at all";
+    for (float v : s.environment.rgb)
+        if (!(std::isfinite(v) && v >= 0.0f)) return "environment radiance invalid";
+    if (s.environment.present() && s.environment.rgb.size() != 3u * s.environment.width * s.environment.height)
+        return "environment size disagrees with its texels";
     for (const auto& m : s.materials) {
         if (!in_unit_interval(m.kd_r, m.kd_g, m.kd_b) || !in_unit_interval(m.ks_r, m.ks_g, m.ks_b))
             return "material colour out of [0, 1]";
         if (!(m.alpha >= 1e-3f && m.alpha <= 1.0f)) return "GGX alpha out of [1e-3, 1]";
         const bool specular = m.ks_r > 0.0f || m.ks_g > 0.0f || m.ks_b > 0.0f;
         if (specular != ((m.flags & gpu::kMaterialHasSpecular) != 0u)) return "specular flag disagrees with ks";
+        const glm::vec3 e(m.emission_r, m.emission_g, m.emission_b);
+        if (!finite(e) || e.r < 0.0f || e.g < 0.0f || e.b < 0.0f) return "emission invalid";
+        const bool emits = e.r > 0.0f || e.g > 0.0f || e.b > 0.0f;
+        if (emits != ((m.flags & gpu::kMaterialEmissive) != 0u)) return "emissive flag disagrees with emission";
     }
     for (std::size_t i = 0; i < s.triangles.size(); ++i) {
         const gpu::Triangle& t = s.triangles[i];
@@ -57,10 +67,15 @@ std::string check_scene_contract(const Scene& s) {
             return "normal not unit length";
     }
     for (const auto& l : s.lights) {
-        if (l.type != gpu::kLightPoint && l.type != gpu::kLightDirectional) return "unknown light type";
+        if (l.type != gpu::kLightPoint && l.type != gpu::kLightDirectional && l.type != gpu::kLightSpot)
+            return "unknown light type";
         if (!finite({l.x, l.y, l.z})) return "light position not finite";
         if (!finite({l.r, l.g, l.b}) || l.r < 0.0f || l.g < 0.0f || l.b < 0.0f) return "light intensity invalid";
         if (l.type == gpu::kLightDirectional && !unit({l.x, l.y, l.z})) return "light direction not unit";
+        if (l.type == gpu::kLightSpot &&
+            (!unit({l.axis_x, l.axis_y, l.axis_z}) || !(l.cos_outer >= -1e-6f && l.cos_outer <= l.cos_inner) ||
+             !(l.cos_inner <= 1.0f)))
+            return "spot axis or cone invalid";
     }
     if (!finite(s.bounds_min) || !finite(s.bounds_max)) return "bounds not finite";
     const RenderSettings& r = s.render;
