@@ -101,14 +101,34 @@ vec3 lc_surface_emission(uint tri_index, vec3 ray_dir) {
     return vec3(m.emission_r, m.emission_g, m.emission_b);
 }
 
-// A camera sample: sample `s` of pixel (x, y) traced into the scene. `seen`
-// is what the ray sees without any light: the surface's emission, or the
-// environment where the ray leaves the scene (then the result is false).
-bool lc_camera_sample(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp, LC_OUT(vec3) seen) {
-    vec3 dir = lc_camera_ray_dir(f, lc_pixel_sample(x, y, s, f.spp, f.seed));
+// Sample `s` of pixel (x, y) traced into the scene: the triangle hit
+// (kInvalidIndex when the ray leaves the scene), its barycentrics, and the
+// ray's direction.
+uint lc_camera_trace(FrameParams f, uint x, uint y, uint s, LC_OUT(vec3) dir, LC_OUT(float) b1,
+                     LC_OUT(float) b2) {
+    dir = lc_camera_ray_dir(f, lc_pixel_sample(x, y, s, f.spp, f.seed));
     vec3 org = vec3(f.cam_pos_x, f.cam_pos_y, f.cam_pos_z);
-    float t, b1, b2;
-    uint tri = lc_trace_closest(org, dir, kRayInfinity, t, b1, b2);
+    float t;
+    return lc_trace_closest(org, dir, kRayInfinity, t, b1, b2);
+}
+
+// A camera sample's first hit as a shaded point; false when the ray leaves
+// the scene.
+bool lc_camera_hit(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp) {
+    vec3 dir;
+    float b1, b2;
+    uint tri = lc_camera_trace(f, x, y, s, dir, b1, b2);
+    if (tri == kInvalidIndex) return false;
+    sp = lc_surface_point(tri, b1, b2, dir);
+    return true;
+}
+
+// lc_camera_hit, and what the ray sees without any light in `seen`: the
+// surface's emission, or the environment where the ray leaves the scene.
+bool lc_camera_sample(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp, LC_OUT(vec3) seen) {
+    vec3 dir;
+    float b1, b2;
+    uint tri = lc_camera_trace(f, x, y, s, dir, b1, b2);
     if (tri == kInvalidIndex) {
         seen = lc_environment_radiance(f, dir);
         return false;
@@ -116,12 +136,6 @@ bool lc_camera_sample(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint
     sp = lc_surface_point(tri, b1, b2, dir);
     seen = lc_surface_emission(tri, dir);
     return true;
-}
-
-// lc_camera_sample without what the ray sees directly.
-bool lc_camera_hit(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp) {
-    vec3 seen;
-    return lc_camera_sample(f, x, y, s, sp, seen);
 }
 
 // Statistics of one shaded point.
