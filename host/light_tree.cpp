@@ -23,8 +23,6 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <stdexcept>
-#include <string>
 #include <thread>
 
 #include <glm/glm.hpp>

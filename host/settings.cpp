@@ -4,6 +4,7 @@
 #include "lightcuts/render.h"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 
@@ -15,6 +16,13 @@ std::string integer_problem(double value, double lo, double hi) {
     if (!std::isfinite(value) || value != std::floor(value) || value < lo || value > hi)
         return "must be an integer from " + text(lo) + " to " + text(hi);
     return "";
+}
+
+// "1" rather than std::to_string's "1.000000".
+std::string shortest(float v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", double(v));
+    return text;
 }
 
 }  // namespace
@@ -29,7 +37,7 @@ std::string setting_problem(std::string_view key, double value) {
         return integer_problem(value, 1, kMaxLightSamples);
     if (key == kSettingRelativeError) {
         if (!(value >= 0.0 && value <= double(kMaxRelativeError)))
-            return "must be a number from 0 to " + std::to_string(kMaxRelativeError).substr(0, 3);
+            return "must be a number from 0 to " + shortest(kMaxRelativeError);
         return "";
     }
     throw std::logic_error("setting_problem: unknown setting '" + std::string(key) + "'");

@@ -413,7 +413,7 @@ const BadInput kBadInputs[] = {
     {"bad_env_missing.json", "nonexistent.exr", "lights[0].file: ", "file not found"},
     {"bad_env_negative.json", "bad_env_negative.json", "lights[0].color[0]: ", "negative"},
     {"bad_env_directions.json", "bad_env_directions.json", "lights[0].directions: ", "from 1 to 16777216"},
-    {"bad_env_scale.json", "bad_env_scale.json", "lights[0].scale: ", ""},
+    {"bad_env_scale.json", "bad_env_scale.json", "lights[0].scale: ", "must be in (0, "},
     {"bad_env_nan.json", "bad_env_nan.exr", "pixel (1, 0): ", "finite"},
     {"bad_emission_negative.json", "bad_emission_negative.json", "meshes[0].material.emission[0]: ", "negative"},
     {"bad_mtl_ke.json", "bad_ke.obj", "material 'glow'.Ke: ", ">= 0"},

@@ -62,8 +62,8 @@ void lc_heap_pop(LC_INOUT(uint) size) {
 // all; leaves are final (exact, zero error) and go to leaf_sum, refinable
 // interior nodes go to the heap. `inherited` is true when the caller already
 // knows the representative's unit contribution (shared with the parent).
-void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, bool inherited, vec3 inherited_unit, float min_distance2,
-                    LC_INOUT(uint) heap_size, LC_INOUT(vec3) leaf_sum,
+void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, bool inherited,
+                    vec3 inherited_unit, float min_distance2, LC_INOUT(uint) heap_size, LC_INOUT(vec3) leaf_sum,
                     LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
     LightNode node = LC_LIGHT_NODE(node_index);
     vec3 intensity = lc_node_intensity(node);
