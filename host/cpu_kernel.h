@@ -62,6 +62,7 @@ struct ShadeKernel {
 #include "shared/trace.h"
 #include "shared/shading.h"
 #include "shared/brute.h"
+#include "shared/sampling.h"
 #include "shared/lightcuts.h"
 #undef LC_BVH_NODE
 #undef LC_TRIANGLE

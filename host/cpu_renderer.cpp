@@ -30,7 +30,33 @@ struct PixelResult {
     float cut_size = 0.0f;
 };
 
-PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, bool lightcuts, std::uint32_t x,
+enum class Method { kBrute, kLightcuts, kSampled, kStochastic };
+
+Method method_of(const std::string& name) {
+    if (name == "lightcuts") return Method::kLightcuts;
+    if (name == "sampled") return Method::kSampled;
+    if (name == "stochastic") return Method::kStochastic;
+    return Method::kBrute;
+}
+
+// One camera sample's reflected light at `sp` by `method`.
+glm::vec3 shade_point(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Method method,
+                      const cpu::ShadeKernel::SurfacePoint& sp, std::uint32_t stream,
+                      cpu::ShadeKernel::ShadeStats& ss) {
+    switch (method) {
+        case Method::kLightcuts: return k.lc_shade_lightcuts(sp, frame, ss);
+        case Method::kStochastic: return k.lc_shade_stochastic(sp, frame, stream, ss);
+        case Method::kSampled:
+            // As the Vulkan kernel does: the sum over the light samples, then
+            // times 1/k.
+            return k.lc_shade_sampled(sp, frame, stream, 0u, frame.light_samples, ss) *
+                   (1.0f / float(frame.light_samples));
+        case Method::kBrute: break;
+    }
+    return k.lc_shade_brute(sp, frame.light_count, frame.min_distance2, ss);
+}
+
+PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Method method, std::uint32_t x,
                         std::uint32_t y, Worker& t) {
     glm::vec3 sum(0.0f);
     std::uint64_t cut_sum = 0;
@@ -41,8 +67,7 @@ PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, bool
         sum += seen;
         if (!hit) continue;
         cpu::ShadeKernel::ShadeStats ss{0u, 0u, 0u};
-        sum += lightcuts ? k.lc_shade_lightcuts(sp, frame, ss)
-                         : k.lc_shade_brute(sp, frame.light_count, frame.min_distance2, ss);
+        sum += shade_point(k, frame, method, sp, k.lc_sample_stream(frame.seed, x, y, s), ss);
         cut_sum += ss.cut_size;
         t.shadow_rays += ss.shadow_rays;
         t.max_cut_hits += ss.hit_max_cut;
@@ -77,7 +102,8 @@ void for_each_tile(std::uint32_t tile_count, std::vector<Worker>& workers, Work 
 
 RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& options) {
     validate_render_options(options);
-    const bool lightcuts = options.method == "lightcuts";
+    const Method method = method_of(options.method);
+    const bool lightcuts = method_selects_cuts(options.method);
     const gpu::FrameParams frame = make_frame_params(prepared, options);
     auto start = std::chrono::steady_clock::now();
 
@@ -100,7 +126,7 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
         const std::uint32_t x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
         for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); ++y)
             for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); ++x) {
-                const PixelResult px = shade_pixel(k, frame, lightcuts, x, y, t);
+                const PixelResult px = shade_pixel(k, frame, method, x, y, t);
                 result.image.set(x, y, px.radiance);
                 if (lightcuts) stats.cut_size[std::size_t(y) * frame.width + x] = px.cut_size;
             }

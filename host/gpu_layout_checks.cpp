@@ -48,7 +48,8 @@ static_assert(offsetof(GBufferTexel, material) == 36);
 static_assert(sizeof(CutEntry) == 20);
 static_assert(offsetof(CutEntry, unit_r) == 8);
 
-static_assert(sizeof(FrameParams) == 112);
+static_assert(sizeof(FrameParams) == 128);
+static_assert(offsetof(FrameParams, light_samples) == 108);
 static_assert(offsetof(FrameParams, env_width) == 100);
 static_assert(offsetof(FrameParams, min_distance2) == 12);
 static_assert(offsetof(FrameParams, relative_error) == 28);

@@ -23,10 +23,10 @@
 namespace {
 
 struct RenderArgs {
-    std::string scene, method;
+    std::string scene, method, light_pick;
     lc::RenderOutputs outputs;
     lc::DeviceChoice device;
-    std::optional<std::uint32_t> spp, width, height, max_cut, seed, area_samples;
+    std::optional<std::uint32_t> spp, width, height, max_cut, seed, area_samples, light_samples;
     std::optional<float> relative_error;
     unsigned threads = 0;
 };
@@ -63,6 +63,8 @@ lc::RenderOptions render_options(const RenderArgs& a, const lc::Scene& scene) {
     o.relative_error = a.relative_error.value_or(scene.render.relative_error);
     o.max_cut = a.max_cut.value_or(scene.render.max_cut);
     o.seed = a.seed.value_or(scene.render.seed);
+    o.light_samples = a.light_samples.value_or(scene.render.light_samples);
+    o.light_pick = a.light_pick.empty() ? scene.render.light_pick : a.light_pick;
     o.width = a.width.value_or(scene.camera.width);
     o.height = a.height.value_or(scene.camera.height);
     o.threads = a.threads;
@@ -146,7 +148,10 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
     render->add_option("scene", r.scene, "Scene file (JSON)")->required();
     render->add_option("-o,--output", r.outputs.image, "Output .exr (a tone-mapped .png is written beside it)")
         ->required();
-    render->add_option("--method", r.method, "brute (exact) or lightcuts")->check(ask(lc::method_problem));
+    render->add_option("--method", r.method,
+                       "brute (exact), lightcuts, sampled (lights drawn through the light tree) or "
+                       "stochastic (Stochastic Lightcuts)")
+        ->check(ask(lc::method_problem));
     render->add_option("--spp", r.spp, "Camera rays per pixel")->check(setting(lc::kSettingSpp));
     render->add_option("--width", r.width, "Image width")->check(setting(lc::kSettingWidth));
     render->add_option("--height", r.height, "Image height")->check(setting(lc::kSettingHeight));
@@ -157,7 +162,13 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
     render->add_option("--area-samples", r.area_samples,
                        "Point lights the emissive surfaces become, in all (default 65536)")
         ->check(setting(lc::kSettingAreaLightSamples));
-    render->add_option("--seed", r.seed, "Seed for pixel jitter and light-tree representatives")
+    render->add_option("--light-samples", r.light_samples, "sampled: lights drawn per camera sample (default 1)")
+        ->check(setting(lc::kSettingLightSamples));
+    render->add_option("--light-pick", r.light_pick,
+                       "sampled: how lights are drawn: tree (importance through the light tree, the default), "
+                       "uniform or power")
+        ->check(ask(lc::light_pick_problem));
+    render->add_option("--seed", r.seed, "Seed for pixel jitter, light-tree representatives and light samples")
         ->check(setting(lc::kSettingSeed));
     render->add_option("--threads", r.threads, "CPU threads (0 = all cores)");
     render->add_option("--device", r.device.device,

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "lightcuts/image.h"
+#include "lightcuts/settings.h"
 
 namespace lc {
 
@@ -150,9 +151,9 @@ void OutputSet::commit() {
 OutputSet reserve_render_outputs(const RenderOutputs& outputs, const fs::path& scene_file, std::string_view method) {
     if (outputs.image.extension() != ".exr")
         throw std::invalid_argument("image " + outputs.image.string() + ": must end in .exr");
-    if (!outputs.cut_heatmap.empty() && method != "lightcuts")
+    if (!outputs.cut_heatmap.empty() && !method_selects_cuts(method))
         throw std::invalid_argument("cut heatmap " + outputs.cut_heatmap.string() +
-                                    ": needs method lightcuts, not " + std::string(method));
+                                    ": needs method lightcuts or stochastic, not " + std::string(method));
     OutputSet set;
     set.add_input(scene_file, "scene");
     set.add(outputs.image, "image");

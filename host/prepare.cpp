@@ -102,6 +102,10 @@ gpu::FrameParams make_frame_params(const PreparedScene& prepared, const RenderOp
     f.loop_probe_rounds = 2;
     f.env_width = prepared.scene.environment.width;
     f.env_height = prepared.scene.environment.height;
+    f.light_samples = options.light_samples;
+    f.light_pick = options.light_pick == "uniform" ? gpu::kLightPickUniform
+                   : options.light_pick == "power" ? gpu::kLightPickPower
+                                                   : gpu::kLightPickTree;
     return f;
 }
 

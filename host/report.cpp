@@ -130,7 +130,9 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
         if (same != r.buffer_bytes.end()) same->bytes = bytes;
         else r.buffer_bytes.push_back({name, bytes});
     }
-    if (options.method == "lightcuts") r.lightcuts = lightcuts_report(options, prepared, s);
+    if (method_selects_cuts(options.method)) r.lightcuts = lightcuts_report(options, prepared, s);
+    if (options.method == "sampled") r.sampling = SamplingReport{options.light_samples, options.light_pick};
+    r.seed = options.seed;
     return r;
 }
 
@@ -150,6 +152,9 @@ std::string report_text(const RenderReport& r) {
         text += format("  %u tile(s) rendered again with the work split finer (the driver cut long loops short)\n",
                        r.loop_limit_retries);
     if (r.lightcuts) text += lightcuts_text(r, *r.lightcuts);
+    if (r.sampling)
+        text += format("  %u light sample(s) per camera sample, picked by %s\n", r.sampling->light_samples,
+                       r.sampling->light_pick.c_str());
     return text;
 }
 
@@ -163,6 +168,7 @@ std::string report_json(const RenderReport& r) {
         {"width", r.width},
         {"height", r.height},
         {"spp", r.spp},
+        {"seed", r.seed},
         {"triangles", r.triangles},
         {"lights", r.lights},
         {"black_lights", r.black_lights},
@@ -183,6 +189,8 @@ std::string report_json(const RenderReport& r) {
         {"buffer_bytes", buffers},
     };
     if (r.lightcuts) j["lightcuts"] = lightcuts_json(*r.lightcuts);
+    if (r.sampling)
+        j["sampling"] = {{"light_samples", r.sampling->light_samples}, {"light_pick", r.sampling->light_pick}};
     return j.dump(2) + "\n";
 }
 

@@ -33,6 +33,7 @@ std::string setting_problem(std::string_view key, double value) {
     if (key == kSettingMaxCut) return integer_problem(value, 1, kMaxU32);
     if (key == kSettingSeed) return integer_problem(value, 0, kMaxU32);
     if (key == kSettingWidth || key == kSettingHeight) return integer_problem(value, 1, kMaxImageSide);
+    if (key == kSettingLightSamples) return integer_problem(value, 1, kMaxLightSamplesPerPoint);
     if (key == kSettingAreaLightSamples || key == kSettingDirections)
         return integer_problem(value, 1, kMaxLightSamples);
     if (key == kSettingRelativeError) {
@@ -44,18 +45,26 @@ std::string setting_problem(std::string_view key, double value) {
 }
 
 std::string method_problem(std::string_view method) {
-    if (method == "brute" || method == "lightcuts") return "";
-    return "must be \"brute\" or \"lightcuts\", got \"" + std::string(method) + "\"";
+    if (method == "brute" || method == "lightcuts" || method == "sampled" || method == "stochastic") return "";
+    return "must be \"brute\", \"lightcuts\", \"sampled\" or \"stochastic\", got \"" + std::string(method) + "\"";
+}
+
+std::string light_pick_problem(std::string_view pick) {
+    if (pick == "tree" || pick == "uniform" || pick == "power") return "";
+    return "must be \"tree\", \"uniform\" or \"power\", got \"" + std::string(pick) + "\"";
 }
 
 void validate_render_options(const RenderOptions& o) {
     std::string problem = method_problem(o.method);
     if (!problem.empty()) throw std::invalid_argument("method " + problem);
+    problem = light_pick_problem(o.light_pick);
+    if (!problem.empty()) throw std::invalid_argument(std::string(kSettingLightPick) + " " + problem);
     const std::pair<std::string_view, double> values[] = {
         {kSettingSpp, o.spp},
         {kSettingRelativeError, o.relative_error},
         {kSettingMaxCut, o.max_cut},
         {kSettingSeed, o.seed},
+        {kSettingLightSamples, o.light_samples},
     };
     for (const auto& [key, value] : values) {
         problem = setting_problem(key, value);

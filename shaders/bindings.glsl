@@ -41,6 +41,7 @@ LC_CONST uint kSpecHeapCapacity = 4u;     // all cut-heap slots per invocation,
                                           // LightTree::cut_heap_capacity(max_cut)
 LC_CONST uint kSpecSpillStride = 5u;      // invocations the spill buffer is laid out for
 LC_CONST uint kSpecEnableOriented = 6u;   // any spot or oriented light (emission cones)
+LC_CONST uint kSpecStochastic = 7u;       // lightcuts.comp: Stochastic Lightcuts' fresh representatives
 
 // PixelStats.flags
 LC_CONST uint kPixelHeapOverflow = 1u;  // a heap outgrew its capacity (a bug: the capacity
@@ -78,14 +79,19 @@ void lc_count_add(inout uint lo, inout uint hi, uint v) {
 // (48 bytes). The heap slots themselves stay in the spill buffer.
 LC_CONST uint kCutDone = 1u;       // result added to the pixel; later dispatches skip it
 LC_CONST uint kCutSpilled = 2u;    // the heap went past kHeapShared slots
+LC_CONST uint kCutSelected = 4u;   // stochastic: the cut is final; its clusters are being shaded
 struct CutState {
     uint heap_size;
     uint cut_size;
     uint shadow_rays;
     uint flags;                    // kCut* bits
     float leaf_r, leaf_g, leaf_b;
+    // While the cut is refined: the running sum of the heap's estimates.
+    // Stochastic, once kCutSelected: leaf_sum plus the fresh estimates of
+    // heap slots [0, shaded).
     float heap_r, heap_g, heap_b;
-    uint pad0, pad1;
+    uint shaded;
+    uint pad0;
 };
 
 // PushConstants.cut_flags

@@ -50,6 +50,10 @@ uint lc_tile_pixel() {
     return i < push.tile_width * push.tile_height ? i : kInvalidIndex;
 }
 
+// Image coordinates of tile pixel i.
+uint lc_tile_x(uint i) { return push.tile_x + i % push.tile_width; }
+uint lc_tile_y(uint i) { return push.tile_y + i / push.tile_width; }
+
 SurfacePoint lc_texel_surface(GBufferTexel g) {
     SurfacePoint sp;
     sp.p = vec3(g.px, g.py, g.pz);

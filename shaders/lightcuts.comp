@@ -1,18 +1,25 @@
 // Lightcuts (Walter et al. 2005, section 4): cut selection and shading at the
 // G-buffer point of every tile pixel; the result is added to the pixel's sum.
+// With kStochastic (--method stochastic, Yuksel 2019) the cut is selected
+// the same way and then each of its clusters that is not a single light is
+// shaded again with a representative drawn afresh (shared/lightcuts.h,
+// lc_shade_stochastic).
 //
 // One dispatch normally runs each cut from the roots to the end. Where the
 // driver limits how long an invocation may loop (lavapipe), the host gives
-// each dispatch a budget of refinements instead and dispatches until every
-// cut is final; a cut that is not final yet waits in CutState and the heap
-// buffer.
+// each dispatch a budget of steps instead (a refinement, or a stochastic
+// cluster shaded) and dispatches until every cut is done; a cut that is not
+// done yet waits in CutState and the heap buffer.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
 #include "kernel.glsl"
 #include "heap.glsl"
 #define LC_LIGHT(i) lights[i]
+#include "shared/sampling.h"
 #include "shared/lightcuts.h"
+
+layout(constant_id = kSpecStochastic) const bool kStochastic = false;
 
 layout(std430, binding = kBindingCutState) buffer CutStates { CutState cut_states[]; };
 
@@ -31,6 +38,8 @@ void main() {
     uint heap_size = 0u;
     vec3 leaf_sum = vec3(0.0f);
     vec3 heap_sum = vec3(0.0f);
+    bool selected = false;  // stochastic: the cut is final; heap_sum is the fresh sum
+    uint shaded = 0u;       // stochastic: heap slots shaded afresh so far
     if ((push.cut_flags & kCutFirstDispatch) != 0u) {
         lc_cut_start(sp, m, frame, heap_size, leaf_sum, heap_sum, stats);
     } else {
@@ -40,17 +49,34 @@ void main() {
         stats.cut_size = s.cut_size;
         stats.shadow_rays = s.shadow_rays;
         g_heap_spilled = (s.flags & kCutSpilled) != 0u;
+        selected = (s.flags & kCutSelected) != 0u;
+        shaded = s.shaded;
         leaf_sum = vec3(s.leaf_r, s.leaf_g, s.leaf_b);
         heap_sum = vec3(s.heap_r, s.heap_g, s.heap_b);
         lc_heap_restore(heap_size);
     }
 
-    bool final_cut = false;
-    for (uint r = 0u; r < push.refine_budget && !final_cut; ++r)
-        final_cut = !lc_cut_refine(sp, m, frame, heap_size, leaf_sum, heap_sum, stats);
+    uint stream = kStochastic ? lc_sample_stream(frame.seed, lc_tile_x(i), lc_tile_y(i), push.sample_index) : 0u;
+    bool done = false;
+    for (uint r = 0u; r < push.refine_budget && !done; ++r) {
+        if (!selected) {
+            if (lc_cut_refine(sp, m, frame, heap_size, leaf_sum, heap_sum, stats)) continue;
+            selected = true;
+            heap_sum = leaf_sum;  // the fresh sum starts from the exact single lights
+            done = !kStochastic;
+        } else if (shaded < heap_size) {
+            heap_sum += lc_shade_cluster_stochastic(sp, m, LC_HEAP_LOAD(shaded).node, frame.min_distance2, stream,
+                                                    stats);
+            shaded += 1u;
+        } else {
+            done = true;
+        }
+    }
+    // A stochastic cut whose last cluster was shaded in the last step is done.
+    if (kStochastic && selected && shaded >= heap_size) done = true;
     bool cut_short = lc_loops_were_cut_short();
 
-    if (!final_cut) {
+    if (!done) {
         PixelStats ps = pixel_stats[i];
         if ((push.cut_flags & kCutLastDispatch) != 0u) ps.flags |= kPixelCutUnfinished;
         if (cut_short) ps.flags |= kPixelLoopLimit;
@@ -61,16 +87,16 @@ void main() {
         s.heap_size = heap_size;
         s.cut_size = stats.cut_size;
         s.shadow_rays = stats.shadow_rays;
-        s.flags = g_heap_spilled ? kCutSpilled : 0u;
+        s.flags = (g_heap_spilled ? kCutSpilled : 0u) | (selected ? kCutSelected : 0u);
         s.leaf_r = leaf_sum.x; s.leaf_g = leaf_sum.y; s.leaf_b = leaf_sum.z;
         s.heap_r = heap_sum.x; s.heap_g = heap_sum.y; s.heap_b = heap_sum.z;
+        s.shaded = shaded;
         s.pad0 = 0u;
-        s.pad1 = 0u;
         cut_states[i] = s;
         return;
     }
 
-    lc_accumulate(i, lc_cut_result(heap_size, leaf_sum));
+    lc_accumulate(i, kStochastic ? heap_sum : lc_cut_result(heap_size, leaf_sum));
     PixelStats ps = pixel_stats[i];
     lc_count_add(ps.cut_size_lo, ps.cut_size_hi, stats.cut_size);
     lc_count_add(ps.shadow_rays_lo, ps.shadow_rays_hi, stats.shadow_rays);

@@ -9,8 +9,8 @@
 void main() {
     uint i = lc_tile_pixel();
     if (i == kInvalidIndex) return;
-    uint x = push.tile_x + i % push.tile_width;
-    uint y = push.tile_y + i / push.tile_width;
+    uint x = lc_tile_x(i);
+    uint y = lc_tile_y(i);
 
     SurfacePoint sp;
     GBufferTexel g;

@@ -64,6 +64,9 @@ accept() {  # options for a CPU render of the one-triangle scene
 accept --width 1 --height 1 --spp 1 --error 0 --max-cut 1 --seed 0 --method lightcuts
 accept --width 1 --height 1 --spp 65536 --error 1 --max-cut 4000000000 --seed 4294967295 --method lightcuts
 accept --width 1 --height 1 --max-cut 4294967295 --method lightcuts
+accept --width 2 --height 2 --method sampled --light-samples 1 --light-pick uniform
+accept --width 2 --height 2 --method sampled --light-samples 65536 --light-pick power
+accept --width 2 --height 2 --method stochastic --spp 4 --light-pick tree
 accept --width 16384 --height 1 --method brute
 accept --width 1 --height 16384 --method brute
 integer="must be an integer from"
@@ -77,7 +80,10 @@ for bad in "--seed=-1" "--seed=4294967296"; do
   expect_error "--seed: $integer 0 to 4294967295" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
 for side in width height; do for bad in 0 16385; do
   expect_error "--$side: $integer 1 to 16384" render "$mini" -o "$tmp/edge2.exr" "--$side=$bad"; done; done
-expect_error '--method: must be "brute" or "lightcuts", got "fast"' render "$mini" -o "$tmp/edge2.exr" --method fast
+for bad in "--light-samples=0" "--light-samples=65537"; do
+  expect_error "--light-samples: $integer 1 to 65536" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
+expect_error '--method: must be "brute", "lightcuts", "sampled" or "stochastic", got "fast"' render "$mini" -o "$tmp/edge2.exr" --method fast
+expect_error '--light-pick: must be "tree", "uniform" or "power", got "random"' render "$mini" -o "$tmp/edge2.exr" --light-pick random
 expect_error '--device: must be "auto", "cpu" or "vulkan"' render "$mini" -o "$tmp/edge2.exr" --device gpu
 [ -e "$tmp/edge2.exr" ] && fail "a refused render left edge2.exr behind"
 
@@ -100,6 +106,8 @@ no_output() {
 }
 # Combinations refused before rendering.
 expect_error "needs method lightcuts" render "$mini" -o "$tmp/v.exr" --method brute --cut-heatmap "$tmp/v_cuts.png"
+expect_error "needs method lightcuts or stochastic, not sampled" render "$mini" -o "$tmp/v.exr" --method sampled \
+  --cut-heatmap "$tmp/v_cuts.png"
 expect_error "is also the PNG preview" render "$mini" -o "$tmp/v.exr" --method lightcuts --cut-heatmap "$tmp/v.png"
 expect_error "folder $tmp/nowhere does not exist" render "$mini" -o "$tmp/v.exr" --stats "$tmp/nowhere/v.json"
 mkdir "$tmp/v_dir"

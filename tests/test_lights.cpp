@@ -265,7 +265,7 @@ TEST(EnvironmentLight, SingleTexelIsADirectionalLight) {
     const double solid_angle =
         2.0 * pi / map.width * (std::cos(pi * ty / map.height) - std::cos(pi * (ty + 1) / map.height));
     float d[3];
-    environment_direction((tx + 0.5f) / map.width, (ty + 0.5f) / map.height, d);
+    environment_direction((float(tx) + 0.5f) / float(map.width), (float(ty) + 0.5f) / float(map.height), d);
     const glm::vec3 towards(d[0], d[1], d[2]);
     const gpu::Light sun = test::directional_light(-towards, glm::vec3(float(1000.0 * solid_angle)));
     for (glm::vec3 n : {glm::vec3(0, 1, 0), glm::normalize(towards + glm::vec3(0, 0.3f, 0)), glm::vec3(1, 0, 0)}) {

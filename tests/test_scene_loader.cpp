@@ -463,7 +463,8 @@ const BadInput kBadInputs[] = {
     {"bad_roughness.json", "bad_roughness.json", "meshes[0].material.roughness: ", "(0, 1]"},
     {"bad_kd_override.json", "bad_kd_override.json", "meshes[0].material.kd[1]: ", "at most 1"},
     // Render block.
-    {"bad_render_method.json", "bad_render_method.json", "render.method: ", "\"brute\" or \"lightcuts\""},
+    {"bad_render_method.json", "bad_render_method.json", "render.method: ",
+     "\"brute\", \"lightcuts\", \"sampled\" or \"stochastic\""},
     {"bad_render_spp.json", "bad_render_spp.json", "render.spp: ", "must be an integer from 1 to 65536"},
     {"bad_render_relative_error.json", "bad_render_relative_error.json", "render.relative_error: ",
      "must be a number from 0 to 1"},
@@ -528,6 +529,8 @@ const BadSetting kBadSettings[] = {
     {"relative_error", "1.5", 1.5},
     {"relative_error", "-0.1", -0.1},
     {"seed", "4294967296", 4294967296.0},
+    {"light_samples", "0", 0.0},
+    {"light_samples", "65537", 65537.0},
 };
 
 INSTANTIATE_TEST_SUITE_P(Cases, RenderSettingRange, ::testing::ValuesIn(kBadSettings),
@@ -543,6 +546,18 @@ TEST(SceneLoader, RenderSettingsAcceptTheFullRange) {
     EXPECT_FLOAT_EQ(scene.render.relative_error, 1.0f);
     EXPECT_EQ(scene.render.max_cut, 4000000000u);
     EXPECT_EQ(scene.render.seed, 0u);
+}
+
+TEST(SceneLoader, SamplingSettings) {
+    TempDir dir;
+    const Scene scene = load_scene(
+        scene_with_render(dir, R"({"method": "sampled", "light_samples": 65536, "light_pick": "power"})"));
+    EXPECT_EQ(scene.render.method, "sampled");
+    EXPECT_EQ(scene.render.light_samples, 65536u);
+    EXPECT_EQ(scene.render.light_pick, "power");
+    const fs::path bad = scene_with_render(dir, R"({"light_pick": "random"})");
+    EXPECT_EQ(input_error_of([&] { load_scene(bad); }),
+              bad.lexically_normal().string() + ": render.light_pick: " + light_pick_problem("random"));
 }
 
 TEST(SceneLoader, RenderSettingProblemTextMatchesTheCommandLine) {

@@ -100,12 +100,17 @@ private:
         const std::string path = "render";
         in_.expect_object(j, path);
         in_.check_keys(j, path, {kSettingMethod, kSettingSpp, kSettingRelativeError, kSettingMaxCut, kSettingSeed,
-                                 kSettingAreaLightSamples});
+                                 kSettingAreaLightSamples, kSettingLightSamples, kSettingLightPick});
         RenderSettings& r = scene_.render;
         if (const json* v = JsonReader::find(j, kSettingMethod)) {
             const std::string field = join_key(path, kSettingMethod);
             r.method = in_.string(*v, field);
             if (const std::string problem = method_problem(r.method); !problem.empty()) in_.fail(field, problem);
+        }
+        if (const json* v = JsonReader::find(j, kSettingLightPick)) {
+            const std::string field = join_key(path, kSettingLightPick);
+            r.light_pick = in_.string(*v, field);
+            if (const std::string problem = light_pick_problem(r.light_pick); !problem.empty()) in_.fail(field, problem);
         }
         const auto setting = [&](std::string_view key) -> std::optional<double> {
             const json* v = JsonReader::find(j, key);
@@ -120,6 +125,7 @@ private:
         if (const auto v = setting(kSettingMaxCut)) r.max_cut = static_cast<std::uint32_t>(*v);
         if (const auto v = setting(kSettingSeed)) r.seed = static_cast<std::uint32_t>(*v);
         if (const auto v = setting(kSettingAreaLightSamples)) r.area_light_samples = static_cast<std::uint32_t>(*v);
+        if (const auto v = setting(kSettingLightSamples)) r.light_samples = static_cast<std::uint32_t>(*v);
     }
 
     // -- meshes -------------------------------------------------------------

@@ -22,6 +22,7 @@ struct SpecData {
     std::uint32_t heap_capacity;
     std::uint32_t spill_stride;
     VkBool32 enable_oriented;
+    VkBool32 stochastic;
 };
 
 Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const KernelCode& code,
@@ -44,6 +45,7 @@ Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const Ker
         {gpu::kSpecHeapCapacity, offsetof(SpecData, heap_capacity), sizeof(std::uint32_t)},
         {gpu::kSpecSpillStride, offsetof(SpecData, spill_stride), sizeof(std::uint32_t)},
         {gpu::kSpecEnableOriented, offsetof(SpecData, enable_oriented), sizeof(VkBool32)},
+        {gpu::kSpecStochastic, offsetof(SpecData, stochastic), sizeof(VkBool32)},
     };
     VkSpecializationInfo spec_info{};
     spec_info.mapEntryCount = std::uint32_t(std::size(entries));
@@ -77,6 +79,7 @@ Kernels::Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMetho
     spec.heap_capacity = std::max(heap.capacity, 1u);
     spec.spill_stride = switches.spill_stride;
     spec.enable_oriented = switches.oriented;
+    spec.stochastic = method.stochastic();
     primary_ = compute_pipeline(
         ctx, layout, {lc_spirv_primary, sizeof lc_spirv_primary, "primary.comp (camera rays)"}, spec);
     shading_ = compute_pipeline(ctx, layout, method.kernel(), spec);

@@ -7,37 +7,37 @@
 
 #include "spirv/brute.h"
 #include "spirv/lightcuts.h"
+#include "spirv/sampled.h"
 
 namespace lc::vk {
 
 namespace {
 
-// Brute force: every light at every pixel, in one dispatch or in ranges of
-// lights, one dispatch per range, each adding to the pixel's sum.
-class BruteForce final : public ShadingMethod {
+// A method that loops over a range of items per pixel (brute force: the
+// lights; sampled: the light samples), in one dispatch or in ranges, one
+// dispatch per range, each adding to the pixel's sum.
+class RangedMethod final : public ShadingMethod {
 public:
-    BruteForce(const gpu::FrameParams& frame, const Tuning& tuning)
-        : light_count_(frame.light_count), chunk_(std::max(frame.light_count, 1u)) {
+    RangedMethod(KernelCode code, std::uint32_t items, const Tuning& tuning)
+        : code_(code), items_(items), chunk_(std::max(items, 1u)) {
         if (tuning.lights_per_dispatch > 0) chunk_ = std::min(chunk_, tuning.lights_per_dispatch);
     }
 
-    KernelCode kernel() const override {
-        return {lc_spirv_brute, sizeof lc_spirv_brute, "brute.comp (all lights)"};
-    }
+    KernelCode kernel() const override { return code_; }
 
     std::uint32_t dispatch_count() const override {
-        return std::max(1u, (light_count_ + chunk_ - 1) / chunk_);
+        return std::max(1u, (items_ + chunk_ - 1) / chunk_);
     }
 
     void set_push_constants(std::uint32_t d, gpu::PushConstants& push) const override {
-        const std::uint32_t first = std::min(d * chunk_, light_count_);
+        const std::uint32_t first = std::min(d * chunk_, items_);
         push.light_first = first;
-        push.light_count = std::min(chunk_, light_count_ - first);
+        push.light_count = std::min(chunk_, items_ - first);
     }
 
-    // Each invocation loops over its range of lights (plus the BVH of each
-    // shadow ray), so a quarter of the range is well under the limit that
-    // the whole range went over.
+    // Each invocation loops over its range (plus the BVH of each shadow
+    // ray), so a quarter of the range is well under the limit that the
+    // whole range went over.
     bool split_finer() override {
         if (chunk_ <= 1) return false;
         chunk_ = std::max(1u, chunk_ / 4);
@@ -45,21 +45,23 @@ public:
     }
 
 private:
-    std::uint32_t light_count_;
-    std::uint32_t chunk_;  // lights per dispatch
+    KernelCode code_;
+    std::uint32_t items_;
+    std::uint32_t chunk_;  // items per dispatch
 };
 
 // The first refinement budget when the driver's loop limit forces a split.
 constexpr std::uint32_t kFirstRefineBudget = 128;
 
 // Lightcuts: every cut from the roots to the end in one dispatch, or a
-// budget of refinements per dispatch, the cut paused in CutState and the
-// heap's spill buffer in between.
+// budget of steps per dispatch, the cut paused in CutState and the heap's
+// spill buffer in between. A step is one refinement, or (stochastic) one
+// cluster of the final cut shaded with a fresh representative.
 class Lightcuts final : public ShadingMethod {
 public:
     Lightcuts(const gpu::FrameParams& frame, const LightTree& tree, const Tuning& tuning,
-              std::uint32_t shared_memory_bytes)
-        : max_cut_(frame.max_cut) {
+              std::uint32_t shared_memory_bytes, bool stochastic)
+        : max_cut_(frame.max_cut), stochastic_(stochastic) {
         // Walter 2005 §4 keeps a max-heap of the refinable clusters of the
         // cut; the tree bounds its size, whatever max_cut says. The first K
         // slots live in shared memory, as many as fit a whole workgroup.
@@ -75,14 +77,18 @@ public:
         // node off the heap for good, so a cut never sees more refinements
         // than either allows.
         const std::uint64_t interior = tree.nodes.size() - tree.lights.size();
-        max_refinements_ = std::uint32_t(std::min<std::uint64_t>(frame.max_cut, interior));
+        const std::uint64_t refinements = std::min<std::uint64_t>(frame.max_cut, interior);
+        // The refinements, the step that finds the cut final, and the heap's
+        // clusters shaded afresh.
+        max_steps_ = refinements + 1 + (stochastic ? heap_.capacity : 0);
         if (tuning.refinements_per_dispatch > 0) budget_ = tuning.refinements_per_dispatch;
     }
 
     KernelCode kernel() const override {
         return {lc_spirv_lightcuts, sizeof lc_spirv_lightcuts,
-                "lightcuts.comp (cut selection + shading)"};
+                stochastic_ ? "lightcuts.comp (stochastic lightcuts)" : "lightcuts.comp (cut selection + shading)"};
     }
+    bool stochastic() const override { return stochastic_; }
     HeapLayout heap() const override { return heap_; }
     TileBuffer heap_spill() const override {
         return {"heap spill", std::uint64_t(heap_.capacity) * sizeof(gpu::CutEntry),
@@ -92,10 +98,9 @@ public:
     TileBuffer cut_state() const override { return {"cut state", sizeof(gpu::CutState), ""}; }
     bool reports_cuts() const override { return true; }
 
-    // max_refinements / budget + 1 dispatches of `budget` refinements each
-    // finish every cut (the last one also finds it final).
+    // Dispatches of `budget` steps each that finish every cut.
     std::uint32_t dispatch_count() const override {
-        return budget_ == gpu::kUnlimitedRefinements ? 1 : max_refinements_ / budget_ + 1;
+        return budget_ == gpu::kUnlimitedRefinements ? 1 : std::uint32_t((max_steps_ + budget_ - 1) / budget_);
     }
 
     void set_push_constants(std::uint32_t d, gpu::PushConstants& push) const override {
@@ -113,8 +118,9 @@ public:
 
 private:
     std::uint32_t max_cut_;
+    bool stochastic_;
     HeapLayout heap_;
-    std::uint32_t max_refinements_ = 0;
+    std::uint64_t max_steps_ = 0;
     std::uint32_t budget_ = gpu::kUnlimitedRefinements;  // refinements per dispatch
 };
 
@@ -124,9 +130,14 @@ std::unique_ptr<ShadingMethod> make_shading_method(const RenderOptions& options,
                                                    const gpu::FrameParams& frame,
                                                    const LightTree& tree, const Tuning& tuning,
                                                    std::uint32_t shared_memory_bytes) {
-    if (options.method == "lightcuts")
-        return std::make_unique<Lightcuts>(frame, tree, tuning, shared_memory_bytes);
-    return std::make_unique<BruteForce>(frame, tuning);
+    if (method_selects_cuts(options.method))
+        return std::make_unique<Lightcuts>(frame, tree, tuning, shared_memory_bytes, options.method == "stochastic");
+    if (options.method == "sampled")
+        return std::make_unique<RangedMethod>(
+            KernelCode{lc_spirv_sampled, sizeof lc_spirv_sampled, "sampled.comp (light samples)"},
+            frame.light_samples, tuning);
+    return std::make_unique<RangedMethod>(
+        KernelCode{lc_spirv_brute, sizeof lc_spirv_brute, "brute.comp (all lights)"}, frame.light_count, tuning);
 }
 
 }  // namespace lc::vk

@@ -52,6 +52,8 @@ public:
     virtual TileBuffer cut_state() const { return {"cut state", 0, ""}; }
     // True when the method's cut sizes go into RenderStats::cut_size.
     virtual bool reports_cuts() const { return false; }
+    // The kernel's kSpecStochastic (lightcuts.comp only).
+    virtual bool stochastic() const { return false; }
 
     // Dispatches one sample's shading takes with the current split.
     virtual std::uint32_t dispatch_count() const = 0;
@@ -63,7 +65,8 @@ public:
     virtual bool split_finer() = 0;
 };
 
-// "brute" or "lightcuts" (options.method, already validated).
+// "brute", "lightcuts", "sampled" or "stochastic" (options.method, already
+// validated).
 // `shared_memory_bytes` is the device's maxComputeSharedMemorySize.
 std::unique_ptr<ShadingMethod> make_shading_method(const RenderOptions& options,
                                                    const gpu::FrameParams& frame,

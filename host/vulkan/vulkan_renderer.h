@@ -20,8 +20,9 @@ struct Tuning {
     double target_dispatch_ms = 30.0;
     // Split the work of each pixel from the start, as is otherwise done only
     // where the driver cuts long loops short (0: no split): brute force over
-    // at most this many lights per dispatch, Lightcuts with at most this many
-    // refinements per dispatch.
+    // at most this many lights per dispatch (sampled: light samples),
+    // Lightcuts with at most this many steps per dispatch (a refinement, or a
+    // stochastic cluster shaded).
     std::uint32_t lights_per_dispatch = 0;
     std::uint32_t refinements_per_dispatch = 0;
 

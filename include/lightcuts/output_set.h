@@ -65,12 +65,12 @@ struct RenderOutputs {
     std::filesystem::path image;         // linear OpenEXR; must end in .exr
     bool png_preview = true;             // tone-mapped PNG beside it (the image's name, .png)
     std::filesystem::path stats;         // JSON report (report.h); empty for none
-    std::filesystem::path cut_heatmap;   // per-pixel cut size as a PNG; lightcuts only; empty for none
+    std::filesystem::path cut_heatmap;   // per-pixel cut size as a PNG; lightcuts and stochastic only; empty for none
 };
 
 // Refuses, before anything is rendered, every combination that could not be
 // written (std::invalid_argument): an image not ending in .exr, a cut heatmap
-// without method "lightcuts", and whatever OutputSet::add refuses, the
+// without a method that selects cuts (lightcuts, stochastic), and whatever OutputSet::add refuses, the
 // scene file being an input. Returns the set holding the temporaries.
 OutputSet reserve_render_outputs(const RenderOutputs& outputs, const std::filesystem::path& scene_file,
                                  std::string_view method);

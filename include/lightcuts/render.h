@@ -50,12 +50,14 @@ struct SceneArray {
 std::vector<SceneArray> scene_arrays(const PreparedScene& prepared);
 
 struct RenderOptions {
-    std::string method = "brute";     // "brute" or "lightcuts"
+    std::string method = "brute";     // "brute", "lightcuts", "sampled" or "stochastic"
     std::uint32_t width = 0, height = 0;  // 0: the scene's camera size
     std::uint32_t spp = 1;
     float relative_error = 0.02f;
     std::uint32_t max_cut = 1000;
     std::uint32_t seed = 1;
+    std::uint32_t light_samples = 1;  // sampled: lights drawn per camera sample
+    std::string light_pick = "tree";  // sampled: "tree", "uniform" or "power"
     unsigned threads = 0;             // CPU: 0 = all cores
     bool progress = false;            // show percentage and ETA on stderr
 };

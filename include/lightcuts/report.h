@@ -29,9 +29,14 @@ struct LightcutsReport {
     std::uint64_t heap_spill_samples = 0;     // GPU only
 };
 
+struct SamplingReport {
+    std::uint32_t light_samples = 0;          // per camera sample
+    std::string light_pick;                   // "tree", "uniform" or "power"
+};
+
 struct RenderReport {
     std::string scene, method, device;
-    std::uint32_t width = 0, height = 0, spp = 0;
+    std::uint32_t width = 0, height = 0, spp = 0, seed = 0;
     std::size_t triangles = 0, lights = 0, bvh_nodes = 0;
     std::size_t black_lights = 0;             // zero-intensity lights left out of the tree
     std::size_t area_lights = 0;              // samples of the emissive surfaces (in `lights`)
@@ -46,7 +51,8 @@ struct RenderReport {
     // The kernels' arrays (scene_arrays), then the device's own buffers; a
     // device buffer of the same name replaces the scene array's entry.
     std::vector<BufferBytes> buffer_bytes;
-    std::optional<LightcutsReport> lightcuts; // method "lightcuts" only
+    std::optional<LightcutsReport> lightcuts; // methods "lightcuts" and "stochastic"
+    std::optional<SamplingReport> sampling;   // method "sampled" only
 };
 
 // `scene_file` is reported as given; `load_seconds` is the time load_scene took.

@@ -14,6 +14,7 @@ inline constexpr std::uint32_t kMaxSpp = 65536;        // camera rays per pixel
 inline constexpr std::uint32_t kMaxImageSide = 16384;  // width and height
 inline constexpr float kMaxRelativeError = 1.0f;       // lightcuts threshold, as a fraction
 inline constexpr std::uint32_t kMaxLightSamples = 1u << 24;  // area-light samples, environment directions
+inline constexpr std::uint32_t kMaxLightSamplesPerPoint = 65536;  // --method sampled, per camera sample
 // max_cut may be any positive 32-bit value: the cut heap is sized by the
 // light tree, never by max_cut (a cut cannot outgrow the tree).
 
@@ -28,13 +29,23 @@ inline constexpr std::string_view kSettingWidth = "width";
 inline constexpr std::string_view kSettingHeight = "height";
 inline constexpr std::string_view kSettingAreaLightSamples = "area_light_samples";
 inline constexpr std::string_view kSettingDirections = "directions";  // of an environment
+inline constexpr std::string_view kSettingLightSamples = "light_samples";  // --method sampled
+inline constexpr std::string_view kSettingLightPick = "light_pick";        // --method sampled
 
 // What is wrong with `value` for the numeric setting `key` (one of the
 // kSetting* names above, not method), or "" when it is valid. Integer
 // settings refuse fractions; NaN and infinities are refused everywhere.
 std::string setting_problem(std::string_view key, double value);
 
-// What is wrong with a method name, or "" for "brute" and "lightcuts".
+// What is wrong with a method name, or "" for "brute", "lightcuts",
+// "sampled" and "stochastic".
 std::string method_problem(std::string_view method);
+
+// True for the methods that select a lightcut per shaded point (and so
+// report cut sizes): "lightcuts" and "stochastic".
+inline bool method_selects_cuts(std::string_view method) { return method == "lightcuts" || method == "stochastic"; }
+
+// What is wrong with a light pick, or "" for "tree", "uniform" and "power".
+std::string light_pick_problem(std::string_view pick);
 
 }  // namespace lc

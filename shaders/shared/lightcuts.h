@@ -10,10 +10,6 @@
 // No include guard: each kernel context (a GLSL shader, a C++ kernel
 // struct in host/cpu_kernel.h) includes it exactly once.
 
-vec3 lc_node_intensity(LightNode node) {
-    return vec3(node.intensity_r, node.intensity_g, node.intensity_b);
-}
-
 // Unscaled contribution of a light (material * geometry * visibility):
 // the representative's estimate is this times the cluster's RGB intensity.
 vec3 lc_rep_unit(SurfacePoint sp, uint light_index, float min_distance2,
@@ -150,13 +146,36 @@ vec3 lc_cut_result(uint heap_size, vec3 leaf_sum) {
     return result;
 }
 
-vec3 lc_shade_lightcuts(SurfacePoint sp, FrameParams f, LC_INOUT(ShadeStats) stats) {
-    Material m = LC_MATERIAL(sp.material);
-    uint heap_size = 0u;
-    vec3 leaf_sum = vec3(0.0f);
+// Runs the cut selection from the roots to the final cut.
+void lc_select_cut(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_size, LC_OUT(vec3) leaf_sum,
+                   LC_INOUT(ShadeStats) stats) {
     vec3 heap_sum = vec3(0.0f);
     lc_cut_start(sp, m, f, heap_size, leaf_sum, heap_sum, stats);
     while (lc_cut_refine(sp, m, f, heap_size, leaf_sum, heap_sum, stats)) {
     }
+}
+
+vec3 lc_shade_lightcuts(SurfacePoint sp, FrameParams f, LC_INOUT(ShadeStats) stats) {
+    Material m = LC_MATERIAL(sp.material);
+    uint heap_size = 0u;
+    vec3 leaf_sum = vec3(0.0f);
+    lc_select_cut(sp, m, f, heap_size, leaf_sum, stats);
     return lc_cut_result(heap_size, leaf_sum);
+}
+
+// Stochastic Lightcuts (Yuksel 2019): the cut is selected exactly as above,
+// with the fixed representatives, so it depends on the shaded point only;
+// then every cluster of the cut that is not a single light is shaded again
+// with a representative drawn afresh from the sample's `stream`
+// (lc_shade_cluster_stochastic, one more shadow ray each). Single lights are
+// exact already. Each cluster's estimate is unbiased given the cut, so the
+// pixel is, and the mean over samples converges to the exact image.
+vec3 lc_shade_stochastic(SurfacePoint sp, FrameParams f, uint stream, LC_INOUT(ShadeStats) stats) {
+    Material m = LC_MATERIAL(sp.material);
+    uint heap_size = 0u;
+    vec3 result = vec3(0.0f);
+    lc_select_cut(sp, m, f, heap_size, result, stats);
+    for (uint i = 0u; i < heap_size; ++i)
+        result += lc_shade_cluster_stochastic(sp, m, LC_HEAP_LOAD(i).node, f.min_distance2, stream, stats);
+    return result;
 }

@@ -150,7 +150,14 @@ struct CutEntry {
     float unit_r, unit_g, unit_b;
 };
 
-// Everything a frame's kernels need besides the buffers (112 bytes); one
+// How --method sampled draws its lights (FrameParams.light_pick):
+// through the light tree by importance at the shaded point, with the same
+// probability for every light, or in proportion to each light's power.
+LC_CONST uint kLightPickTree = 0u;
+LC_CONST uint kLightPickUniform = 1u;
+LC_CONST uint kLightPickPower = 2u;
+
+// Everything a frame's kernels need besides the buffers (128 bytes); one
 // storage buffer on the GPU, the same for every tile and sample. The camera
 // basis vectors are pre-scaled by tan(fov/2) (and aspect for right).
 struct FrameParams {
@@ -166,7 +173,9 @@ struct FrameParams {
     uint roots[kLightTypeCount];  // root node of each type's tree; kInvalidIndex if absent
     uint loop_probe_rounds;       // always 2: see lc_loops_were_cut_short (shaders/kernel.glsl)
     uint env_width, env_height;   // environment map seen by rays that leave; 0 x 0: black
-    uint pad0;
+    uint light_samples;           // --method sampled: lights drawn per camera sample
+    uint light_pick;              // --method sampled: kLightPick*
+    uint pad0, pad1, pad2;
 };
 
 #ifdef __cplusplus

@@ -42,6 +42,16 @@ constexpr double kCutsDifferFraction = 0.004;
 // Lightcuts, every pixel whose cut is the same: as kBruteRelative.
 // Measured at most 6.3e-5 (shipped room; random scenes 1.9e-5).
 constexpr double kLightcutsRelative = 2e-4;
+// Sampled and stochastic: pixels where one device's light choice went
+// another way than the other's (a random number within rounding of a branch
+// probability), as a fraction of the image. Measured at most 2 of 1280
+// pixels (0.16%, stochastic, all light kinds).
+constexpr double kSampledDifferFraction = 0.01;
+// Tree sampling: a light's probability is a product of ratios of cluster
+// importances, each made of the bounds' acos, asin and cos, which the
+// device computes with its own approximations. Measured at most 1.3e-3
+// (spot lights; 8.3e-4 for the other kinds).
+constexpr double kTreePdfRelative = 4e-3;
 // Shadow rays counted: |gpu - cpu| <= kShadowRaysRelative * cpu + 1.
 // Measured 3.4e-6 (1 of 291159, shipped room, lightcuts), equal elsewhere.
 constexpr double kShadowRaysRelative = 1e-5;

@@ -1,0 +1,171 @@
+// The stochastic methods: light sampling through the light tree
+// (--method sampled) and the fresh representatives of Stochastic Lightcuts
+// (--method stochastic). Shared by the CPU reference and the Vulkan
+// kernels; needs trace.h and shading.h first. The includer defines
+// LC_LIGHT_NODE(i) -> LightNode as for shared/lightcuts.h.
+//
+// Every random number is a hash of (seed, pixel, camera sample, stream), so
+// a render is deterministic for its seed and the same on both devices, and
+// no two light samples or clusters of a pixel share their numbers.
+// No include guard: each kernel context includes it exactly once.
+
+// The random stream of camera sample `s` of pixel (x, y); a different
+// stream from the pixel jitter of lc_pixel_sample.
+uint lc_sample_stream(uint seed, uint x, uint y, uint s) {
+    return lc_hash(lc_hash(seed ^ 0x5bd1e995u) ^ lc_hash(x ^ lc_hash(y ^ lc_hash(s))));
+}
+
+// Sub-stream `k` of a stream: light sample k, or the cluster with node k.
+uint lc_substream(uint stream, uint k) { return lc_hash(stream ^ lc_hash(k + 0x9e3779b9u)); }
+
+// How much a cluster is worth sampling at a shaded point (Conty Estevez and
+// Kulla 2018; pbrt-v4's BVHLightSampler): its intensity (luminance) times
+// the material, cosine and emission bounds of the error bound, over the
+// squared distance to the box centre, kept from falling below the squared
+// radius of the box's bounding sphere (or d_min^2) so that a point inside a
+// cluster does not make it infinitely important. Zero exactly where the
+// error bound is zero, i.e. where no light of the cluster can contribute:
+// tree sampling then never misses a light that can, which keeps it unbiased.
+float lc_cluster_importance(SurfacePoint sp, Material m, LightNode node, float min_distance2) {
+    vec3 brdf;
+    float emission;
+    bool positional;
+    if (!lc_cluster_shape_bound(sp, m, node, brdf, emission, positional)) return 0.0f;
+    float importance = lc_luminance(brdf * lc_node_intensity(node)) * emission;
+    if (positional) {
+        vec3 lo = vec3(node.min_x, node.min_y, node.min_z) - sp.p;
+        vec3 hi = vec3(node.max_x, node.max_y, node.max_z) - sp.p;
+        vec3 c = 0.5f * (lo + hi);
+        vec3 half_diagonal = 0.5f * (hi - lo);
+        importance /= max(max(dot(c, c), dot(half_diagonal, half_diagonal)), min_distance2);
+    }
+    return importance;
+}
+
+// What tree descent weighs a node by: lc_cluster_importance for
+// kLightPickTree, the luminance of the cluster's intensity for
+// kLightPickPower (which makes the descent pick each light in proportion to
+// its power, with no table beyond the tree).
+float lc_pick_weight(SurfacePoint sp, Material m, uint node_index, uint pick, float min_distance2) {
+    LightNode node = LC_LIGHT_NODE(node_index);
+    if (pick == kLightPickPower) return lc_luminance(lc_node_intensity(node));
+    return lc_cluster_importance(sp, m, node, min_distance2);
+}
+
+// Probability that descent from `node_index` goes to its left child, in
+// proportion to the children's weights. Where neither child has any weight
+// (the parent's bound was not zero, but both tighter ones are: no light
+// below can contribute) it goes by power instead: whatever light it reaches
+// contributes zero without a shadow ray, and the probabilities of all
+// lights still sum to one.
+float lc_left_probability(SurfacePoint sp, Material m, uint node_index, uint pick, float min_distance2) {
+    uint left = LC_LIGHT_NODE(node_index).left;
+    float wl = lc_pick_weight(sp, m, left, pick, min_distance2);
+    float wr = lc_pick_weight(sp, m, left + 1u, pick, min_distance2);
+    if (!(wl + wr > 0.0f) && pick != kLightPickPower) {
+        wl = lc_pick_weight(sp, m, left, kLightPickPower, min_distance2);
+        wr = lc_pick_weight(sp, m, left + 1u, kLightPickPower, min_distance2);
+    }
+    float total = wl + wr;
+    return total > 0.0f ? wl / total : 0.5f;
+}
+
+// Probability of picking the tree of light type `type` (its root), in
+// proportion to the roots' weights; 0 when no tree has any.
+float lc_root_probability(SurfacePoint sp, Material m, FrameParams f, uint type, uint pick) {
+    float total = 0.0f;
+    float mine = 0.0f;
+    for (uint t = 0u; t < kLightTypeCount; ++t) {
+        if (f.roots[t] == kInvalidIndex) continue;
+        float w = lc_pick_weight(sp, m, f.roots[t], pick, f.min_distance2);
+        total += w;
+        if (t == type) mine = w;
+    }
+    return total > 0.0f ? mine / total : 0.0f;
+}
+
+// Descends from `node_index` to a leaf, choosing each child with
+// lc_left_probability and one fresh random number per level of `stream`.
+// Returns the leaf's light and multiplies `pdf` by the branch probabilities
+// taken. (Written as a loop with its test in the head: with a `return`
+// inside `while (true)` instead, lavapipe returned light 0 from the copy of
+// this function inlined into lightcuts.comp, though the pdf was right.)
+uint lc_descend(SurfacePoint sp, Material m, uint node_index, uint pick, float min_distance2, uint stream,
+                LC_INOUT(float) pdf) {
+    uint h = stream;
+    LightNode node = LC_LIGHT_NODE(node_index);
+    while ((node.flags & kNodeLeaf) == 0u) {
+        float p_left = lc_left_probability(sp, m, node_index, pick, min_distance2);
+        h = lc_hash(h);
+        bool go_left = lc_unit_float(h) < p_left;
+        pdf *= go_left ? p_left : 1.0f - p_left;
+        node_index = go_left ? node.left : node.left + 1u;
+        node = LC_LIGHT_NODE(node_index);
+    }
+    return node.rep_light;
+}
+
+// One light drawn for a shaded point with the scene's light pick: a root in
+// proportion to the roots' weights, then down its tree (tree and power), or
+// any light with the same probability (uniform). Its probability in `pdf`;
+// kInvalidIndex when no light can be drawn.
+uint lc_pick_light(SurfacePoint sp, Material m, FrameParams f, uint stream, LC_OUT(float) pdf) {
+    pdf = 0.0f;
+    if (f.light_count == 0u) return kInvalidIndex;
+    float u = lc_unit_float(stream);
+    if (f.light_pick == kLightPickUniform) {
+        pdf = 1.0f / float(f.light_count);
+        return min(uint(u * float(f.light_count)), f.light_count - 1u);
+    }
+    float weights[kLightTypeCount];
+    float total = 0.0f;
+    for (uint t = 0u; t < kLightTypeCount; ++t) {
+        weights[t] = f.roots[t] == kInvalidIndex ? 0.0f : lc_pick_weight(sp, m, f.roots[t], f.light_pick, f.min_distance2);
+        total += weights[t];
+    }
+    if (!(total > 0.0f)) return kInvalidIndex;
+    // The last type with any weight takes what rounding leaves above the others.
+    uint type = kLightTypeCount;
+    float below = 0.0f;
+    for (uint t = 0u; t < kLightTypeCount; ++t) {
+        if (!(weights[t] > 0.0f)) continue;
+        type = t;
+        below += weights[t] / total;
+        if (u < below) break;
+    }
+    pdf = weights[type] / total;
+    return lc_descend(sp, m, f.roots[type], f.light_pick, f.min_distance2, stream, pdf);
+}
+
+// --method sampled: light samples [first, first + count) of the point's
+// f.light_samples, each one light picked by lc_pick_light and one shadow
+// ray; returns their sum of contribution / probability (the caller divides
+// by f.light_samples, after every range is summed).
+vec3 lc_shade_sampled(SurfacePoint sp, FrameParams f, uint stream, uint first, uint count,
+                      LC_INOUT(ShadeStats) stats) {
+    Material m = LC_MATERIAL(sp.material);
+    vec3 sum = vec3(0.0f);
+    for (uint k = first; k < first + count; ++k) {
+        float pdf;
+        uint light = lc_pick_light(sp, m, f, lc_substream(stream, k), pdf);
+        if (light == kInvalidIndex || !(pdf > 0.0f)) continue;
+        Light l = LC_LIGHT(light);
+        sum += lc_light_unit_shadowed(sp, l, f.min_distance2, stats) * (lc_light_intensity(l) / pdf);
+    }
+    return sum;
+}
+
+// Stochastic Lightcuts (Yuksel 2019): the contribution of the cluster
+// `node_index` estimated with a representative drawn afresh, in proportion
+// to the luminance of the lights' intensities (the distribution the fixed
+// representatives are drawn from when the tree is built), one shadow ray.
+// Unbiased for the cluster's exact contribution: the light drawn, j, has
+// probability P_j and the estimate is I_j * unit_j / P_j.
+vec3 lc_shade_cluster_stochastic(SurfacePoint sp, Material m, uint node_index, float min_distance2, uint stream,
+                                 LC_INOUT(ShadeStats) stats) {
+    float pdf = 1.0f;
+    uint light = lc_descend(sp, m, node_index, kLightPickPower, min_distance2, lc_substream(stream, node_index), pdf);
+    if (light == kInvalidIndex || !(pdf > 0.0f)) return vec3(0.0f);
+    Light l = LC_LIGHT(light);
+    return lc_light_unit_shadowed(sp, l, min_distance2, stats) * (lc_light_intensity(l) / pdf);
+}

@@ -1,0 +1,318 @@
+// The stochastic methods on the CPU (shaders/shared/sampling.h): the
+// probabilities tree descent gives the lights, and the unbiasedness of
+// --method sampled and --method stochastic against brute force.
+#include <cmath>
+#include <functional>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cpu_kernel.h"
+#include "test_util.h"
+
+namespace lc {
+namespace {
+
+using Kernel = cpu::ShadeKernel;
+using test::random_unit;
+
+// Point, spot, oriented (one- and two-sided) and directional lights in and
+// above the room, of random colours and powers.
+std::vector<gpu::Light> mixed_lights(std::size_t n, std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::vector<gpu::Light> lights;
+    for (std::size_t i = 0; i < n; ++i) {
+        const glm::vec3 p(-0.9f + 1.8f * u(rng), 0.1f + 1.8f * u(rng), -0.9f + 1.8f * u(rng));
+        const glm::vec3 c = glm::vec3(0.2f + u(rng), 0.2f + u(rng), 0.2f + u(rng)) * (0.1f + 3.0f * u(rng) * u(rng));
+        switch (i % 5) {
+            case 0: lights.push_back(test::point_light(p, c)); break;
+            case 1: lights.push_back(test::spot_light(p, random_unit(rng), c, 10.0f + 20.0f * u(rng), 40.0f + 40.0f * u(rng))); break;
+            case 2: lights.push_back(test::oriented_light(p, random_unit(rng), c)); break;
+            case 3: lights.push_back(test::oriented_light(p, random_unit(rng), c, true)); break;
+            default:
+                if (i % 25 == 4) lights.push_back(test::directional_light(random_unit(rng), 0.05f * c));
+                else lights.push_back(test::point_light(p, c));
+        }
+    }
+    return lights;
+}
+
+// The probability tree descent gives every light at a point, enumerated:
+// the root's probability times the branch probabilities on the way down.
+std::vector<double> enumerate_probabilities(Kernel& k, const Kernel::SurfacePoint& sp, const gpu::Material& m,
+                                            const gpu::FrameParams& f, const LightTree& tree) {
+    std::vector<double> p(tree.lights.size(), 0.0);
+    std::function<void(std::uint32_t, double)> walk = [&](std::uint32_t node, double prob) {
+        const gpu::LightNode& n = tree.nodes[node];
+        if (n.flags & gpu::kNodeLeaf) {
+            p[n.rep_light] += prob;
+            return;
+        }
+        const float left = k.lc_left_probability(sp, m, node, f.light_pick, f.min_distance2);
+        walk(n.left, prob * left);
+        walk(n.left + 1, prob * (1.0f - left));
+    };
+    for (std::uint32_t t = 0; t < gpu::kLightTypeCount; ++t)
+        if (f.roots[t] != gpu::kInvalidIndex) walk(f.roots[t], k.lc_root_probability(sp, m, f, t, f.light_pick));
+    return p;
+}
+
+struct PickCase {
+    const char* name;
+    std::uint32_t pick;
+};
+
+class TreeDescent : public ::testing::TestWithParam<PickCase> {};
+
+// At random shaded points of random materials: the probabilities sum to 1;
+// every light drawn comes with the enumerated probability of that light;
+// with the tree's importance every light that reaches the point unshadowed
+// can be drawn (so the estimator misses nothing); with power, each light's
+// probability is its share of the total luminance.
+TEST_P(TreeDescent, ProbabilitiesSumToOneAndAreTheProductOfTheBranches) {
+    const std::uint32_t pick = GetParam().pick;
+    PreparedScene p = prepare_scene(test::room_scene(mixed_lights(400, 7), 8), 1);
+    RenderOptions o = test::options("sampled", 8);
+    gpu::FrameParams f = make_frame_params(p, o);
+    f.light_pick = pick;
+    Kernel k = cpu::make_shade_kernel(p, nullptr);
+    const LightTree& tree = p.tree;
+    double luminance_total = 0.0;
+    for (const gpu::Light& l : tree.lights) luminance_total += gpu::lc_luminance({l.r, l.g, l.b});
+
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    int points_with_light = 0;
+    for (int trial = 0; trial < 200; ++trial) {
+        Kernel::SurfacePoint sp;
+        sp.p = glm::vec3(-1.0f + 2.0f * u(rng), 2.0f * u(rng), -1.0f + 2.0f * u(rng));
+        sp.n = random_unit(rng);
+        sp.wo = random_unit(rng);
+        if (glm::dot(sp.wo, sp.n) < 0.0f) sp.wo = -sp.wo;
+        gpu::Material m = trial % 2 ? test::glossy({u(rng), u(rng), u(rng)}, glm::vec3(0.5f), 0.05f + u(rng))
+                                    : test::lambert({u(rng), u(rng), u(rng)});
+        p.scene.materials[0] = m;
+        sp.material = 0;
+
+        const std::vector<double> prob = enumerate_probabilities(k, sp, m, f, tree);
+        double sum = 0.0;
+        for (double q : prob) sum += q;
+        bool any_contribution = false;
+        for (std::size_t j = 0; j < tree.lights.size(); ++j) {
+            glm::vec3 wi;
+            float t_max;
+            const glm::vec3 unit = k.lc_light_unit(sp, tree.lights[j], f.min_distance2, wi, t_max);
+            if (unit.x + unit.y + unit.z > 0.0f) {
+                any_contribution = true;
+                if (pick == gpu::kLightPickTree) {
+                    ASSERT_GT(prob[j], 0.0) << "light " << j << ", trial " << trial;
+                }
+            }
+            if (pick == gpu::kLightPickPower) {
+                const gpu::Light& l = tree.lights[j];
+                ASSERT_NEAR(prob[j], gpu::lc_luminance({l.r, l.g, l.b}) / luminance_total, 1e-4 * prob[j])
+                    << "light " << j;
+            }
+        }
+        if (pick == gpu::kLightPickTree && !any_contribution) {
+            // No light can reach the point: tree descent draws none (and
+            // the sum may be 0); otherwise it must be 1.
+            EXPECT_TRUE(sum == 0.0 || std::abs(sum - 1.0) < 1e-5) << sum;
+            continue;
+        }
+        ++points_with_light;
+        ASSERT_NEAR(sum, 1.0, 1e-5) << "trial " << trial;
+        for (std::uint32_t s = 0; s < 20; ++s) {
+            float pdf = -1.0f;
+            const std::uint32_t light = k.lc_pick_light(sp, m, f, k.lc_substream(trial, s), pdf);
+            ASSERT_NE(light, gpu::kInvalidIndex);
+            ASSERT_NEAR(pdf, prob[light], 1e-5 * prob[light]) << "light " << light << ", trial " << trial;
+        }
+    }
+    EXPECT_GT(points_with_light, 100);
+}
+
+INSTANTIATE_TEST_SUITE_P(Sampling, TreeDescent,
+                         ::testing::Values(PickCase{"Tree", gpu::kLightPickTree},
+                                           PickCase{"Power", gpu::kLightPickPower}),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+// The draws themselves follow the probabilities: 2^18 draws at one point
+// over 24 lights, every light's count within 5 standard deviations of its
+// expectation (a false failure about once in 10^5 seeds).
+TEST(TreeDescent, DrawFrequenciesFollowTheProbabilities) {
+    PreparedScene p = prepare_scene(test::room_scene(mixed_lights(24, 3), 8), 1);
+    RenderOptions o = test::options("sampled", 8);
+    const gpu::FrameParams f = make_frame_params(p, o);
+    Kernel k = cpu::make_shade_kernel(p, nullptr);
+    Kernel::SurfacePoint sp{{0.1f, 0.02f, 0.2f}, {0.0f, 1.0f, 0.0f}, glm::normalize(glm::vec3(0.3f, 1.0f, 0.2f)), 0};
+    const gpu::Material m = p.scene.materials[0];
+    const std::vector<double> prob = enumerate_probabilities(k, sp, m, f, p.tree);
+    constexpr std::uint32_t kDraws = 1u << 18;
+    std::vector<double> count(prob.size(), 0.0);
+    for (std::uint32_t s = 0; s < kDraws; ++s) {
+        float pdf;
+        const std::uint32_t light = k.lc_pick_light(sp, m, f, k.lc_substream(12345u, s), pdf);
+        ASSERT_NE(light, gpu::kInvalidIndex);
+        count[light] += 1.0;
+    }
+    for (std::size_t j = 0; j < prob.size(); ++j) {
+        const double expected = prob[j] * kDraws;
+        const double sigma = std::sqrt(kDraws * prob[j] * (1.0 - prob[j]));
+        EXPECT_NEAR(count[j], expected, 5.0 * sigma + 1e-9) << "light " << j;
+    }
+}
+
+// Uniform picking: every light with probability 1/N.
+TEST(TreeDescent, UniformPickGivesEveryLightTheSameProbability) {
+    PreparedScene p = prepare_scene(test::room_scene(mixed_lights(37, 5), 8), 1);
+    RenderOptions o = test::options("sampled", 8);
+    o.light_pick = "uniform";
+    const gpu::FrameParams f = make_frame_params(p, o);
+    Kernel k = cpu::make_shade_kernel(p, nullptr);
+    Kernel::SurfacePoint sp{{0.0f, 0.5f, 0.0f}, {0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0};
+    std::vector<int> seen(p.tree.lights.size(), 0);
+    for (std::uint32_t s = 0; s < 4000; ++s) {
+        float pdf;
+        const std::uint32_t light = k.lc_pick_light(sp, p.scene.materials[0], f, k.lc_substream(9u, s), pdf);
+        ASSERT_LT(light, p.tree.lights.size());
+        EXPECT_FLOAT_EQ(pdf, 1.0f / float(p.tree.lights.size()));
+        seen[light] = 1;
+    }
+    for (std::size_t j = 0; j < seen.size(); ++j) EXPECT_EQ(seen[j], 1) << "light " << j << " never drawn";
+}
+
+// Luminance means over the whole image and over its four quadrants.
+std::vector<double> region_means(const Image& image) {
+    std::vector<double> sums(5, 0.0);
+    std::vector<double> counts(5, 0.0);
+    for (std::uint32_t y = 0; y < image.height; ++y)
+        for (std::uint32_t x = 0; x < image.width; ++x) {
+            const std::size_t i = 3 * (std::size_t(y) * image.width + x);
+            const double v = gpu::lc_luminance({image.rgb[i], image.rgb[i + 1], image.rgb[i + 2]});
+            const std::size_t q = 1 + (x * 2 / image.width) + 2 * (y * 2 / image.height);
+            sums[0] += v, counts[0] += 1;
+            sums[q] += v, counts[q] += 1;
+        }
+    for (std::size_t r = 0; r < sums.size(); ++r) sums[r] /= counts[r];
+    return sums;
+}
+
+struct UnbiasedCase {
+    const char* name;
+    const char* method;
+    const char* pick;
+    float relative_error;
+    double visible_bias;  // a bias this large (relative) would fail the test
+};
+
+class Unbiased : public ::testing::TestWithParam<UnbiasedCase> {};
+
+// The mean of R = 100 renders with seeds 1..R against brute force, for the
+// image's mean luminance and each quadrant's: |mean - brute| must be within
+// 4.5 standard errors (estimated from the renders). The renders are
+// independent and each region's mean averages many pixels, so the statistic
+// is close to normal: a false failure has probability about 7e-6 per
+// region, 1.4e-4 for the whole suite (5 regions, 4 methods). One spp at
+// the pixel centres, so every render shades the same points as brute
+// force. The test also checks that it would see a small bias: that 4.5
+// standard errors of the image mean are below `visible_bias` of it (1% for
+// tree sampling and stochastic lightcuts, 2.5% for the baselines, whose
+// variance is larger at the same 100 light samples).
+TEST_P(Unbiased, MeanOfIndependentRendersMatchesBruteForce) {
+    const UnbiasedCase& c = GetParam();
+    constexpr std::uint32_t kSize = 12;
+    constexpr int kRenders = 100;
+    PreparedScene p = prepare_scene(test::room_scene(mixed_lights(300, 21), kSize), 1);
+    const std::vector<double> exact = region_means(render_cpu(p, test::options("brute", kSize)).image);
+
+    RenderOptions o = test::options(c.method, kSize);
+    o.light_pick = c.pick;
+    o.light_samples = 100;
+    o.relative_error = c.relative_error;
+    std::vector<double> sum(exact.size(), 0.0), sum2(exact.size(), 0.0);
+    for (int r = 0; r < kRenders; ++r) {
+        o.seed = std::uint32_t(r + 1);
+        const std::vector<double> means = region_means(render_cpu(p, o).image);
+        for (std::size_t i = 0; i < means.size(); ++i) {
+            sum[i] += means[i];
+            sum2[i] += means[i] * means[i];
+        }
+    }
+    for (std::size_t i = 0; i < exact.size(); ++i) {
+        const double mean = sum[i] / kRenders;
+        const double variance = std::max(0.0, (sum2[i] - kRenders * mean * mean) / (kRenders - 1));
+        const double standard_error = std::sqrt(variance / kRenders);
+        std::printf("[ measured ] %s region %zu: mean %.6g, brute %.6g, %.2f standard errors (se/mean %.2g)\n",
+                    c.name, i, mean, exact[i], std::abs(mean - exact[i]) / standard_error, standard_error / mean);
+        EXPECT_GT(standard_error, 0.0) << "the renders do not differ: the seed does not reach the method";
+        EXPECT_LE(std::abs(mean - exact[i]), 4.5 * standard_error) << c.name << " region " << i;
+        if (i == 0) {
+            EXPECT_LT(4.5 * standard_error, c.visible_bias * exact[i]) << "the test could not see the bias";
+        }
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Sampling, Unbiased,
+                         ::testing::Values(UnbiasedCase{"SampledTree", "sampled", "tree", 0.02f, 0.01},
+                                           UnbiasedCase{"SampledUniform", "sampled", "uniform", 0.02f, 0.025},
+                                           UnbiasedCase{"SampledPower", "sampled", "power", 0.02f, 0.025},
+                                           UnbiasedCase{"Stochastic", "stochastic", "tree", 0.2f, 0.01}),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+// Deterministic lightcuts at the same threshold is biased, and the
+// statistic above sees it: its error (the same in every render) is many
+// times what stochastic lightcuts leaves over 100 renders.
+TEST(Unbiased, DeterministicLightcutsIsBiasedWhereStochasticIsNot) {
+    constexpr std::uint32_t kSize = 12;
+    PreparedScene p = prepare_scene(test::room_scene(mixed_lights(300, 21), kSize), 1);
+    const double exact = region_means(render_cpu(p, test::options("brute", kSize)).image)[0];
+    RenderOptions o = test::options("lightcuts", kSize);
+    o.relative_error = 0.2f;
+    const double deterministic = region_means(render_cpu(p, o).image)[0];
+    o.method = "stochastic";
+    double stochastic = 0.0;
+    for (int r = 0; r < 100; ++r) {
+        o.seed = std::uint32_t(r + 1);
+        stochastic += region_means(render_cpu(p, o).image)[0] / 100.0;
+    }
+    std::printf("[ measured ] image mean: brute %.6g, lightcuts %.6g, stochastic (100 renders) %.6g\n", exact,
+                deterministic, stochastic);
+    EXPECT_GT(std::abs(deterministic - exact), 3.0 * std::abs(stochastic - exact));
+}
+
+// The seed decides the light samples, so a render is the same for the same
+// seed (and thread count does not matter), and differs for another seed.
+TEST(Sampling, SameSeedSameImageWhateverTheThreads) {
+    PreparedScene p = prepare_scene(test::room_scene(mixed_lights(100, 2), 16), 1);
+    for (const char* method : {"sampled", "stochastic"}) {
+        RenderOptions o = test::options(method, 16);
+        o.spp = 2;
+        o.threads = 1;
+        const RenderResult a = render_cpu(p, o);
+        o.threads = 2;
+        const RenderResult b = render_cpu(p, o);
+        EXPECT_EQ(a.image.rgb, b.image.rgb) << method;
+        o.seed = 2;
+        EXPECT_NE(render_cpu(p, o).image.rgb, a.image.rgb) << method;
+    }
+}
+
+// Stochastic lightcuts selects the same cut as lightcuts (the cut sizes are
+// equal) and shades each cluster that is not a single light with one more
+// shadow ray, so it needs at most twice the rays.
+TEST(Sampling, StochasticSelectsTheLightcutsCut) {
+    PreparedScene p = prepare_scene(test::room_scene(mixed_lights(300, 4), 16), 1);
+    RenderOptions o = test::options("lightcuts", 16);
+    const RenderResult lightcuts = render_cpu(p, o);
+    o.method = "stochastic";
+    const RenderResult stochastic = render_cpu(p, o);
+    EXPECT_EQ(lightcuts.stats.cut_size, stochastic.stats.cut_size);
+    EXPECT_GT(stochastic.stats.shadow_rays, lightcuts.stats.shadow_rays);
+    EXPECT_LE(stochastic.stats.shadow_rays, 2 * lightcuts.stats.shadow_rays);
+}
+
+}  // namespace
+}  // namespace lc
