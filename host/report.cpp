@@ -132,6 +132,7 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
     }
     if (method_selects_cuts(options.method)) r.lightcuts = lightcuts_report(options, prepared, s);
     if (options.method == "sampled") r.sampling = SamplingReport{options.light_samples, options.light_pick};
+    if (options.method == "stochastic") r.sampling = SamplingReport{options.light_samples, "stochastic"};
     r.seed = options.seed;
     return r;
 }
@@ -152,7 +153,9 @@ std::string report_text(const RenderReport& r) {
         text += format("  %u tile(s) rendered again with the work split finer (the driver cut long loops short)\n",
                        r.loop_limit_retries);
     if (r.lightcuts) text += lightcuts_text(r, *r.lightcuts);
-    if (r.sampling)
+    if (r.sampling && r.method == "stochastic")
+        text += format("  %u fresh representative(s) per cluster of the cut\n", r.sampling->light_samples);
+    else if (r.sampling)
         text += format("  %u light sample(s) per camera sample, picked by %s\n", r.sampling->light_samples,
                        r.sampling->light_pick.c_str());
     return text;

@@ -88,10 +88,10 @@ struct CutState {
     float leaf_r, leaf_g, leaf_b;
     // While the cut is refined: the running sum of the heap's estimates.
     // Stochastic, once kCutSelected: leaf_sum plus the fresh estimates of
-    // heap slots [0, shaded).
+    // heap slots [0, shaded) and of draws [0, draw) of slot `shaded`.
     float heap_r, heap_g, heap_b;
     uint shaded;
-    uint pad0;
+    uint draw;
 };
 
 // PushConstants.cut_flags

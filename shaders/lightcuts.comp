@@ -7,8 +7,8 @@
 //
 // One dispatch normally runs each cut from the roots to the end. Where the
 // driver limits how long an invocation may loop (lavapipe), the host gives
-// each dispatch a budget of steps instead (a refinement, or a stochastic
-// cluster shaded) and dispatches until every cut is done; a cut that is not
+// each dispatch a budget of steps instead (a refinement, or one fresh draw
+// of a stochastic cluster) and dispatches until every cut is done; a cut that is not
 // done yet waits in CutState and the heap buffer.
 #version 460
 #extension GL_GOOGLE_include_directive : require
@@ -40,6 +40,7 @@ void main() {
     vec3 heap_sum = vec3(0.0f);
     bool selected = false;  // stochastic: the cut is final; heap_sum is the fresh sum
     uint shaded = 0u;       // stochastic: heap slots shaded afresh so far
+    uint draw = 0u;         // ... and draws of slot `shaded` (frame.light_samples per slot)
     if ((push.cut_flags & kCutFirstDispatch) != 0u) {
         lc_cut_start(sp, m, frame, heap_size, leaf_sum, heap_sum, stats);
     } else {
@@ -51,6 +52,7 @@ void main() {
         g_heap_spilled = (s.flags & kCutSpilled) != 0u;
         selected = (s.flags & kCutSelected) != 0u;
         shaded = s.shaded;
+        draw = s.draw;
         leaf_sum = vec3(s.leaf_r, s.leaf_g, s.leaf_b);
         heap_sum = vec3(s.heap_r, s.heap_g, s.heap_b);
         lc_heap_restore(heap_size);
@@ -66,8 +68,13 @@ void main() {
             done = !kStochastic;
         } else if (shaded < heap_size) {
             heap_sum += lc_shade_cluster_stochastic(sp, m, LC_HEAP_LOAD(shaded).node, frame.min_distance2, stream,
-                                                    stats);
-            shaded += 1u;
+                                                    draw, stats) *
+                        (1.0f / float(frame.light_samples));
+            draw += 1u;
+            if (draw == frame.light_samples) {
+                draw = 0u;
+                shaded += 1u;
+            }
         } else {
             done = true;
         }
@@ -91,7 +98,7 @@ void main() {
         s.leaf_r = leaf_sum.x; s.leaf_g = leaf_sum.y; s.leaf_b = leaf_sum.z;
         s.heap_r = heap_sum.x; s.heap_g = heap_sum.y; s.heap_b = heap_sum.z;
         s.shaded = shaded;
-        s.pad0 = 0u;
+        s.draw = draw;
         cut_states[i] = s;
         return;
     }

@@ -205,6 +205,7 @@ struct UnbiasedCase {
     const char* method;
     const char* pick;
     float relative_error;
+    std::uint32_t light_samples;
     double visible_bias;  // a bias this large (relative) would fail the test
 };
 
@@ -215,7 +216,7 @@ class Unbiased : public ::testing::TestWithParam<UnbiasedCase> {};
 // 4.5 standard errors (estimated from the renders). The renders are
 // independent and each region's mean averages many pixels, so the statistic
 // is close to normal: a false failure has probability about 7e-6 per
-// region, 1.4e-4 for the whole suite (5 regions, 4 methods). One spp at
+// region, 1.7e-4 for the whole suite (5 regions, 5 cases). One spp at
 // the pixel centres, so every render shades the same points as brute
 // force. The test also checks that it would see a small bias: that 4.5
 // standard errors of the image mean are below `visible_bias` of it (1% for
@@ -230,7 +231,7 @@ TEST_P(Unbiased, MeanOfIndependentRendersMatchesBruteForce) {
 
     RenderOptions o = test::options(c.method, kSize);
     o.light_pick = c.pick;
-    o.light_samples = 100;
+    o.light_samples = c.light_samples;
     o.relative_error = c.relative_error;
     std::vector<double> sum(exact.size(), 0.0), sum2(exact.size(), 0.0);
     for (int r = 0; r < kRenders; ++r) {
@@ -256,10 +257,11 @@ TEST_P(Unbiased, MeanOfIndependentRendersMatchesBruteForce) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Sampling, Unbiased,
-                         ::testing::Values(UnbiasedCase{"SampledTree", "sampled", "tree", 0.02f, 0.01},
-                                           UnbiasedCase{"SampledUniform", "sampled", "uniform", 0.02f, 0.025},
-                                           UnbiasedCase{"SampledPower", "sampled", "power", 0.02f, 0.025},
-                                           UnbiasedCase{"Stochastic", "stochastic", "tree", 0.2f, 0.01}),
+                         ::testing::Values(UnbiasedCase{"SampledTree", "sampled", "tree", 0.02f, 100, 0.01},
+                                           UnbiasedCase{"SampledUniform", "sampled", "uniform", 0.02f, 100, 0.025},
+                                           UnbiasedCase{"SampledPower", "sampled", "power", 0.02f, 100, 0.025},
+                                           UnbiasedCase{"Stochastic", "stochastic", "tree", 0.2f, 1, 0.01},
+                                           UnbiasedCase{"StochasticThreeDraws", "stochastic", "tree", 0.5f, 3, 0.01}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 // Deterministic lightcuts at the same threshold is biased, and the

@@ -56,7 +56,7 @@ constexpr std::uint32_t kFirstRefineBudget = 128;
 // Lightcuts: every cut from the roots to the end in one dispatch, or a
 // budget of steps per dispatch, the cut paused in CutState and the heap's
 // spill buffer in between. A step is one refinement, or (stochastic) one
-// cluster of the final cut shaded with a fresh representative.
+// fresh representative drawn for a cluster of the final cut.
 class Lightcuts final : public ShadingMethod {
 public:
     Lightcuts(const gpu::FrameParams& frame, const LightTree& tree, const Tuning& tuning,
@@ -78,9 +78,9 @@ public:
         // than either allows.
         const std::uint64_t interior = tree.nodes.size() - tree.lights.size();
         const std::uint64_t refinements = std::min<std::uint64_t>(frame.max_cut, interior);
-        // The refinements, the step that finds the cut final, and the heap's
-        // clusters shaded afresh.
-        max_steps_ = refinements + 1 + (stochastic ? heap_.capacity : 0);
+        // The refinements, the step that finds the cut final, and the fresh
+        // draws of the heap's clusters.
+        max_steps_ = refinements + 1 + (stochastic ? std::uint64_t(heap_.capacity) * frame.light_samples : 0);
         if (tuning.refinements_per_dispatch > 0) budget_ = tuning.refinements_per_dispatch;
     }
 

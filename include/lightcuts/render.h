@@ -56,7 +56,7 @@ struct RenderOptions {
     float relative_error = 0.02f;
     std::uint32_t max_cut = 1000;
     std::uint32_t seed = 1;
-    std::uint32_t light_samples = 1;  // sampled: lights drawn per camera sample
+    std::uint32_t light_samples = 1;  // sampled: lights per camera sample; stochastic: draws per cluster
     std::string light_pick = "tree";  // sampled: "tree", "uniform" or "power"
     unsigned threads = 0;             // CPU: 0 = all cores
     bool progress = false;            // show percentage and ETA on stderr

@@ -30,8 +30,8 @@ struct LightcutsReport {
 };
 
 struct SamplingReport {
-    std::uint32_t light_samples = 0;          // per camera sample
-    std::string light_pick;                   // "tree", "uniform" or "power"
+    std::uint32_t light_samples = 0;          // sampled: per camera sample; stochastic: per cluster
+    std::string light_pick;                   // "tree", "uniform" or "power"; "stochastic" for stochastic
 };
 
 struct RenderReport {
@@ -52,7 +52,7 @@ struct RenderReport {
     // device buffer of the same name replaces the scene array's entry.
     std::vector<BufferBytes> buffer_bytes;
     std::optional<LightcutsReport> lightcuts; // methods "lightcuts" and "stochastic"
-    std::optional<SamplingReport> sampling;   // method "sampled" only
+    std::optional<SamplingReport> sampling;   // methods "sampled" and "stochastic"
 };
 
 // `scene_file` is reported as given; `load_seconds` is the time load_scene took.

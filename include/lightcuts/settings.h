@@ -14,7 +14,7 @@ inline constexpr std::uint32_t kMaxSpp = 65536;        // camera rays per pixel
 inline constexpr std::uint32_t kMaxImageSide = 16384;  // width and height
 inline constexpr float kMaxRelativeError = 1.0f;       // lightcuts threshold, as a fraction
 inline constexpr std::uint32_t kMaxLightSamples = 1u << 24;  // area-light samples, environment directions
-inline constexpr std::uint32_t kMaxLightSamplesPerPoint = 65536;  // --method sampled, per camera sample
+inline constexpr std::uint32_t kMaxLightSamplesPerPoint = 65536;  // sampled, stochastic: light_samples
 // max_cut may be any positive 32-bit value: the cut heap is sized by the
 // light tree, never by max_cut (a cut cannot outgrow the tree).
 
@@ -29,7 +29,7 @@ inline constexpr std::string_view kSettingWidth = "width";
 inline constexpr std::string_view kSettingHeight = "height";
 inline constexpr std::string_view kSettingAreaLightSamples = "area_light_samples";
 inline constexpr std::string_view kSettingDirections = "directions";  // of an environment
-inline constexpr std::string_view kSettingLightSamples = "light_samples";  // --method sampled
+inline constexpr std::string_view kSettingLightSamples = "light_samples";  // sampled, stochastic
 inline constexpr std::string_view kSettingLightPick = "light_pick";        // --method sampled
 
 // What is wrong with `value` for the numeric setting `key` (one of the

@@ -167,15 +167,19 @@ vec3 lc_shade_lightcuts(SurfacePoint sp, FrameParams f, LC_INOUT(ShadeStats) sta
 // with the fixed representatives, so it depends on the shaded point only;
 // then every cluster of the cut that is not a single light is shaded again
 // with a representative drawn afresh from the sample's `stream`
-// (lc_shade_cluster_stochastic, one more shadow ray each). Single lights are
-// exact already. Each cluster's estimate is unbiased given the cut, so the
-// pixel is, and the mean over samples converges to the exact image.
+// (lc_shade_cluster_stochastic, f.light_samples draws of one shadow ray
+// each, averaged). Single lights are exact already. Each cluster's estimate
+// is unbiased given the cut, so the pixel is, and the mean over samples
+// converges to the exact image.
 vec3 lc_shade_stochastic(SurfacePoint sp, FrameParams f, uint stream, LC_INOUT(ShadeStats) stats) {
     Material m = LC_MATERIAL(sp.material);
     uint heap_size = 0u;
     vec3 result = vec3(0.0f);
     lc_select_cut(sp, m, f, heap_size, result, stats);
+    float weight = 1.0f / float(f.light_samples);
     for (uint i = 0u; i < heap_size; ++i)
-        result += lc_shade_cluster_stochastic(sp, m, LC_HEAP_LOAD(i).node, f.min_distance2, stream, stats);
+        for (uint d = 0u; d < f.light_samples; ++d)
+            result += lc_shade_cluster_stochastic(sp, m, LC_HEAP_LOAD(i).node, f.min_distance2, stream, d, stats) *
+                      weight;
     return result;
 }

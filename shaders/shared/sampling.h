@@ -160,12 +160,15 @@ vec3 lc_shade_sampled(SurfacePoint sp, FrameParams f, uint stream, uint first, u
 // to the luminance of the lights' intensities (the distribution the fixed
 // representatives are drawn from when the tree is built), one shadow ray.
 // Unbiased for the cluster's exact contribution: the light drawn, j, has
-// probability P_j and the estimate is I_j * unit_j / P_j.
+// probability P_j and the estimate is I_j * unit_j / P_j. `draw` numbers
+// the independent draws of one cluster at one camera sample
+// (f.light_samples of them; the caller averages).
 vec3 lc_shade_cluster_stochastic(SurfacePoint sp, Material m, uint node_index, float min_distance2, uint stream,
-                                 LC_INOUT(ShadeStats) stats) {
+                                 uint draw, LC_INOUT(ShadeStats) stats) {
     float pdf = 1.0f;
-    uint light = lc_descend(sp, m, node_index, kLightPickPower, min_distance2, lc_substream(stream, node_index), pdf);
-    if (light == kInvalidIndex || !(pdf > 0.0f)) return vec3(0.0f);
+    uint light = lc_descend(sp, m, node_index, kLightPickPower, min_distance2,
+                            lc_substream(lc_substream(stream, node_index), draw), pdf);
+    if (!(pdf > 0.0f)) return vec3(0.0f);
     Light l = LC_LIGHT(light);
     return lc_light_unit_shadowed(sp, l, min_distance2, stats) * (lc_light_intensity(l) / pdf);
 }

@@ -173,7 +173,7 @@ struct FrameParams {
     uint roots[kLightTypeCount];  // root node of each type's tree; kInvalidIndex if absent
     uint loop_probe_rounds;       // always 2: see lc_loops_were_cut_short (shaders/kernel.glsl)
     uint env_width, env_height;   // environment map seen by rays that leave; 0 x 0: black
-    uint light_samples;           // --method sampled: lights drawn per camera sample
+    uint light_samples;           // sampled: lights per camera sample; stochastic: draws per cluster
     uint light_pick;              // --method sampled: kLightPick*
     uint pad0, pad1, pad2;
 };
