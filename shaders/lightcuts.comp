@@ -67,7 +67,7 @@ void main() {
             heap_sum = leaf_sum;  // the fresh sum starts from the exact single lights
             done = !kStochastic;
         } else if (shaded < heap_size) {
-            heap_sum += lc_shade_cluster_stochastic(sp, m, LC_HEAP_LOAD(shaded).node, frame.min_distance2, stream,
+            heap_sum += lc_shade_cluster_stochastic(sp, LC_HEAP_LOAD(shaded).node, frame.min_distance2, stream,
                                                     draw, stats) *
                         (1.0f / float(frame.light_samples));
             draw += 1u;

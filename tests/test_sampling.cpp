@@ -41,8 +41,8 @@ std::vector<gpu::Light> mixed_lights(std::size_t n, std::uint32_t seed) {
 
 // The probability tree descent gives every light at a point, enumerated:
 // the root's probability times the branch probabilities on the way down.
-std::vector<double> enumerate_probabilities(Kernel& k, const Kernel::SurfacePoint& sp, const gpu::Material& m,
-                                            const gpu::FrameParams& f, const LightTree& tree) {
+std::vector<double> enumerate_probabilities(Kernel& k, const Kernel::SurfacePoint& sp, const gpu::FrameParams& f,
+                                            const LightTree& tree) {
     std::vector<double> p(tree.lights.size(), 0.0);
     std::function<void(std::uint32_t, double)> walk = [&](std::uint32_t node, double prob) {
         const gpu::LightNode& n = tree.nodes[node];
@@ -50,12 +50,12 @@ std::vector<double> enumerate_probabilities(Kernel& k, const Kernel::SurfacePoin
             p[n.rep_light] += prob;
             return;
         }
-        const float left = k.lc_left_probability(sp, m, node, f.light_pick, f.min_distance2);
+        const float left = k.lc_left_probability(sp, node, f.light_pick, f.min_distance2);
         walk(n.left, prob * left);
         walk(n.left + 1, prob * (1.0f - left));
     };
     for (std::uint32_t t = 0; t < gpu::kLightTypeCount; ++t)
-        if (f.roots[t] != gpu::kInvalidIndex) walk(f.roots[t], k.lc_root_probability(sp, m, f, t, f.light_pick));
+        if (f.roots[t] != gpu::kInvalidIndex) walk(f.roots[t], k.lc_root_probability(sp, f, t, f.light_pick));
     return p;
 }
 
@@ -96,7 +96,7 @@ TEST_P(TreeDescent, ProbabilitiesSumToOneAndAreTheProductOfTheBranches) {
         p.scene.materials[0] = m;
         sp.material = 0;
 
-        const std::vector<double> prob = enumerate_probabilities(k, sp, m, f, tree);
+        const std::vector<double> prob = enumerate_probabilities(k, sp, f, tree);
         double sum = 0.0;
         for (double q : prob) sum += q;
         bool any_contribution = false;
@@ -126,7 +126,7 @@ TEST_P(TreeDescent, ProbabilitiesSumToOneAndAreTheProductOfTheBranches) {
         ASSERT_NEAR(sum, 1.0, 1e-5) << "trial " << trial;
         for (std::uint32_t s = 0; s < 20; ++s) {
             float pdf = -1.0f;
-            const std::uint32_t light = k.lc_pick_light(sp, m, f, k.lc_substream(trial, s), pdf);
+            const std::uint32_t light = k.lc_pick_light(sp, f, k.lc_substream(trial, s), pdf);
             ASSERT_NE(light, gpu::kInvalidIndex);
             ASSERT_NEAR(pdf, prob[light], 1e-5 * prob[light]) << "light " << light << ", trial " << trial;
         }
@@ -148,13 +148,12 @@ TEST(TreeDescent, DrawFrequenciesFollowTheProbabilities) {
     const gpu::FrameParams f = make_frame_params(p, o);
     Kernel k = cpu::make_shade_kernel(p, nullptr);
     Kernel::SurfacePoint sp{{0.1f, 0.02f, 0.2f}, {0.0f, 1.0f, 0.0f}, glm::normalize(glm::vec3(0.3f, 1.0f, 0.2f)), 0};
-    const gpu::Material m = p.scene.materials[0];
-    const std::vector<double> prob = enumerate_probabilities(k, sp, m, f, p.tree);
+    const std::vector<double> prob = enumerate_probabilities(k, sp, f, p.tree);
     constexpr std::uint32_t kDraws = 1u << 18;
     std::vector<double> count(prob.size(), 0.0);
     for (std::uint32_t s = 0; s < kDraws; ++s) {
         float pdf;
-        const std::uint32_t light = k.lc_pick_light(sp, m, f, k.lc_substream(12345u, s), pdf);
+        const std::uint32_t light = k.lc_pick_light(sp, f, k.lc_substream(12345u, s), pdf);
         ASSERT_NE(light, gpu::kInvalidIndex);
         count[light] += 1.0;
     }
@@ -176,7 +175,7 @@ TEST(TreeDescent, UniformPickGivesEveryLightTheSameProbability) {
     std::vector<int> seen(p.tree.lights.size(), 0);
     for (std::uint32_t s = 0; s < 4000; ++s) {
         float pdf;
-        const std::uint32_t light = k.lc_pick_light(sp, p.scene.materials[0], f, k.lc_substream(9u, s), pdf);
+        const std::uint32_t light = k.lc_pick_light(sp, f, k.lc_substream(9u, s), pdf);
         ASSERT_LT(light, p.tree.lights.size());
         EXPECT_FLOAT_EQ(pdf, 1.0f / float(p.tree.lights.size()));
         seen[light] = 1;

@@ -179,7 +179,7 @@ vec3 lc_shade_stochastic(SurfacePoint sp, FrameParams f, uint stream, LC_INOUT(S
     float weight = 1.0f / float(f.light_samples);
     for (uint i = 0u; i < heap_size; ++i)
         for (uint d = 0u; d < f.light_samples; ++d)
-            result += lc_shade_cluster_stochastic(sp, m, LC_HEAP_LOAD(i).node, f.min_distance2, stream, d, stats) *
+            result += lc_shade_cluster_stochastic(sp, LC_HEAP_LOAD(i).node, f.min_distance2, stream, d, stats) *
                       weight;
     return result;
 }

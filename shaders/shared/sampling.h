@@ -19,26 +19,51 @@ uint lc_sample_stream(uint seed, uint x, uint y, uint s) {
 uint lc_substream(uint stream, uint k) { return lc_hash(stream ^ lc_hash(k + 0x9e3779b9u)); }
 
 // How much a cluster is worth sampling at a shaded point (Conty Estevez and
-// Kulla 2018; pbrt-v4's BVHLightSampler): its intensity (luminance) times
-// the material, cosine and emission bounds of the error bound, over the
-// squared distance to the box centre, kept from falling below the squared
-// radius of the box's bounding sphere (or d_min^2) so that a point inside a
-// cluster does not make it infinitely important. Zero exactly where the
-// error bound is zero, i.e. where no light of the cluster can contribute:
-// tree sampling then never misses a light that can, which keeps it unbiased.
-float lc_cluster_importance(SurfacePoint sp, Material m, LightNode node, float min_distance2) {
-    vec3 brdf;
-    float emission;
-    bool positional;
-    if (!lc_cluster_shape_bound(sp, m, node, brdf, emission, positional)) return 0.0f;
-    float importance = lc_luminance(brdf * lc_node_intensity(node)) * emission;
+// Kulla 2018; pbrt-v4's LightBounds::Importance): its intensity (luminance)
+// times a bound of the cosine at the point and the emission bound of the
+// error bound (lc_emission_bound), over the squared distance to the box
+// centre, kept from falling below the squared radius of the box's bounding
+// sphere (or d_min^2) so that a point inside a cluster does not make it
+// infinitely important. The material is left out, as in pbrt-v4: for
+// Lambert it is the same factor for every cluster, and the GGX lobe's bound
+// (lc_ggx_bound) cost more than it saved (docs/lightcuts.md). Zero only
+// where the cosine or the emission bound is zero, i.e. where no light of
+// the cluster can contribute: tree sampling then never misses a light that
+// can, which keeps it unbiased.
+float lc_cluster_importance(SurfacePoint sp, LightNode node, float min_distance2) {
+    vec3 lo = vec3(node.min_x, node.min_y, node.min_z);
+    vec3 hi = vec3(node.max_x, node.max_y, node.max_z);
+    bool positional = lc_node_type(node) != kLightDirectional;
     if (positional) {
-        vec3 lo = vec3(node.min_x, node.min_y, node.min_z) - sp.p;
-        vec3 hi = vec3(node.max_x, node.max_y, node.max_z) - sp.p;
-        vec3 c = 0.5f * (lo + hi);
-        vec3 half_diagonal = 0.5f * (hi - lo);
-        importance /= max(max(dot(c, c), dot(half_diagonal, half_diagonal)), min_distance2);
+        lo -= sp.p;
+        hi -= sp.p;
     }
+    vec3 c = 0.5f * (lo + hi);
+    vec3 half_diagonal = 0.5f * (hi - lo);
+    float d2 = dot(c, c);
+    float r2 = dot(half_diagonal, half_diagonal);
+    // Cosine bound over the box's bounding sphere (pbrt-v4's
+    // LightBounds::Importance): cos(max(0, theta - theta_b)), theta the angle
+    // between n and the way to the centre, theta_b the half-angle the sphere
+    // subtends; 1 where the point is inside the sphere.
+    float cos_bound = 1.0f;
+    if (d2 > r2) {
+        float inv_d = inversesqrt(d2);
+        float cos_t = dot(sp.n, c) * inv_d;
+        float sin_b2 = r2 / d2;
+        float cos_b = sqrt(max(1.0f - sin_b2, 0.0f));
+        if (cos_t < cos_b) {
+            float sin_t = sqrt(max(1.0f - cos_t * cos_t, 0.0f));
+            // Plus the cosine's rounding slack, so that a light whose
+            // exact cosine rounds above zero is never given weight zero.
+            cos_bound = cos_t * cos_b + sin_t * sqrt(sin_b2) + kCosineAbsSlack;
+        }
+    }
+    if (!(cos_bound > 0.0f)) return 0.0f;
+    float emission = (positional && kEnableOriented) ? lc_emission_bound(node, sp.p) : 1.0f;
+    if (!(emission > 0.0f)) return 0.0f;
+    float importance = lc_luminance(lc_node_intensity(node)) * min(cos_bound * kBoundSlack, 1.0f) * emission;
+    if (positional) importance /= max(max(d2, r2), min_distance2);
     return importance;
 }
 
@@ -46,10 +71,10 @@ float lc_cluster_importance(SurfacePoint sp, Material m, LightNode node, float m
 // kLightPickTree, the luminance of the cluster's intensity for
 // kLightPickPower (which makes the descent pick each light in proportion to
 // its power, with no table beyond the tree).
-float lc_pick_weight(SurfacePoint sp, Material m, uint node_index, uint pick, float min_distance2) {
+float lc_pick_weight(SurfacePoint sp, uint node_index, uint pick, float min_distance2) {
     LightNode node = LC_LIGHT_NODE(node_index);
     if (pick == kLightPickPower) return lc_luminance(lc_node_intensity(node));
-    return lc_cluster_importance(sp, m, node, min_distance2);
+    return lc_cluster_importance(sp, node, min_distance2);
 }
 
 // Probability that descent from `node_index` goes to its left child, in
@@ -58,13 +83,13 @@ float lc_pick_weight(SurfacePoint sp, Material m, uint node_index, uint pick, fl
 // below can contribute) it goes by power instead: whatever light it reaches
 // contributes zero without a shadow ray, and the probabilities of all
 // lights still sum to one.
-float lc_left_probability(SurfacePoint sp, Material m, uint node_index, uint pick, float min_distance2) {
+float lc_left_probability(SurfacePoint sp, uint node_index, uint pick, float min_distance2) {
     uint left = LC_LIGHT_NODE(node_index).left;
-    float wl = lc_pick_weight(sp, m, left, pick, min_distance2);
-    float wr = lc_pick_weight(sp, m, left + 1u, pick, min_distance2);
+    float wl = lc_pick_weight(sp, left, pick, min_distance2);
+    float wr = lc_pick_weight(sp, left + 1u, pick, min_distance2);
     if (!(wl + wr > 0.0f) && pick != kLightPickPower) {
-        wl = lc_pick_weight(sp, m, left, kLightPickPower, min_distance2);
-        wr = lc_pick_weight(sp, m, left + 1u, kLightPickPower, min_distance2);
+        wl = lc_pick_weight(sp, left, kLightPickPower, min_distance2);
+        wr = lc_pick_weight(sp, left + 1u, kLightPickPower, min_distance2);
     }
     float total = wl + wr;
     return total > 0.0f ? wl / total : 0.5f;
@@ -72,12 +97,12 @@ float lc_left_probability(SurfacePoint sp, Material m, uint node_index, uint pic
 
 // Probability of picking the tree of light type `type` (its root), in
 // proportion to the roots' weights; 0 when no tree has any.
-float lc_root_probability(SurfacePoint sp, Material m, FrameParams f, uint type, uint pick) {
+float lc_root_probability(SurfacePoint sp, FrameParams f, uint type, uint pick) {
     float total = 0.0f;
     float mine = 0.0f;
     for (uint t = 0u; t < kLightTypeCount; ++t) {
         if (f.roots[t] == kInvalidIndex) continue;
-        float w = lc_pick_weight(sp, m, f.roots[t], pick, f.min_distance2);
+        float w = lc_pick_weight(sp, f.roots[t], pick, f.min_distance2);
         total += w;
         if (t == type) mine = w;
     }
@@ -90,12 +115,12 @@ float lc_root_probability(SurfacePoint sp, Material m, FrameParams f, uint type,
 // taken. (Written as a loop with its test in the head: with a `return`
 // inside `while (true)` instead, lavapipe returned light 0 from the copy of
 // this function inlined into lightcuts.comp, though the pdf was right.)
-uint lc_descend(SurfacePoint sp, Material m, uint node_index, uint pick, float min_distance2, uint stream,
+uint lc_descend(SurfacePoint sp, uint node_index, uint pick, float min_distance2, uint stream,
                 LC_INOUT(float) pdf) {
     uint h = stream;
     LightNode node = LC_LIGHT_NODE(node_index);
     while ((node.flags & kNodeLeaf) == 0u) {
-        float p_left = lc_left_probability(sp, m, node_index, pick, min_distance2);
+        float p_left = lc_left_probability(sp, node_index, pick, min_distance2);
         h = lc_hash(h);
         bool go_left = lc_unit_float(h) < p_left;
         pdf *= go_left ? p_left : 1.0f - p_left;
@@ -109,7 +134,7 @@ uint lc_descend(SurfacePoint sp, Material m, uint node_index, uint pick, float m
 // proportion to the roots' weights, then down its tree (tree and power), or
 // any light with the same probability (uniform). Its probability in `pdf`;
 // kInvalidIndex when no light can be drawn.
-uint lc_pick_light(SurfacePoint sp, Material m, FrameParams f, uint stream, LC_OUT(float) pdf) {
+uint lc_pick_light(SurfacePoint sp, FrameParams f, uint stream, LC_OUT(float) pdf) {
     pdf = 0.0f;
     if (f.light_count == 0u) return kInvalidIndex;
     float u = lc_unit_float(stream);
@@ -120,7 +145,7 @@ uint lc_pick_light(SurfacePoint sp, Material m, FrameParams f, uint stream, LC_O
     float weights[kLightTypeCount];
     float total = 0.0f;
     for (uint t = 0u; t < kLightTypeCount; ++t) {
-        weights[t] = f.roots[t] == kInvalidIndex ? 0.0f : lc_pick_weight(sp, m, f.roots[t], f.light_pick, f.min_distance2);
+        weights[t] = f.roots[t] == kInvalidIndex ? 0.0f : lc_pick_weight(sp, f.roots[t], f.light_pick, f.min_distance2);
         total += weights[t];
     }
     if (!(total > 0.0f)) return kInvalidIndex;
@@ -134,7 +159,7 @@ uint lc_pick_light(SurfacePoint sp, Material m, FrameParams f, uint stream, LC_O
         if (u < below) break;
     }
     pdf = weights[type] / total;
-    return lc_descend(sp, m, f.roots[type], f.light_pick, f.min_distance2, stream, pdf);
+    return lc_descend(sp, f.roots[type], f.light_pick, f.min_distance2, stream, pdf);
 }
 
 // --method sampled: light samples [first, first + count) of the point's
@@ -143,11 +168,10 @@ uint lc_pick_light(SurfacePoint sp, Material m, FrameParams f, uint stream, LC_O
 // by f.light_samples, after every range is summed).
 vec3 lc_shade_sampled(SurfacePoint sp, FrameParams f, uint stream, uint first, uint count,
                       LC_INOUT(ShadeStats) stats) {
-    Material m = LC_MATERIAL(sp.material);
     vec3 sum = vec3(0.0f);
     for (uint k = first; k < first + count; ++k) {
         float pdf;
-        uint light = lc_pick_light(sp, m, f, lc_substream(stream, k), pdf);
+        uint light = lc_pick_light(sp, f, lc_substream(stream, k), pdf);
         if (light == kInvalidIndex || !(pdf > 0.0f)) continue;
         Light l = LC_LIGHT(light);
         sum += lc_light_unit_shadowed(sp, l, f.min_distance2, stats) * (lc_light_intensity(l) / pdf);
@@ -163,10 +187,10 @@ vec3 lc_shade_sampled(SurfacePoint sp, FrameParams f, uint stream, uint first, u
 // probability P_j and the estimate is I_j * unit_j / P_j. `draw` numbers
 // the independent draws of one cluster at one camera sample
 // (f.light_samples of them; the caller averages).
-vec3 lc_shade_cluster_stochastic(SurfacePoint sp, Material m, uint node_index, float min_distance2, uint stream,
+vec3 lc_shade_cluster_stochastic(SurfacePoint sp, uint node_index, float min_distance2, uint stream,
                                  uint draw, LC_INOUT(ShadeStats) stats) {
     float pdf = 1.0f;
-    uint light = lc_descend(sp, m, node_index, kLightPickPower, min_distance2,
+    uint light = lc_descend(sp, node_index, kLightPickPower, min_distance2,
                             lc_substream(lc_substream(stream, node_index), draw), pdf);
     if (!(pdf > 0.0f)) return vec3(0.0f);
     Light l = LC_LIGHT(light);

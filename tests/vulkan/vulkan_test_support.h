@@ -48,9 +48,9 @@ constexpr double kLightcutsRelative = 2e-4;
 // pixels (0.16%, stochastic, all light kinds).
 constexpr double kSampledDifferFraction = 0.01;
 // Tree sampling: a light's probability is a product of ratios of cluster
-// importances, each made of the bounds' acos, asin and cos, which the
-// device computes with its own approximations. Measured at most 1.3e-3
-// (spot lights; 8.3e-4 for the other kinds).
+// importances, made of square roots and (spot lights' emission bound) acos,
+// asin and cos, which the device computes with its own approximations.
+// Measured at most 1.3e-3 (spot lights; 6.1e-4 for the other kinds).
 constexpr double kTreePdfRelative = 4e-3;
 // Shadow rays counted: |gpu - cpu| <= kShadowRaysRelative * cpu + 1.
 // Measured 3.4e-6 (1 of 291159, shipped room, lightcuts), equal elsewhere.
