@@ -79,8 +79,10 @@ std::string check_scene_contract(const Scene& s) {
     }
     if (!finite(s.bounds_min) || !finite(s.bounds_max)) return "bounds not finite";
     const RenderSettings& r = s.render;
-    if (r.method != "brute" && r.method != "lightcuts") return "unknown method";
-    if (r.spp < 1 || r.max_cut < 1) return "spp or max_cut below 1";
+    if (r.method != "brute" && r.method != "lightcuts" && r.method != "sampled" && r.method != "stochastic")
+        return "unknown method";
+    if (r.light_pick != "tree" && r.light_pick != "uniform" && r.light_pick != "power") return "unknown light pick";
+    if (r.spp < 1 || r.max_cut < 1 || r.light_samples < 1) return "spp, max_cut or light_samples below 1";
     if (!(r.relative_error >= 0.0f) || !std::isfinite(r.relative_error)) return "relative_error invalid";
     return {};
 }
