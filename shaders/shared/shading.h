@@ -377,43 +377,26 @@ float lc_emission_bound(LightNode node, vec3 x) {
     return s * s;
 }
 
-// The parts of a cluster's bound that do not depend on the distance to it:
-// the material and cosine bound (RGB, per unit intensity) in `brdf` and the
-// emission bound in `emission`; false when either is zero, i.e. when no
-// light of the cluster can reach the point at all. `positional` tells
-// whether the box holds positions (an inverse-square falloff applies) or
-// unit directions (directional lights: x is the origin, G = 1).
-bool lc_cluster_shape_bound(SurfacePoint sp, Material m, LightNode node, LC_OUT(vec3) brdf,
-                            LC_OUT(float) emission, LC_OUT(bool) positional) {
-    vec3 box_min = vec3(node.min_x, node.min_y, node.min_z);
-    vec3 box_max = vec3(node.max_x, node.max_y, node.max_z);
-    positional = lc_node_type(node) != kLightDirectional;
-    vec3 x = positional ? sp.p : vec3(0.0f);
-    brdf = vec3(0.0f);
-    emission = 1.0f;
-    float cos_bound = lc_cosine_bound(box_min, box_max, x, sp.n);
-    if (cos_bound <= 0.0f) return false;
-    if (positional && kEnableOriented) emission = lc_emission_bound(node, sp.p);
-    if (emission <= 0.0f) return false;
-    brdf = lc_kd(m) * (cos_bound / kPi);
-    if (kEnableGgx && (m.flags & kMaterialHasSpecular) != 0u)
-        brdf += lc_ks(m) * lc_ggx_bound(m, box_min, box_max, x, sp.n, sp.wo);
-    return true;
-}
-
 // Bound of material * geometry * emission (per unit intensity, RGB) over
 // every light of a cluster, read from its node. Positional lights: the box
 // holds positions, G <= 1/d_min^2 with the same clamp as the exact term.
-// Directional lights: the box holds unit directions, so G = 1.
+// Directional lights: the box holds unit directions, so x is the origin and
+// G = 1.
 vec3 lc_cluster_bound(SurfacePoint sp, Material m, LightNode node, float min_distance2) {
-    vec3 brdf;
-    float factor;
-    bool positional;
-    if (!lc_cluster_shape_bound(sp, m, node, brdf, factor, positional)) return vec3(0.0f);
+    vec3 box_min = vec3(node.min_x, node.min_y, node.min_z);
+    vec3 box_max = vec3(node.max_x, node.max_y, node.max_z);
+    bool positional = lc_node_type(node) != kLightDirectional;
+    vec3 x = positional ? sp.p : vec3(0.0f);
+    float cos_bound = lc_cosine_bound(box_min, box_max, x, sp.n);
+    if (cos_bound <= 0.0f) return vec3(0.0f);
+    float factor = 1.0f;
     if (positional) {
-        vec3 box_min = vec3(node.min_x, node.min_y, node.min_z);
-        vec3 box_max = vec3(node.max_x, node.max_y, node.max_z);
+        if (kEnableOriented) factor = lc_emission_bound(node, sp.p);
+        if (factor <= 0.0f) return vec3(0.0f);
         factor *= kBoundSlack / max(lc_box_distance2(box_min, box_max, sp.p), min_distance2);
     }
-    return brdf * factor;
+    vec3 bound = lc_kd(m) * (cos_bound / kPi);
+    if (kEnableGgx && (m.flags & kMaterialHasSpecular) != 0u)
+        bound += lc_ks(m) * lc_ggx_bound(m, box_min, box_max, x, sp.n, sp.wo);
+    return bound * factor;
 }
