@@ -1,0 +1,210 @@
+// Shadow rays per second: the software BVH (shaders/shared/trace.h, as the
+// CPU path runs it) against Embree 3 on the same rays, the ones brute force
+// traces on a scene: from every camera hit to every light that can light it.
+//
+//   build/bench/embree_rays SCENE [SIZE] [THREADS]
+//
+// The rays are traced in two orders: as brute force casts them (pixel by
+// pixel, each pixel's rays to all lights) and light by light (the rays of
+// every pixel to one light, then the next light), which is the coherence
+// lightcuts could use by tracing a tile's rays to the same cluster
+// together. Embree runs single rays (rtcOccluded1), packets of 8 consecutive
+// rays (rtcOccluded8) and streams (rtcOccluded1M over 256 rays). Built only
+// where Debian's libembree-dev is installed (an optional, benchmark-only
+// dependency).
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <functional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cpu_kernel.h"
+#include "lightcuts/scene.h"
+
+namespace {
+
+struct ShadowRay {
+    glm::vec3 org;
+    glm::vec3 dir;
+    float t_max;
+    std::uint32_t light;  // for the light-by-light order
+};
+
+// Runs trace(thread, begin, end) over [0, n) split into `threads`
+// contiguous parts; returns the seconds it took.
+double timed_parallel(std::size_t n, unsigned threads,
+                      const std::function<void(unsigned, std::size_t, std::size_t)>& trace) {
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<std::thread> pool;
+    for (unsigned t = 0; t < threads; ++t)
+        pool.emplace_back(trace, t, n * t / threads, n * (t + 1) / threads);
+    for (auto& th : pool) th.join();
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void report(const char* what, std::size_t rays, double seconds, std::size_t occluded, std::size_t reference) {
+    std::printf("  %-38s %6.2f Mrays/s  (%.3f s; %zu occluded, %+lld against the software BVH)\n", what,
+                double(rays) / seconds * 1e-6, seconds, occluded,
+                static_cast<long long>(occluded) - static_cast<long long>(reference));
+}
+
+}  // namespace
+
+int run(int argc, char** argv);
+
+int main(int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "embree_rays: %s\n", e.what());
+        return 1;
+    }
+}
+
+int run(int argc, char** argv) {
+    if (argc < 2) {
+        std::fprintf(stderr, "usage: embree_rays SCENE [SIZE] [THREADS]\n");
+        return 2;
+    }
+    const std::uint32_t size = argc > 2 ? std::uint32_t(std::atoi(argv[2])) : 32;
+    const unsigned threads = argc > 3 ? unsigned(std::atoi(argv[3])) : std::max(1u, std::thread::hardware_concurrency());
+    lc::PreparedScene p = lc::prepare_scene(lc::load_scene(argv[1]), 1);
+    lc::RenderOptions o;
+    o.width = o.height = size;
+    const lc::gpu::FrameParams f = lc::make_frame_params(p, o);
+    lc::cpu::ShadeKernel k = lc::cpu::make_shade_kernel(p, nullptr);
+
+    // The rays brute force traces, pixel by pixel.
+    std::vector<ShadowRay> rays;
+    for (std::uint32_t y = 0; y < size; ++y)
+        for (std::uint32_t x = 0; x < size; ++x) {
+            lc::cpu::ShadeKernel::SurfacePoint sp;
+            if (!k.lc_camera_hit(f, x, y, 0, sp)) continue;
+            for (std::uint32_t l = 0; l < p.tree.lights.size(); ++l) {
+                glm::vec3 wi;
+                float t_max;
+                const glm::vec3 unit = k.lc_light_unit(sp, p.tree.lights[l], f.min_distance2, wi, t_max);
+                if (unit.x + unit.y + unit.z > 0.0f) rays.push_back({sp.p, wi, t_max, l});
+            }
+        }
+    std::vector<ShadowRay> by_light = rays;
+    std::stable_sort(by_light.begin(), by_light.end(),
+                     [](const ShadowRay& a, const ShadowRay& b) { return a.light < b.light; });
+    std::printf("%s: %ux%u, %zu triangles, %zu lights, %zu shadow rays, %u thread(s)\n", argv[1], size, size,
+                p.scene.triangles.size(), p.tree.lights.size(), rays.size(), threads);
+
+    RTCDevice device = rtcNewDevice(nullptr);
+    RTCScene scene = rtcNewScene(device);
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    const std::size_t tris = p.scene.triangles.size();
+    auto* vertices = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * tris));
+    auto* indices = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), tris));
+    for (std::size_t t = 0; t < tris; ++t) {
+        const lc::gpu::Triangle& tri = p.scene.triangles[t];
+        const float v[9] = {tri.v0_x, tri.v0_y, tri.v0_z, tri.v1_x, tri.v1_y, tri.v1_z, tri.v2_x, tri.v2_y, tri.v2_z};
+        std::copy(v, v + 9, vertices + 9 * t);
+        for (unsigned c = 0; c < 3; ++c) indices[3 * t + c] = unsigned(3 * t + c);
+    }
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(scene);
+
+    for (const auto& [order_name, list] : {std::pair<const char*, const std::vector<ShadowRay>*>{"pixel order", &rays},
+                                           {"light order", &by_light}}) {
+        const std::vector<ShadowRay>& r = *list;
+        std::printf(" %s:\n", order_name);
+        std::vector<std::size_t> hits(threads);
+        auto total = [&] {
+            std::size_t s = 0;
+            for (std::size_t h : hits) s += h;
+            return s;
+        };
+
+        std::fill(hits.begin(), hits.end(), 0);
+        double s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+            lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
+            std::size_t h = 0;
+            for (std::size_t i = b; i < e; ++i) h += tk.lc_trace_any(r[i].org, r[i].dir, r[i].t_max) ? 1 : 0;
+            hits[t] = h;
+        });
+        const std::size_t reference = total();
+        report("software BVH, single rays", r.size(), s, reference, reference);
+
+        std::fill(hits.begin(), hits.end(), 0);
+        s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+            RTCIntersectContext ctx;
+            rtcInitIntersectContext(&ctx);
+            std::size_t h = 0;
+            for (std::size_t i = b; i < e; ++i) {
+                RTCRay ray{};
+                ray.org_x = r[i].org.x, ray.org_y = r[i].org.y, ray.org_z = r[i].org.z;
+                ray.dir_x = r[i].dir.x, ray.dir_y = r[i].dir.y, ray.dir_z = r[i].dir.z;
+                ray.tnear = 0.0f, ray.tfar = r[i].t_max, ray.mask = ~0u;
+                rtcOccluded1(scene, &ctx, &ray);
+                h += ray.tfar < 0.0f ? 1 : 0;
+            }
+            hits[t] = h;
+        });
+        report("Embree rtcOccluded1", r.size(), s, total(), reference);
+
+        std::fill(hits.begin(), hits.end(), 0);
+        s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+            RTCIntersectContext ctx;
+            rtcInitIntersectContext(&ctx);
+            std::size_t h = 0;
+            for (std::size_t i = b; i < e; i += 8) {
+                alignas(32) RTCRay8 ray{};
+                alignas(32) int valid[8];
+                for (std::size_t j = 0; j < 8; ++j) {
+                    const bool on = i + j < e;
+                    valid[j] = on ? -1 : 0;
+                    const ShadowRay& sr = r[on ? i + j : i];
+                    ray.org_x[j] = sr.org.x, ray.org_y[j] = sr.org.y, ray.org_z[j] = sr.org.z;
+                    ray.dir_x[j] = sr.dir.x, ray.dir_y[j] = sr.dir.y, ray.dir_z[j] = sr.dir.z;
+                    ray.tnear[j] = 0.0f, ray.tfar[j] = sr.t_max, ray.mask[j] = ~0u;
+                }
+                rtcOccluded8(valid, scene, &ctx, &ray);
+                for (std::size_t j = 0; j < 8 && i + j < e; ++j) h += ray.tfar[j] < 0.0f ? 1 : 0;
+            }
+            hits[t] = h;
+        });
+        report("Embree rtcOccluded8 (packets)", r.size(), s, total(), reference);
+
+        std::fill(hits.begin(), hits.end(), 0);
+        s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+            RTCIntersectContext ctx;
+            rtcInitIntersectContext(&ctx);
+            ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+            constexpr std::size_t kStream = 256;
+            std::vector<RTCRay> stream(kStream);
+            std::size_t h = 0;
+            for (std::size_t i = b; i < e; i += kStream) {
+                const std::size_t n = std::min(kStream, e - i);
+                for (std::size_t j = 0; j < n; ++j) {
+                    const ShadowRay& sr = r[i + j];
+                    RTCRay& ray = stream[j];
+                    ray = RTCRay{};
+                    ray.org_x = sr.org.x, ray.org_y = sr.org.y, ray.org_z = sr.org.z;
+                    ray.dir_x = sr.dir.x, ray.dir_y = sr.dir.y, ray.dir_z = sr.dir.z;
+                    ray.tnear = 0.0f, ray.tfar = sr.t_max, ray.mask = ~0u;
+                }
+                rtcOccluded1M(scene, &ctx, stream.data(), unsigned(n), sizeof(RTCRay));
+                for (std::size_t j = 0; j < n; ++j) h += stream[j].tfar < 0.0f ? 1 : 0;
+            }
+            hits[t] = h;
+        });
+        report("Embree rtcOccluded1M (streams of 256)", r.size(), s, total(), reference);
+    }
+    rtcReleaseScene(scene);
+    rtcReleaseDevice(device);
+    return 0;
+}
