@@ -162,8 +162,9 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
     render->add_option("--area-samples", r.area_samples,
                        "Point lights the emissive surfaces become, in all (default 65536)")
         ->check(setting(lc::kSettingAreaLightSamples));
-    render->add_option("--light-samples", r.light_samples, "sampled: lights drawn per camera sample; stochastic: representatives drawn per "
-                       "cluster of the cut (default 1)")
+    render->add_option("--light-samples", r.light_samples,
+                       "sampled: lights drawn per camera sample; stochastic: representatives drawn per cluster "
+                       "of the cut (default 1)")
         ->check(setting(lc::kSettingLightSamples));
     render->add_option("--light-pick", r.light_pick,
                        "sampled: how lights are drawn: tree (importance through the light tree, the default), "

@@ -132,7 +132,7 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
     }
     if (method_selects_cuts(options.method)) r.lightcuts = lightcuts_report(options, prepared, s);
     if (options.method == "sampled") r.sampling = SamplingReport{options.light_samples, options.light_pick};
-    if (options.method == "stochastic") r.sampling = SamplingReport{options.light_samples, "stochastic"};
+    if (options.method == "stochastic") r.sampling = SamplingReport{options.light_samples, ""};
     r.seed = options.seed;
     return r;
 }
@@ -192,8 +192,10 @@ std::string report_json(const RenderReport& r) {
         {"buffer_bytes", buffers},
     };
     if (r.lightcuts) j["lightcuts"] = lightcuts_json(*r.lightcuts);
-    if (r.sampling)
-        j["sampling"] = {{"light_samples", r.sampling->light_samples}, {"light_pick", r.sampling->light_pick}};
+    if (r.sampling) {
+        j["sampling"] = {{"light_samples", r.sampling->light_samples}};
+        if (!r.sampling->light_pick.empty()) j["sampling"]["light_pick"] = r.sampling->light_pick;
+    }
     return j.dump(2) + "\n";
 }
 

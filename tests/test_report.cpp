@@ -49,6 +49,27 @@ TEST(Report, JsonHasEveryKeyScriptsReadAndTheBlackLights) {
     EXPECT_THAT(report_text(report), HasSubstr("cut size mean"));
 }
 
+// Sampled reports its light samples and pick; stochastic its cut and its
+// draws per cluster (no pick: it always draws by intensity).
+TEST(Report, StochasticMethodsReportTheirSampling) {
+    Scene s = test::room_scene(test::random_point_lights(20, {-0.9f, 0.1f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 3), 4);
+    const PreparedScene p = prepare_scene(std::move(s), 1);
+    RenderOptions o = test::options("sampled", 4);
+    o.light_samples = 3;
+    o.light_pick = "power";
+    RenderReport report = make_report("room.json", o, p, render_cpu(p, o), 0.0);
+    EXPECT_FALSE(report.lightcuts.has_value());
+    EXPECT_THAT(report_json(report), HasSubstr("\"light_samples\": 3"));
+    EXPECT_THAT(report_json(report), HasSubstr("\"light_pick\": \"power\""));
+    EXPECT_THAT(report_text(report), HasSubstr("3 light sample(s) per camera sample, picked by power"));
+    o.method = "stochastic";
+    report = make_report("room.json", o, p, render_cpu(p, o), 0.0);
+    EXPECT_TRUE(report.lightcuts.has_value());
+    EXPECT_THAT(report_json(report), HasSubstr("\"light_samples\": 3"));
+    EXPECT_THAT(report_json(report), Not(HasSubstr("\"light_pick\"")));
+    EXPECT_THAT(report_text(report), HasSubstr("3 fresh representative(s) per cluster of the cut"));
+}
+
 TEST(Report, BruteForceHasNoLightcutsPart) {
     Scene s = test::room_scene({test::point_light({0.0f, 1.5f, 0.0f}, glm::vec3(1.0f))}, 4);
     const PreparedScene p = prepare_scene(std::move(s), 1);

@@ -31,7 +31,7 @@ struct LightcutsReport {
 
 struct SamplingReport {
     std::uint32_t light_samples = 0;          // sampled: per camera sample; stochastic: per cluster
-    std::string light_pick;                   // "tree", "uniform" or "power"; "stochastic" for stochastic
+    std::string light_pick;                   // sampled: "tree", "uniform" or "power"; stochastic: ""
 };
 
 struct RenderReport {
