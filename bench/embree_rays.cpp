@@ -1,10 +1,15 @@
 // Shadow rays per second: the software BVH (shaders/shared/trace.h, as the
-// CPU path runs it) against Embree 3 on the same rays, the ones brute force
-// traces on a scene: from every camera hit to every light that can light it.
+// CPU path runs it) against Embree 3 on the same rays: the ones brute force
+// traces on a scene (from every camera hit to every light that can light
+// it), and the ones lightcuts traces at the defaults (recorded by the CPU
+// kernel as it selects the cuts).
 //
 //   build/bench/embree_rays SCENE [SIZE] [THREADS]
 //
-// The rays are traced in two orders: as brute force casts them (pixel by
+// Brute force's rays are collected at SIZE x SIZE (default 32), lightcuts'
+// at 128 x 128 (a few hundred rays per pixel instead of one per light).
+//
+// Brute force's rays are traced in two orders: as it casts them (pixel by
 // pixel, each pixel's rays to all lights) and light by light (the rays of
 // every pixel to one light, then the next light), which is the coherence
 // lightcuts could use by tracing a tile's rays to the same cluster
@@ -93,11 +98,33 @@ int run(int argc, char** argv) {
                 if (unit.x + unit.y + unit.z > 0.0f) rays.push_back({sp.p, wi, t_max, l});
             }
         }
+    // Lightcuts' rays at the defaults, pixel by pixel as it casts them.
+    constexpr std::uint32_t kLightcutsSize = 128;
+    std::vector<ShadowRay> lightcuts_rays;
+    {
+        lc::RenderOptions lo;
+        lo.width = lo.height = kLightcutsSize;
+        const lc::gpu::FrameParams lf = lc::make_frame_params(p, lo);
+        std::vector<lc::cpu::ShadowRayRecord> log;
+        std::vector<lc::gpu::CutEntry> heap(p.tree.cut_heap_capacity(lf.max_cut));
+        auto recorder = lc::cpu::make_shade_kernel<true>(p, heap.data());
+        recorder.ray_log = &log;
+        for (std::uint32_t y = 0; y < kLightcutsSize; ++y)
+            for (std::uint32_t x = 0; x < kLightcutsSize; ++x) {
+                decltype(recorder)::SurfacePoint sp;
+                if (!recorder.lc_camera_hit(lf, x, y, 0, sp)) continue;
+                decltype(recorder)::ShadeStats stats{0u, 0u, 0u};
+                recorder.lc_shade_lightcuts(sp, lf, stats);
+            }
+        for (const auto& r : log) lightcuts_rays.push_back({r.org, r.dir, r.t_max, 0u});
+    }
     std::vector<ShadowRay> by_light = rays;
     std::stable_sort(by_light.begin(), by_light.end(),
                      [](const ShadowRay& a, const ShadowRay& b) { return a.light < b.light; });
-    std::printf("%s: %ux%u, %zu triangles, %zu lights, %zu shadow rays, %u thread(s)\n", argv[1], size, size,
-                p.scene.triangles.size(), p.tree.lights.size(), rays.size(), threads);
+    std::printf("%s: %zu triangles, %zu lights; %zu brute-force shadow rays at %ux%u, %zu lightcuts shadow rays "
+                "at %ux%u; %u thread(s)\n",
+                argv[1], p.scene.triangles.size(), p.tree.lights.size(), rays.size(), size, size,
+                lightcuts_rays.size(), kLightcutsSize, kLightcutsSize, threads);
 
     RTCDevice device = rtcNewDevice(nullptr);
     RTCScene scene = rtcNewScene(device);
@@ -118,8 +145,11 @@ int run(int argc, char** argv) {
     rtcReleaseGeometry(geom);
     rtcCommitScene(scene);
 
-    for (const auto& [order_name, list] : {std::pair<const char*, const std::vector<ShadowRay>*>{"pixel order", &rays},
-                                           {"light order", &by_light}}) {
+    const std::pair<const char*, const std::vector<ShadowRay>*> sets[] = {
+        {"brute force, pixel order", &rays},
+        {"brute force, light by light", &by_light},
+        {"lightcuts (error 0.02, max_cut 1000), pixel order", &lightcuts_rays}};
+    for (const auto& [order_name, list] : sets) {
         const std::vector<ShadowRay>& r = *list;
         std::printf(" %s:\n", order_name);
         std::vector<std::size_t> hits(threads);

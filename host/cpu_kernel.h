@@ -3,6 +3,8 @@
 // the Vulkan kernels run, here as member functions reading host arrays.
 #pragma once
 
+#include <vector>
+
 #include <glm/glm.hpp>
 
 #include "lightcuts/render.h"
@@ -28,10 +30,20 @@ struct TraceKernel {
 #undef LC_TRIANGLE
 };
 
+// A shadow ray as the kernels cast it (origin, unit direction, length).
+struct ShadowRayRecord {
+    vec3 org;
+    vec3 dir;
+    float t_max;
+};
+
 // Everything a pixel needs. `heap` must hold tree.cut_heap_capacity(max_cut)
 // entries; one kernel object per thread (make_shade_kernel binds one to a
-// scene).
-struct ShadeKernel {
+// scene). kRecordRays: every shadow ray is also appended to `*ray_log`
+// (bench/embree_rays traces lightcuts' rays again with other tracers); the
+// renderer's kernel, ShadeKernel, has no such code.
+template <bool kRecordRays>
+struct BasicShadeKernel {
     const BvhNode* bvh_nodes = nullptr;
     const Triangle* triangles = nullptr;
     const TriangleNormals* normals = nullptr;
@@ -43,6 +55,7 @@ struct ShadeKernel {
     // Highest heap slot written + 1 since the caller last reset it: tells how
     // many slots a cut needed (the GPU keeps only the first K in shared memory).
     uint heap_high_water = 0u;
+    std::vector<ShadowRayRecord>* ray_log = nullptr;  // kRecordRays only
 
     // The CPU reference always runs the full kernel; the GPU switches parts
     // off only where the scene cannot use them.
@@ -59,6 +72,8 @@ struct ShadeKernel {
 #define LC_ENVIRONMENT_TEXEL(i) vec3(environment[3u * (i)], environment[3u * (i) + 1u], environment[3u * (i) + 2u])
 #define LC_HEAP_LOAD(i) heap[i]
 #define LC_HEAP_STORE(i, e) (heap_high_water = max(heap_high_water, (i) + 1u), heap[i] = (e))
+#define LC_ON_SHADOW_RAY(o, d, t) \
+    if constexpr (kRecordRays) ray_log->push_back({o, d, t})
 #include "shared/trace.h"
 #include "shared/shading.h"
 #include "shared/brute.h"
@@ -73,11 +88,15 @@ struct ShadeKernel {
 #undef LC_ENVIRONMENT_TEXEL
 #undef LC_HEAP_LOAD
 #undef LC_HEAP_STORE
+#undef LC_ON_SHADOW_RAY
 };
 
+using ShadeKernel = BasicShadeKernel<false>;
+
 // A kernel reading the prepared scene's arrays, with `heap` as its cut heap.
-inline ShadeKernel make_shade_kernel(const PreparedScene& p, CutEntry* heap) {
-    ShadeKernel k;
+template <bool kRecordRays = false>
+BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, CutEntry* heap) {
+    BasicShadeKernel<kRecordRays> k;
     k.bvh_nodes = p.bvh.nodes.data();
     k.triangles = p.scene.triangles.data();
     k.normals = p.scene.normals.data();

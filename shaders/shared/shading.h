@@ -235,6 +235,9 @@ vec3 lc_light_unit(SurfacePoint sp, Light light, float min_distance2, LC_OUT(vec
 }
 
 bool lc_visible(SurfacePoint sp, vec3 wi, float t_max) {
+#ifdef LC_ON_SHADOW_RAY
+    LC_ON_SHADOW_RAY(sp.p, wi, t_max);  // the CPU's ray recorder (host/cpu_kernel.h)
+#endif
     return !kEnableShadows || !lc_trace_any(sp.p, wi, t_max);
 }
 
