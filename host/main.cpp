@@ -155,9 +155,10 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
     render->add_option("--spp", r.spp, "Camera rays per pixel")->check(setting(lc::kSettingSpp));
     render->add_option("--width", r.width, "Image width")->check(setting(lc::kSettingWidth));
     render->add_option("--height", r.height, "Image height")->check(setting(lc::kSettingHeight));
-    render->add_option("--error", r.relative_error, "Lightcuts relative error threshold (default 0.02)")
+    render->add_option("--error", r.relative_error,
+                       "lightcuts and stochastic: relative error threshold of the cut (default 0.02)")
         ->check(setting(lc::kSettingRelativeError));
-    render->add_option("--max-cut", r.max_cut, "Lightcuts largest cut (default 1000)")
+    render->add_option("--max-cut", r.max_cut, "lightcuts and stochastic: largest cut (default 1000)")
         ->check(setting(lc::kSettingMaxCut));
     render->add_option("--area-samples", r.area_samples,
                        "Point lights the emissive surfaces become, in all (default 65536)")
