@@ -53,6 +53,14 @@ double timed_parallel(std::size_t n, unsigned threads,
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+RTCRay to_rtc_ray(const ShadowRay& r) {
+    RTCRay ray{};
+    ray.org_x = r.org.x, ray.org_y = r.org.y, ray.org_z = r.org.z;
+    ray.dir_x = r.dir.x, ray.dir_y = r.dir.y, ray.dir_z = r.dir.z;
+    ray.tnear = 0.0f, ray.tfar = r.t_max, ray.mask = ~0u;
+    return ray;
+}
+
 void report(const char* what, std::size_t rays, double seconds, std::size_t occluded, std::size_t reference) {
     std::printf("  %-38s %6.2f Mrays/s  (%.3f s; %zu occluded, %+lld against the software BVH)\n", what,
                 double(rays) / seconds * 1e-6, seconds, occluded,
@@ -175,10 +183,7 @@ int run(int argc, char** argv) {
             rtcInitIntersectContext(&ctx);
             std::size_t h = 0;
             for (std::size_t i = b; i < e; ++i) {
-                RTCRay ray{};
-                ray.org_x = r[i].org.x, ray.org_y = r[i].org.y, ray.org_z = r[i].org.z;
-                ray.dir_x = r[i].dir.x, ray.dir_y = r[i].dir.y, ray.dir_z = r[i].dir.z;
-                ray.tnear = 0.0f, ray.tfar = r[i].t_max, ray.mask = ~0u;
+                RTCRay ray = to_rtc_ray(r[i]);
                 rtcOccluded1(scene, &ctx, &ray);
                 h += ray.tfar < 0.0f ? 1 : 0;
             }
@@ -219,14 +224,7 @@ int run(int argc, char** argv) {
             std::size_t h = 0;
             for (std::size_t i = b; i < e; i += kStream) {
                 const std::size_t n = std::min(kStream, e - i);
-                for (std::size_t j = 0; j < n; ++j) {
-                    const ShadowRay& sr = r[i + j];
-                    RTCRay& ray = stream[j];
-                    ray = RTCRay{};
-                    ray.org_x = sr.org.x, ray.org_y = sr.org.y, ray.org_z = sr.org.z;
-                    ray.dir_x = sr.dir.x, ray.dir_y = sr.dir.y, ray.dir_z = sr.dir.z;
-                    ray.tnear = 0.0f, ray.tfar = sr.t_max, ray.mask = ~0u;
-                }
+                for (std::size_t j = 0; j < n; ++j) stream[j] = to_rtc_ray(r[i + j]);
                 rtcOccluded1M(scene, &ctx, stream.data(), unsigned(n), sizeof(RTCRay));
                 for (std::size_t j = 0; j < n; ++j) h += stream[j].tfar < 0.0f ? 1 : 0;
             }

@@ -8,8 +8,8 @@
 // One dispatch normally runs each cut from the roots to the end. Where the
 // driver limits how long an invocation may loop (lavapipe), the host gives
 // each dispatch a budget of steps instead (a refinement, or one fresh draw
-// of a stochastic cluster) and dispatches until every cut is done; a cut that is not
-// done yet waits in CutState and the heap buffer.
+// of a stochastic cluster) and dispatches until every cut is done; a cut
+// that is not done yet waits in CutState and the heap buffer.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 

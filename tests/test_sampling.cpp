@@ -50,7 +50,7 @@ std::vector<double> enumerate_probabilities(Kernel& k, const Kernel::SurfacePoin
             p[n.rep_light] += prob;
             return;
         }
-        const float left = k.lc_left_probability(sp, node, f.light_pick, f.min_distance2);
+        const float left = k.lc_left_probability(sp, n.left, f.light_pick, f.min_distance2);
         walk(n.left, prob * left);
         walk(n.left + 1, prob * (1.0f - left));
     };

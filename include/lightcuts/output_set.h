@@ -70,8 +70,8 @@ struct RenderOutputs {
 
 // Refuses, before anything is rendered, every combination that could not be
 // written (std::invalid_argument): an image not ending in .exr, a cut heatmap
-// without a method that selects cuts (lightcuts, stochastic), and whatever OutputSet::add refuses, the
-// scene file being an input. Returns the set holding the temporaries.
+// without a method that selects cuts (lightcuts, stochastic), and whatever
+// OutputSet::add refuses, the scene file being an input. Returns the set holding the temporaries.
 OutputSet reserve_render_outputs(const RenderOutputs& outputs, const std::filesystem::path& scene_file,
                                  std::string_view method);
 

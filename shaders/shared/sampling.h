@@ -77,14 +77,13 @@ float lc_pick_weight(SurfacePoint sp, uint node_index, uint pick, float min_dist
     return lc_cluster_importance(sp, node, min_distance2);
 }
 
-// Probability that descent from `node_index` goes to its left child, in
-// proportion to the children's weights. Where neither child has any weight
+// Probability that descent goes to the left of the two children `left` and
+// `left + 1`, in proportion to their weights. Where neither child has any weight
 // (the parent's bound was not zero, but both tighter ones are: no light
 // below can contribute) it goes by power instead: whatever light it reaches
 // contributes zero without a shadow ray, and the probabilities of all
 // lights still sum to one.
-float lc_left_probability(SurfacePoint sp, uint node_index, uint pick, float min_distance2) {
-    uint left = LC_LIGHT_NODE(node_index).left;
+float lc_left_probability(SurfacePoint sp, uint left, uint pick, float min_distance2) {
     float wl = lc_pick_weight(sp, left, pick, min_distance2);
     float wr = lc_pick_weight(sp, left + 1u, pick, min_distance2);
     if (!(wl + wr > 0.0f) && pick != kLightPickPower) {
@@ -120,7 +119,7 @@ uint lc_descend(SurfacePoint sp, uint node_index, uint pick, float min_distance2
     uint h = stream;
     LightNode node = LC_LIGHT_NODE(node_index);
     while ((node.flags & kNodeLeaf) == 0u) {
-        float p_left = lc_left_probability(sp, node_index, pick, min_distance2);
+        float p_left = lc_left_probability(sp, node.left, pick, min_distance2);
         h = lc_hash(h);
         bool go_left = lc_unit_float(h) < p_left;
         pdf *= go_left ? p_left : 1.0f - p_left;
