@@ -50,7 +50,7 @@ struct SceneArray {
 std::vector<SceneArray> scene_arrays(const PreparedScene& prepared);
 
 struct RenderOptions {
-    std::string method = "brute";     // "brute", "lightcuts", "sampled" or "stochastic"
+    std::string method = "brute";     // "brute", "lightcuts", "sampled", "stochastic" or "path"
     std::uint32_t width = 0, height = 0;  // 0: the scene's camera size
     std::uint32_t spp = 1;
     float relative_error = 0.02f;
@@ -58,6 +58,9 @@ struct RenderOptions {
     std::uint32_t seed = 1;
     std::uint32_t light_samples = 1;  // sampled: lights per camera sample; stochastic: draws per cluster
     std::string light_pick = "tree";  // sampled: "tree", "uniform" or "power"
+    std::uint32_t max_bounces = 0;    // path: surface interactions per path; 0 = unlimited (roulette)
+    double time_limit = 0.0;          // path: stop after the sample pass that passes this many
+                                      // seconds, with the samples done so far; 0 = no limit
     unsigned threads = 0;             // CPU: 0 = all cores
     bool progress = false;            // show percentage and ETA on stderr
 };
@@ -67,6 +70,7 @@ struct RenderStats {
     double seconds_total = 0.0;
     double seconds_primary = 0.0;     // camera rays (GPU: timestamp queries)
     double seconds_shading = 0.0;     // cut selection + shading or brute force
+    std::uint32_t spp_done = 0;       // samples per pixel rendered (path: fewer at a time limit)
     std::uint64_t camera_rays = 0;
     std::uint64_t shadow_rays = 0;
     std::uint64_t max_cut_pixels = 0;       // samples where refinement hit max_cut
@@ -91,6 +95,10 @@ void validate_render_options(const RenderOptions& options);
 gpu::FrameParams make_frame_params(const PreparedScene& prepared, const RenderOptions& options);
 
 RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& options);
+
+// --method path: the unbiased CPU path tracer (host/path_tracer.cpp), the
+// reference for indirect light. render_cpu calls it for that method.
+RenderResult render_path(const PreparedScene& prepared, const RenderOptions& options);
 
 struct VulkanOptions {
     std::string gpu;                  // "" = best available; an index or a name substring
