@@ -121,7 +121,7 @@ int run(int argc, char** argv) {
             for (std::uint32_t x = 0; x < kLightcutsSize; ++x) {
                 decltype(recorder)::SurfacePoint sp;
                 if (!recorder.lc_camera_hit(lf, x, y, 0, sp)) continue;
-                decltype(recorder)::ShadeStats stats{0u, 0u, 0u};
+                decltype(recorder)::ShadeStats stats{0u, 0u, 0u, 0u};
                 recorder.lc_shade_lightcuts(sp, lf, stats);
             }
         for (const auto& r : log) lightcuts_rays.push_back({r.org, r.dir, r.t_max, 0u});

@@ -92,7 +92,7 @@ void BM_CutSelection(benchmark::State& state) {
     std::size_t i = 0;
     std::uint64_t rays = 0, cut = 0;
     for (auto _ : state) {
-        ShadeKernel::ShadeStats ss{0, 0, 0};
+        ShadeKernel::ShadeStats ss{0, 0, 0, 0};
         benchmark::DoNotOptimize(f.k.lc_shade_lightcuts(f.points[i++ % f.points.size()], f.frame, ss));
         rays += ss.shadow_rays;
         cut += ss.cut_size;

@@ -51,6 +51,7 @@ struct BasicShadeKernel {
     const Light* lights = nullptr;
     const LightNode* light_nodes = nullptr;
     const float* environment = nullptr;  // RGB texels of the environment map
+    float vpl_min_distance2 = 0.0f;      // FrameParams.vpl_min_distance2
     CutEntry* heap = nullptr;
     // Highest heap slot written + 1 since the caller last reset it: tells how
     // many slots a cut needed (the GPU keeps only the first K in shared memory).
@@ -70,6 +71,7 @@ struct BasicShadeKernel {
 #define LC_LIGHT(i) lights[i]
 #define LC_LIGHT_NODE(i) light_nodes[i]
 #define LC_ENVIRONMENT_TEXEL(i) vec3(environment[3u * (i)], environment[3u * (i) + 1u], environment[3u * (i) + 2u])
+#define LC_VPL_MIN_DISTANCE2 vpl_min_distance2
 #define LC_HEAP_LOAD(i) heap[i]
 #define LC_HEAP_STORE(i, e) (heap_high_water = max(heap_high_water, (i) + 1u), heap[i] = (e))
 #define LC_ON_SHADOW_RAY(o, d, t) \
@@ -86,6 +88,7 @@ struct BasicShadeKernel {
 #undef LC_LIGHT
 #undef LC_LIGHT_NODE
 #undef LC_ENVIRONMENT_TEXEL
+#undef LC_VPL_MIN_DISTANCE2
 #undef LC_HEAP_LOAD
 #undef LC_HEAP_STORE
 #undef LC_ON_SHADOW_RAY
@@ -104,6 +107,7 @@ BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, CutEntry
     k.lights = p.tree.lights.data();
     k.light_nodes = p.tree.nodes.data();
     k.environment = p.scene.environment.rgb.data();
+    k.vpl_min_distance2 = p.vpl_min_distance2;
     k.heap = heap;
     return k;
 }

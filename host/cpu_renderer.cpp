@@ -22,6 +22,7 @@ struct Worker {
     std::vector<gpu::CutEntry> heap;
     std::uint64_t shadow_rays = 0;
     std::uint64_t max_cut_hits = 0;
+    std::uint64_t cut_indirect = 0;
 };
 
 // All samples of one pixel: the mean radiance and the mean cut size.
@@ -66,11 +67,12 @@ PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Meth
         const bool hit = k.lc_camera_sample(frame, x, y, s, sp, seen);
         sum += seen;
         if (!hit) continue;
-        cpu::ShadeKernel::ShadeStats ss{0u, 0u, 0u};
+        cpu::ShadeKernel::ShadeStats ss{0u, 0u, 0u, 0u};
         sum += shade_point(k, frame, method, sp, k.lc_sample_stream(frame.seed, x, y, s), ss);
         cut_sum += ss.cut_size;
         t.shadow_rays += ss.shadow_rays;
         t.max_cut_hits += ss.hit_max_cut;
+        t.cut_indirect += ss.cut_indirect;
     }
     return {sum / float(frame.spp), float(double(cut_sum) / frame.spp)};
 }
@@ -102,6 +104,7 @@ void for_each_tile(std::uint32_t tile_count, std::vector<Worker>& workers, Work 
 
 RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& options) {
     validate_render_options(options);
+    if (options.method == "path") return render_path(prepared, options);
     const Method method = method_of(options.method);
     const bool lightcuts = method_selects_cuts(options.method);
     const gpu::FrameParams frame = make_frame_params(prepared, options);
@@ -137,11 +140,21 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     for (const auto& t : workers) {
         stats.shadow_rays += t.shadow_rays;
         stats.max_cut_pixels += t.max_cut_hits;
+        stats.cut_indirect_total += t.cut_indirect;
     }
+    stats.spp_done = frame.spp;
     stats.camera_rays = std::uint64_t(frame.width) * frame.height * frame.spp;
     stats.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     stats.seconds_shading = stats.seconds_total;  // the CPU does not time the stages apart
     return result;
 }
 
+}  // namespace lc
+
+// TEMPORARY until host/path_tracer.cpp lands (branch wip-path): the link
+// fails with a duplicate symbol once it does, so this cannot outlive it.
+namespace lc {
+RenderResult render_path(const PreparedScene&, const RenderOptions&) {
+    throw std::runtime_error("method path: the path tracer is not built in yet");
+}
 }  // namespace lc

@@ -26,8 +26,10 @@ RenderResult render(const PreparedScene& prepared, const RenderOptions& options,
     if (choice.device == "cpu") return render_cpu(prepared, options);
     if (choice.device == "vulkan") return render_vulkan(prepared, options, choice.vulkan);
 
-    // auto: a named device is always tried; otherwise only real GPU hardware
+    // auto: the path tracer runs on the CPU only. Otherwise a named device is
+    // always tried, and only real GPU hardware
     // beats the CPU path (lavapipe on the same cores is several times slower).
+    if (options.method == "path") return render_cpu(prepared, options);
     if (choice.vulkan.gpu.empty() && !vulkan_hardware_device_present()) {
         say(choice, list_vulkan_devices().empty()
                         ? "no Vulkan device; rendering on the CPU"

@@ -49,8 +49,9 @@ static_assert(sizeof(CutEntry) == 20);
 static_assert(offsetof(CutEntry, unit_r) == 8);
 
 static_assert(sizeof(FrameParams) == 128);
-static_assert(offsetof(FrameParams, light_samples) == 108);
-static_assert(offsetof(FrameParams, env_width) == 100);
+static_assert(offsetof(FrameParams, light_samples) == 112);
+static_assert(offsetof(FrameParams, env_width) == 104);
+static_assert(offsetof(FrameParams, vpl_min_distance2) == 120);
 static_assert(offsetof(FrameParams, min_distance2) == 12);
 static_assert(offsetof(FrameParams, relative_error) == 28);
 static_assert(offsetof(FrameParams, max_cut) == 44);
@@ -58,6 +59,6 @@ static_assert(offsetof(FrameParams, spp) == 60);
 static_assert(offsetof(FrameParams, width) == 64);
 static_assert(offsetof(FrameParams, roots) == 80);
 static_assert(sizeof(FrameParams::roots) == 4 * kLightTypeCount);
-static_assert(offsetof(FrameParams, loop_probe_rounds) == 96);
+static_assert(offsetof(FrameParams, loop_probe_rounds) == 100);
 
 }  // namespace lc::gpu

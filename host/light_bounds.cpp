@@ -39,6 +39,7 @@ glm::vec3 tree_point(const gpu::Light& l) {
         case gpu::kLightDirectional:
         case gpu::kLightSpot:
         case gpu::kLightOriented:
+        case gpu::kLightVpl:
             return {l.x, l.y, l.z};
         default:
             throw std::invalid_argument("light tree: unknown light type " + std::to_string(l.type));
@@ -57,6 +58,7 @@ EmissionCone EmissionCone::of_light(const gpu::Light& light) {
             cone.falloff_width = std::max(1e-3f, light.cos_inner - light.cos_outer);
             break;
         case gpu::kLightOriented:
+        case gpu::kLightVpl:
             cone.axis = glm::vec3(light.axis_x, light.axis_y, light.axis_z);
             cone.theta_o = 0.0f;
             cone.theta_e = 0.5f * kPi;

@@ -26,8 +26,10 @@ struct RenderArgs {
     std::string scene, method, light_pick;
     lc::RenderOutputs outputs;
     lc::DeviceChoice device;
-    std::optional<std::uint32_t> spp, width, height, max_cut, seed, area_samples, light_samples;
-    std::optional<float> relative_error;
+    std::optional<std::uint32_t> spp, width, height, max_cut, seed, area_samples, light_samples, max_bounces;
+    std::optional<std::uint32_t> vpls, vpl_bounces;
+    std::optional<float> relative_error, vpl_clamp;
+    std::optional<double> time_limit;
     unsigned threads = 0;
 };
 
@@ -65,6 +67,8 @@ lc::RenderOptions render_options(const RenderArgs& a, const lc::Scene& scene) {
     o.seed = a.seed.value_or(scene.render.seed);
     o.light_samples = a.light_samples.value_or(scene.render.light_samples);
     o.light_pick = a.light_pick.empty() ? scene.render.light_pick : a.light_pick;
+    o.max_bounces = a.max_bounces.value_or(scene.render.max_bounces);
+    o.time_limit = a.time_limit.value_or(scene.render.time_limit);
     o.width = a.width.value_or(scene.camera.width);
     o.height = a.height.value_or(scene.camera.height);
     o.threads = a.threads;
@@ -81,6 +85,9 @@ int run_render(RenderArgs a) {
                      scene.degenerate_triangles_dropped);
     const lc::RenderOptions options = render_options(a, scene);
     if (a.area_samples) scene.render.area_light_samples = *a.area_samples;
+    if (a.vpls) scene.render.indirect.vpls = *a.vpls;
+    if (a.vpl_bounces) scene.render.indirect.max_bounces = *a.vpl_bounces;
+    if (a.vpl_clamp) scene.render.indirect.clamp = *a.vpl_clamp;
     lc::validate_render_options(options);
     // Every output is checked and reserved before the render; none is left if any fails.
     lc::OutputSet outputs = lc::reserve_render_outputs(a.outputs, a.scene, options.method);
@@ -139,6 +146,8 @@ int run_info(const std::string& file) {
     std::printf("  image              %ux%u\n", scene.camera.width, scene.camera.height);
     const lc::PreparedScene prepared = lc::prepare_scene(std::move(scene), 1);
     std::printf("  area-light samples %zu\n", prepared.area_lights);
+    if (prepared.vpls)
+        std::printf("  VPLs               %zu from %zu light paths (seed 1)\n", prepared.vpls, prepared.vpl_paths);
     std::printf("  buffers:\n%s", lc::buffer_table(lc::scene_buffer_bytes(prepared)).c_str());
     return 0;
 }
@@ -149,8 +158,8 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
     render->add_option("-o,--output", r.outputs.image, "Output .exr (a tone-mapped .png is written beside it)")
         ->required();
     render->add_option("--method", r.method,
-                       "brute (exact), lightcuts, sampled (lights drawn through the light tree) or "
-                       "stochastic (Stochastic Lightcuts)")
+                       "brute (exact), lightcuts, sampled (lights drawn through the light tree), "
+                       "stochastic (Stochastic Lightcuts) or path (the path tracer, CPU only)")
         ->check(ask(lc::method_problem));
     render->add_option("--spp", r.spp, "Camera rays per pixel")->check(setting(lc::kSettingSpp));
     render->add_option("--width", r.width, "Image width")->check(setting(lc::kSettingWidth));
@@ -171,6 +180,21 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
                        "sampled: how lights are drawn: tree (importance through the light tree, the default), "
                        "uniform or power")
         ->check(ask(lc::light_pick_problem));
+    render->add_option("--vpls", r.vpls,
+                       "Virtual point lights for indirect light (render.indirect.vpls; 0 = direct light only)")
+        ->check(setting(lc::kSettingVpls));
+    render->add_option("--vpl-bounces", r.vpl_bounces,
+                       "VPLs per light path at most (render.indirect.max_bounces, default 3; 0 = until roulette)")
+        ->check(setting(lc::kSettingMaxBounces));
+    render->add_option("--vpl-clamp", r.vpl_clamp,
+                       "Distance below which a VPL's 1/d^2 stops growing (render.indirect.clamp; 0 = none)")
+        ->check(setting(lc::kSettingClamp));
+    render->add_option("--max-bounces", r.max_bounces,
+                       "path: surface interactions per path (1 = direct light only; 0 = unlimited, the default)")
+        ->check(setting(lc::kSettingMaxBounces));
+    render->add_option("--time-limit", r.time_limit,
+                       "path: stop after the sample pass that ends past this many seconds (0 = none)")
+        ->check(setting(lc::kSettingTimeLimit));
     render->add_option("--seed", r.seed, "Seed for pixel jitter, light-tree representatives and light samples")
         ->check(setting(lc::kSettingSeed));
     render->add_option("--threads", r.threads, "CPU threads (0 = all cores)");

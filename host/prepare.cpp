@@ -8,6 +8,7 @@
 
 #include "area_lights.h"
 #include "environment_lights.h"
+#include "vpls.h"
 #include "lightcuts/render.h"
 
 namespace lc {
@@ -59,9 +60,18 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
     prepared.environment_lights = sky.size();
     prepared.light_sampling_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    // Walter 2005 §5: indirect light as VPLs, one more type in the same tree.
+    if (scene.render.indirect.vpls > 0) {
+        const auto vpl_start = std::chrono::steady_clock::now();
+        VplSet vpls = trace_vpls(scene, prepared.bvh, lights, scene.render.indirect, seed);
+        prepared.vpls = vpls.lights.size();
+        prepared.vpl_paths = vpls.paths;
+        lights.insert(lights.end(), vpls.lights.begin(), vpls.lights.end());
+        prepared.vpl_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - vpl_start).count();
+    }
     for (const gpu::Light& l : lights) {
         const std::uint32_t type = l.type & gpu::kLightTypeMask;
-        prepared.has_oriented |= type == gpu::kLightSpot || type == gpu::kLightOriented;
+        prepared.has_oriented |= type == gpu::kLightSpot || type == gpu::kLightOriented || type == gpu::kLightVpl;
     }
     prepared.tree = build_light_tree(lights, seed);
     for (const auto& m : scene.materials)
@@ -72,6 +82,9 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
     const double min_d = kMinDistanceRelative * glm::length(extent);
     prepared.min_distance2 = float(std::clamp(min_d * min_d, double(std::numeric_limits<float>::min()),
                                               double(std::numeric_limits<float>::max())));
+    const double clamp = scene.render.indirect.clamp;
+    prepared.vpl_min_distance2 = std::max(prepared.min_distance2, float(std::min(clamp * clamp,
+                                                                   double(std::numeric_limits<float>::max()))));
     prepared.scene = std::move(scene);
     return prepared;
 }
@@ -93,6 +106,7 @@ gpu::FrameParams make_frame_params(const PreparedScene& prepared, const RenderOp
     f.cam_up_x = up.x; f.cam_up_y = up.y; f.cam_up_z = up.z;
     f.cam_fwd_x = fwd.x; f.cam_fwd_y = fwd.y; f.cam_fwd_z = fwd.z;
     f.min_distance2 = prepared.min_distance2;
+    f.vpl_min_distance2 = prepared.vpl_min_distance2;
     f.relative_error = options.relative_error;
     f.max_cut = options.max_cut;
     f.spp = std::max(options.spp, 1u);

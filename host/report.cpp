@@ -55,6 +55,8 @@ LightcutsReport lightcuts_report(const RenderOptions& o, const PreparedScene& p,
     l.cut_size_p50 = percentile(cuts, 0.5);
     l.cut_size_p99 = percentile(cuts, 0.99);
     l.max_cut_samples = s.max_cut_pixels;
+    const double samples = double(cuts.size()) * std::max(s.spp_done, 1u);
+    l.cut_indirect_mean = samples > 0.0 ? double(s.cut_indirect_total) / samples : 0.0;
     l.heap_capacity_shared = s.heap_capacity_shared;
     l.heap_spill_samples = s.heap_spill_pixels;
     return l;
@@ -66,6 +68,9 @@ std::string lightcuts_text(const RenderReport& r, const LightcutsReport& l) {
     text += format("  cut size mean %.1f, p50 %.0f, p99 %.0f, max %.0f; %llu samples hit max_cut %u\n",
                    l.cut_size_mean, l.cut_size_p50, l.cut_size_p99, l.cut_size_max,
                    static_cast<unsigned long long>(l.max_cut_samples), l.max_cut);
+    if (r.indirect)
+        text += format("  of the cut: %.1f direct, %.1f indirect (VPL) clusters on average\n",
+                       l.cut_size_mean - l.cut_indirect_mean, l.cut_indirect_mean);
     if (r.device != "cpu")
         text += format("  cut heap: %u slots per pixel in shared memory; %llu samples spilled to global memory\n",
                        l.heap_capacity_shared, static_cast<unsigned long long>(l.heap_spill_samples));
@@ -78,6 +83,7 @@ json lightcuts_json(const LightcutsReport& l) {
             {"tree_nodes", l.tree_nodes},
             {"tree_bytes", l.tree_bytes},
             {"cut_size_mean", l.cut_size_mean},
+            {"cut_indirect_mean", l.cut_indirect_mean},
             {"cut_size_p50", l.cut_size_p50},
             {"cut_size_p99", l.cut_size_p99},
             {"cut_size_max", l.cut_size_max},
@@ -103,7 +109,9 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
     r.device = s.device;
     r.width = result.image.width;
     r.height = result.image.height;
-    r.spp = options.spp;
+    r.spp = s.spp_done ? s.spp_done : options.spp;
+    r.spp_requested = options.spp;
+    if (options.method == "path") r.max_bounces = options.max_bounces;
     r.triangles = prepared.scene.triangles.size();
     r.lights = prepared.tree.lights.size();
     r.bvh_nodes = prepared.bvh.nodes.size();
@@ -114,6 +122,10 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
     r.seconds.bvh_build = prepared.bvh.build_seconds;
     r.seconds.light_tree_build = prepared.tree.build_seconds;
     r.seconds.light_sampling = prepared.light_sampling_seconds;
+    r.seconds.vpls = prepared.vpl_seconds;
+    if (prepared.vpls > 0 && options.method != "path")
+        r.indirect = IndirectReport{prepared.vpls, prepared.vpl_paths,
+                                    prepared.scene.render.indirect.max_bounces, prepared.scene.render.indirect.clamp};
     r.seconds.render = s.seconds_total;
     r.seconds.primary = s.seconds_primary;
     r.seconds.shading = s.seconds_shading;
@@ -140,6 +152,11 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
 std::string report_text(const RenderReport& r) {
     std::string text = format("%s: %ux%u, %u spp, %s on %s\n", r.scene.c_str(), r.width, r.height, r.spp,
                               r.method.c_str(), r.device.c_str());
+    if (r.spp != r.spp_requested)
+        text += format("  stopped at the time limit after %u of %u spp\n", r.spp, r.spp_requested);
+    if (r.method == "path")
+        text += r.max_bounces ? format("  paths of at most %u bounce(s)\n", r.max_bounces)
+                              : std::string("  paths of any length (Russian roulette)\n");
     const std::string black =
         r.black_lights ? format(" (and %zu black, left out of the tree)", r.black_lights) : std::string();
     text += format("  triangles %zu, lights %zu%s, BVH %zu nodes built in %.3f s\n", r.triangles, r.lights,
@@ -147,6 +164,10 @@ std::string report_text(const RenderReport& r) {
     if (r.area_lights || r.environment_lights)
         text += format("  of the lights: %zu area-light samples, %zu environment directions (%.3f s)\n",
                        r.area_lights, r.environment_lights, r.seconds.light_sampling);
+    if (r.indirect)
+        text += format("  and %zu VPLs from %zu light paths (max_bounces %u, clamp %g) traced in %.3f s\n",
+                       r.indirect->vpls, r.indirect->paths, r.indirect->max_bounces, double(r.indirect->clamp),
+                       r.seconds.vpls);
     text += format("  render %.3f s, %.0f rays (%.2f Mrays/s), %.1f shadow rays per pixel\n", r.seconds.render,
                    double(r.camera_rays + r.shadow_rays), r.rays_per_second * 1e-6, r.shadow_rays_per_pixel);
     if (r.loop_limit_retries)
@@ -171,6 +192,7 @@ std::string report_json(const RenderReport& r) {
         {"width", r.width},
         {"height", r.height},
         {"spp", r.spp},
+        {"spp_requested", r.spp_requested},
         {"seed", r.seed},
         {"triangles", r.triangles},
         {"lights", r.lights},
@@ -181,6 +203,7 @@ std::string report_json(const RenderReport& r) {
                      {"bvh_build", r.seconds.bvh_build},
                      {"light_tree_build", r.seconds.light_tree_build},
                      {"light_sampling", r.seconds.light_sampling},
+                     {"vpls", r.seconds.vpls},
                      {"render", r.seconds.render},
                      {"primary", r.seconds.primary},
                      {"shading", r.seconds.shading}}},
@@ -192,6 +215,12 @@ std::string report_json(const RenderReport& r) {
         {"buffer_bytes", buffers},
     };
     if (r.lightcuts) j["lightcuts"] = lightcuts_json(*r.lightcuts);
+    if (r.method == "path") j["max_bounces"] = r.max_bounces;
+    if (r.indirect)
+        j["indirect"] = {{"vpls", r.indirect->vpls},
+                         {"paths", r.indirect->paths},
+                         {"max_bounces", r.indirect->max_bounces},
+                         {"clamp", r.indirect->clamp}};
     if (r.sampling) {
         j["sampling"] = {{"light_samples", r.sampling->light_samples}};
         if (!r.sampling->light_pick.empty()) j["sampling"]["light_pick"] = r.sampling->light_pick;

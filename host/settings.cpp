@@ -36,6 +36,13 @@ std::string setting_problem(std::string_view key, double value) {
     if (key == kSettingLightSamples) return integer_problem(value, 1, kMaxLightSamplesPerPoint);
     if (key == kSettingAreaLightSamples || key == kSettingDirections)
         return integer_problem(value, 1, kMaxLightSamples);
+    if (key == kSettingVpls) return integer_problem(value, 0, kMaxVpls);
+    if (key == kSettingMaxBounces) return integer_problem(value, 0, kMaxBounces);
+    if (key == kSettingTimeLimit || key == kSettingClamp) {
+        if (!(value >= 0.0 && value <= double(std::numeric_limits<float>::max())))
+            return "must be a finite number, 0 or more";
+        return "";
+    }
     if (key == kSettingRelativeError) {
         if (!(value >= 0.0 && value <= double(kMaxRelativeError)))
             return "must be a number from 0 to " + shortest(kMaxRelativeError);
@@ -45,8 +52,11 @@ std::string setting_problem(std::string_view key, double value) {
 }
 
 std::string method_problem(std::string_view method) {
-    if (method == "brute" || method == "lightcuts" || method == "sampled" || method == "stochastic") return "";
-    return "must be \"brute\", \"lightcuts\", \"sampled\" or \"stochastic\", got \"" + std::string(method) + "\"";
+    if (method == "brute" || method == "lightcuts" || method == "sampled" || method == "stochastic" ||
+        method == "path")
+        return "";
+    return "must be \"brute\", \"lightcuts\", \"sampled\", \"stochastic\" or \"path\", got \"" +
+           std::string(method) + "\"";
 }
 
 std::string light_pick_problem(std::string_view pick) {
@@ -65,6 +75,8 @@ void validate_render_options(const RenderOptions& o) {
         {kSettingMaxCut, o.max_cut},
         {kSettingSeed, o.seed},
         {kSettingLightSamples, o.light_samples},
+        {kSettingMaxBounces, o.max_bounces},
+        {kSettingTimeLimit, o.time_limit},
     };
     for (const auto& [key, value] : values) {
         problem = setting_problem(key, value);

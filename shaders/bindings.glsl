@@ -49,7 +49,7 @@ LC_CONST uint kPixelHeapOverflow = 1u;  // a heap outgrew its capacity (a bug: t
 LC_CONST uint kPixelLoopLimit = 2u;     // the driver cut the invocation's loops short
 LC_CONST uint kPixelCutUnfinished = 4u; // refinement went on past the pass's last dispatch (a bug)
 
-// Per tile pixel, summed over the samples of the pixel (32 bytes). The two
+// Per tile pixel, summed over the samples of the pixel (40 bytes). The three
 // sums that can pass 2^32 (10^6 lights times 4295 samples do) are 64-bit
 // counts kept as lo/hi word pairs, added to with lc_count_add, so no device
 // needs shaderInt64; the host joins them with count64. Sample counts stay
@@ -61,6 +61,7 @@ struct PixelStats {
     uint spill_samples;     // samples whose heap grew past kHeapShared slots
     uint flags;             // kPixel* bits, or-ed over samples
     uint pad0;
+    uint cut_indirect_lo, cut_indirect_hi;  // ... of which virtual point lights
 };
 
 #ifdef __cplusplus
@@ -76,7 +77,7 @@ void lc_count_add(inout uint lo, inout uint hi, uint v) {
 
 // A Lightcuts cut in the making, kept in global memory between the
 // dispatches of one sample when the refinement is spread over several
-// (48 bytes). The heap slots themselves stay in the spill buffer.
+// (52 bytes). The heap slots themselves stay in the spill buffer.
 LC_CONST uint kCutDone = 1u;       // result added to the pixel; later dispatches skip it
 LC_CONST uint kCutSpilled = 2u;    // the heap went past kHeapShared slots
 LC_CONST uint kCutSelected = 4u;   // stochastic: the cut is final; its clusters are being shaded
@@ -92,6 +93,7 @@ struct CutState {
     float heap_r, heap_g, heap_b;
     uint shaded;
     uint draw;
+    uint cut_indirect;             // VPL clusters of cut_size
 };
 
 // PushConstants.cut_flags

@@ -19,6 +19,7 @@ void main() {
     stats.cut_size = 0u;
     stats.shadow_rays = 0u;
     stats.hit_max_cut = 0u;
+    stats.cut_indirect = 0u;
     vec3 c = lc_shade_brute(lc_texel_surface(g), push.light_count, frame.min_distance2, stats);
     lc_accumulate(i, c);
     lc_count_add(pixel_stats[i].shadow_rays_lo, pixel_stats[i].shadow_rays_hi, stats.shadow_rays);

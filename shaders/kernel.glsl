@@ -34,6 +34,7 @@ layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_sta
 #define LC_MATERIAL(i) materials[i]
 #define LC_NORMALS(i) normals[i]
 #define LC_LIGHT_NODE(i) light_nodes[i]
+#define LC_VPL_MIN_DISTANCE2 frame.vpl_min_distance2
 #define LC_ENVIRONMENT_TEXEL(i) vec3(environment[3u * (i)], environment[3u * (i) + 1u], environment[3u * (i) + 2u])
 // LC_LIGHT is defined by each kernel (brute force offsets it by light_first).
 

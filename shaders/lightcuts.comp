@@ -35,6 +35,7 @@ void main() {
     stats.cut_size = 0u;
     stats.shadow_rays = 0u;
     stats.hit_max_cut = 0u;
+    stats.cut_indirect = 0u;
     uint heap_size = 0u;
     vec3 leaf_sum = vec3(0.0f);
     vec3 heap_sum = vec3(0.0f);
@@ -48,6 +49,7 @@ void main() {
         if ((s.flags & kCutDone) != 0u) return;
         heap_size = s.heap_size;
         stats.cut_size = s.cut_size;
+        stats.cut_indirect = s.cut_indirect;
         stats.shadow_rays = s.shadow_rays;
         g_heap_spilled = (s.flags & kCutSpilled) != 0u;
         selected = (s.flags & kCutSelected) != 0u;
@@ -93,6 +95,7 @@ void main() {
         CutState s;
         s.heap_size = heap_size;
         s.cut_size = stats.cut_size;
+        s.cut_indirect = stats.cut_indirect;
         s.shadow_rays = stats.shadow_rays;
         s.flags = (g_heap_spilled ? kCutSpilled : 0u) | (selected ? kCutSelected : 0u);
         s.leaf_r = leaf_sum.x; s.leaf_g = leaf_sum.y; s.leaf_b = leaf_sum.z;
@@ -106,6 +109,7 @@ void main() {
     lc_accumulate(i, kStochastic ? heap_sum : lc_cut_result(heap_size, leaf_sum));
     PixelStats ps = pixel_stats[i];
     lc_count_add(ps.cut_size_lo, ps.cut_size_hi, stats.cut_size);
+    lc_count_add(ps.cut_indirect_lo, ps.cut_indirect_hi, stats.cut_indirect);
     lc_count_add(ps.shadow_rays_lo, ps.shadow_rays_hi, stats.shadow_rays);
     ps.max_cut_samples += stats.hit_max_cut;
     ps.spill_samples += g_heap_spilled ? 1u : 0u;

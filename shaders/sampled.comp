@@ -22,6 +22,7 @@ void main() {
     stats.cut_size = 0u;
     stats.shadow_rays = 0u;
     stats.hit_max_cut = 0u;
+    stats.cut_indirect = 0u;
     uint stream = lc_sample_stream(frame.seed, lc_tile_x(i), lc_tile_y(i), push.sample_index);
     vec3 c = lc_shade_sampled(lc_texel_surface(g), frame, stream, push.light_first, push.light_count, stats);
     lc_accumulate(i, c * (1.0f / float(frame.light_samples)));

@@ -185,7 +185,7 @@ TEST(Lightcuts, MaxCutOneUsesTheRootRepresentative) {
         for (std::uint32_t x = 0; x < 24; ++x) {
             Kernel::SurfacePoint sp;
             ASSERT_TRUE(k.lc_camera_hit(f, x, y, 0, sp));
-            Kernel::ShadeStats ss{0, 0, 0};
+            Kernel::ShadeStats ss{0, 0, 0, 0};
             glm::vec3 expected = k.lc_rep_unit(sp, root.rep_light, f.min_distance2, ss) * root_intensity;
             glm::vec3 got = r.image.at(x, y);
             ASSERT_EQ(got, expected) << x << "," << y;

@@ -25,6 +25,7 @@ const char* light_total_name(std::uint32_t type) {
         case gpu::kLightDirectional: return "irradiance of the directional lights";
         case gpu::kLightSpot: return "intensity of the spot lights";
         case gpu::kLightOriented: return "intensity of the oriented lights";
+        case gpu::kLightVpl: return "intensity of the virtual point lights";
         default: return "intensity of the lights";
     }
 }

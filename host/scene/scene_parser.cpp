@@ -100,7 +100,8 @@ private:
         const std::string path = "render";
         in_.expect_object(j, path);
         in_.check_keys(j, path, {kSettingMethod, kSettingSpp, kSettingRelativeError, kSettingMaxCut, kSettingSeed,
-                                 kSettingAreaLightSamples, kSettingLightSamples, kSettingLightPick});
+                                 kSettingAreaLightSamples, kSettingLightSamples, kSettingLightPick,
+                                 kSettingMaxBounces, kSettingTimeLimit, kSettingIndirect});
         RenderSettings& r = scene_.render;
         if (const json* v = JsonReader::find(j, kSettingMethod)) {
             const std::string field = join_key(path, kSettingMethod);
@@ -112,20 +113,36 @@ private:
             r.light_pick = in_.string(*v, field);
             if (const std::string problem = light_pick_problem(r.light_pick); !problem.empty()) in_.fail(field, problem);
         }
-        const auto setting = [&](std::string_view key) -> std::optional<double> {
-            const json* v = JsonReader::find(j, key);
-            if (!v) return std::nullopt;
-            const std::string field = join_key(path, key);
-            const double value = in_.number_value(*v, field);
-            if (const std::string problem = setting_problem(key, value); !problem.empty()) in_.fail(field, problem);
-            return value;
-        };
+        const auto setting = [&](std::string_view key) { return number_setting(j, path, key); };
         if (const auto v = setting(kSettingSpp)) r.spp = static_cast<std::uint32_t>(*v);
         if (const auto v = setting(kSettingRelativeError)) r.relative_error = static_cast<float>(*v);
         if (const auto v = setting(kSettingMaxCut)) r.max_cut = static_cast<std::uint32_t>(*v);
         if (const auto v = setting(kSettingSeed)) r.seed = static_cast<std::uint32_t>(*v);
         if (const auto v = setting(kSettingAreaLightSamples)) r.area_light_samples = static_cast<std::uint32_t>(*v);
         if (const auto v = setting(kSettingLightSamples)) r.light_samples = static_cast<std::uint32_t>(*v);
+        if (const auto v = setting(kSettingMaxBounces)) r.max_bounces = static_cast<std::uint32_t>(*v);
+        if (const auto v = setting(kSettingTimeLimit)) r.time_limit = *v;
+        if (const json* v = JsonReader::find(j, kSettingIndirect)) parse_indirect(*v, join_key(path, kSettingIndirect));
+    }
+
+    // render.indirect: {"vpls": N, "max_bounces": B, "clamp": D}.
+    void parse_indirect(const json& j, const std::string& path) {
+        in_.expect_object(j, path);
+        in_.check_keys(j, path, {kSettingVpls, kSettingMaxBounces, kSettingClamp});
+        IndirectSettings& ind = scene_.render.indirect;
+        if (const auto v = number_setting(j, path, kSettingVpls)) ind.vpls = static_cast<std::uint32_t>(*v);
+        if (const auto v = number_setting(j, path, kSettingMaxBounces)) ind.max_bounces = static_cast<std::uint32_t>(*v);
+        if (const auto v = number_setting(j, path, kSettingClamp)) ind.clamp = static_cast<float>(*v);
+    }
+
+    // The number at j[key], checked by setting_problem; nullopt when absent.
+    std::optional<double> number_setting(const json& j, const std::string& path, std::string_view key) const {
+        const json* v = JsonReader::find(j, key);
+        if (!v) return std::nullopt;
+        const std::string field = join_key(path, key);
+        const double value = in_.number_value(*v, field);
+        if (const std::string problem = setting_problem(key, value); !problem.empty()) in_.fail(field, problem);
+        return value;
     }
 
     // -- meshes -------------------------------------------------------------

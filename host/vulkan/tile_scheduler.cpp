@@ -133,6 +133,7 @@ void TileScheduler::read_back(const Tile& tile, RenderResult& result) const {
         out.shadow_rays += gpu::count64(ps.shadow_rays_lo, ps.shadow_rays_hi);
         out.max_cut_pixels += ps.max_cut_samples;
         out.heap_spill_pixels += ps.spill_samples;
+        out.cut_indirect_total += gpu::count64(ps.cut_indirect_lo, ps.cut_indirect_hi);
         // The CPU reference's rounding of the mean, so equal cuts compare equal.
         if (method_.reports_cuts())
             out.cut_size[std::size_t(y) * frame_.width + x] =

@@ -24,11 +24,11 @@ static_assert(sizeof(gpu::PushConstants) == 36);
 static_assert(offsetof(gpu::PushConstants, sample_index) == 16);
 static_assert(offsetof(gpu::PushConstants, refine_budget) == 32);
 // The std430 layouts of bindings.glsl's records: 4-byte scalars only.
-static_assert(sizeof(gpu::PixelStats) == 32);
+static_assert(sizeof(gpu::PixelStats) == 40);
 static_assert(offsetof(gpu::PixelStats, shadow_rays_lo) == 8);
 static_assert(offsetof(gpu::PixelStats, max_cut_samples) == 16);
 static_assert(offsetof(gpu::PixelStats, flags) == 24);
-static_assert(sizeof(gpu::CutState) == 48);
+static_assert(sizeof(gpu::CutState) == 52);
 
 RenderResult render(const Context& ctx, const PreparedScene& prepared,
                     const RenderOptions& options, const Tuning& tuning) {
@@ -46,6 +46,7 @@ RenderResult render(const Context& ctx, const PreparedScene& prepared,
                             setup.resources, frame, tuning.target_dispatch_ms, options.progress);
     scheduler.render(result);
 
+    stats.spp_done = frame.spp;
     stats.camera_rays = std::uint64_t(frame.width) * frame.height * frame.spp;
     stats.heap_capacity_shared = setup.method->heap().shared;
     stats.buffer_bytes = setup.resources.buffer_bytes();
@@ -112,6 +113,8 @@ Tuning Tuning::from_environment() {
 
 RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& options,
                            const VulkanOptions& vulkan, const Tuning& tuning) {
+    if (options.method == "path")
+        throw std::invalid_argument("method path (the path tracer) runs on the CPU only: use --device cpu");
     const Clock::time_point start = Clock::now();
     MessageLog log;
     RenderResult result;

@@ -31,6 +31,12 @@ struct PreparedScene {
     std::size_t area_lights = 0;
     std::size_t environment_lights = 0;
     double light_sampling_seconds = 0.0;
+    // Virtual point lights (render.indirect, host/vpls.h): how many, the light
+    // paths that left them, the time tracing took, and their falloff clamp.
+    std::size_t vpls = 0;
+    std::size_t vpl_paths = 0;
+    double vpl_seconds = 0.0;
+    float vpl_min_distance2 = 0.0f;
 };
 
 // Takes ownership of the scene; builds the BVH and the light tree.
@@ -79,6 +85,7 @@ struct RenderStats {
     std::uint32_t loop_limit_retries = 0;   // GPU: tiles rendered again with the work split over
                                             // more dispatches (the driver cut loops short)
     std::vector<float> cut_size;      // per pixel, mean over samples (lightcuts only)
+    std::uint64_t cut_indirect_total = 0;  // lightcuts: VPL clusters, summed over every sample's cut
     std::vector<std::pair<std::string, std::uint64_t>> buffer_bytes;
 };
 

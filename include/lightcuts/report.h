@@ -24,6 +24,7 @@ struct LightcutsReport {
     std::size_t tree_nodes = 0;
     std::uint64_t tree_bytes = 0;
     double cut_size_mean = 0.0, cut_size_p50 = 0.0, cut_size_p99 = 0.0, cut_size_max = 0.0;
+    double cut_indirect_mean = 0.0;           // of cut_size_mean, VPL clusters (indirect light)
     std::uint64_t max_cut_samples = 0;        // samples whose refinement stopped at max_cut
     std::uint32_t heap_capacity_shared = 0;   // GPU only
     std::uint64_t heap_spill_samples = 0;     // GPU only
@@ -34,15 +35,25 @@ struct SamplingReport {
     std::string light_pick;                   // sampled: "tree", "uniform" or "power"; stochastic: ""
 };
 
+// Indirect light through VPLs (render.indirect).
+struct IndirectReport {
+    std::size_t vpls = 0;                     // in `lights`
+    std::size_t paths = 0;                    // light paths traced to leave them
+    std::uint32_t max_bounces = 0;            // VPLs per path at most; 0: roulette
+    float clamp = 0.0f;                       // distance where a VPL's 1/d^2 stops growing
+};
+
 struct RenderReport {
     std::string scene, method, device;
     std::uint32_t width = 0, height = 0, spp = 0, seed = 0;
+    std::uint32_t spp_requested = 0;         // spp is what was rendered (path: less at a time limit)
+    std::uint32_t max_bounces = 0;           // path only
     std::size_t triangles = 0, lights = 0, bvh_nodes = 0;
     std::size_t black_lights = 0;             // zero-intensity lights left out of the tree
     std::size_t area_lights = 0;              // samples of the emissive surfaces (in `lights`)
     std::size_t environment_lights = 0;       // directions of the environment (in `lights`)
     struct Seconds {
-        double load = 0.0, bvh_build = 0.0, light_tree_build = 0.0, light_sampling = 0.0;
+        double load = 0.0, bvh_build = 0.0, light_tree_build = 0.0, light_sampling = 0.0, vpls = 0.0;
         double render = 0.0, primary = 0.0, shading = 0.0;
     } seconds;
     std::uint64_t camera_rays = 0, shadow_rays = 0;
@@ -53,6 +64,7 @@ struct RenderReport {
     std::vector<BufferBytes> buffer_bytes;
     std::optional<LightcutsReport> lightcuts; // methods "lightcuts" and "stochastic"
     std::optional<SamplingReport> sampling;   // methods "sampled" and "stochastic"
+    std::optional<IndirectReport> indirect;   // scenes with VPLs
 };
 
 // `scene_file` is reported as given; `load_seconds` is the time load_scene took.

@@ -23,8 +23,17 @@ struct Camera {
     std::uint32_t height = 256;
 };
 
+// Indirect light through virtual point lights (the render block's
+// "indirect" object; host/vpls.h).
+struct IndirectSettings {
+    std::uint32_t vpls = 0;         // VPLs to leave; 0: direct light only
+    std::uint32_t max_bounces = 3;  // VPLs per light path at most; 0: until Russian roulette ends it
+    float clamp = 0.0f;             // VPLs' 1/d^2 stops growing below this distance (scene
+                                    // units): biased, darker in corners; 0: none (consistent)
+};
+
 struct RenderSettings {
-    std::string method = "brute";   // "brute", "lightcuts", "sampled" or "stochastic"
+    std::string method = "brute";   // "brute", "lightcuts", "sampled", "stochastic" or "path"
     std::uint32_t spp = 1;          // camera rays per pixel (stratified, jittered)
     float relative_error = 0.02f;   // lightcuts: refine while bound > this * estimate
     std::uint32_t max_cut = 1000;   // lightcuts: largest cut per shaded point
@@ -33,6 +42,9 @@ struct RenderSettings {
     std::string light_pick = "tree";  // sampled: "tree", "uniform" or "power"
     // Point samples the emissive triangles become, in all (area_lights.h).
     std::uint32_t area_light_samples = 65536;
+    IndirectSettings indirect;
+    std::uint32_t max_bounces = 0;  // path: surface interactions per path; 0: unlimited (roulette)
+    double time_limit = 0.0;        // path: seconds, then stop after the current sample pass; 0: none
 };
 
 // An environment: lat-long RGB radiance, +Y up (docs/scene-format.md). A

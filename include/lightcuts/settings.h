@@ -15,6 +15,8 @@ inline constexpr std::uint32_t kMaxImageSide = 16384;  // width and height
 inline constexpr float kMaxRelativeError = 1.0f;       // lightcuts threshold, as a fraction
 inline constexpr std::uint32_t kMaxLightSamples = 1u << 24;  // area-light samples, environment directions
 inline constexpr std::uint32_t kMaxLightSamplesPerPoint = 65536;  // sampled, stochastic: light_samples
+inline constexpr std::uint32_t kMaxVpls = 1u << 24;    // render.indirect.vpls
+inline constexpr std::uint32_t kMaxBounces = 1024;     // max_bounces (path and indirect); 0 = unlimited
 // max_cut may be any positive 32-bit value: the cut heap is sized by the
 // light tree, never by max_cut (a cut cannot outgrow the tree).
 
@@ -31,6 +33,11 @@ inline constexpr std::string_view kSettingAreaLightSamples = "area_light_samples
 inline constexpr std::string_view kSettingDirections = "directions";  // of an environment
 inline constexpr std::string_view kSettingLightSamples = "light_samples";  // sampled, stochastic
 inline constexpr std::string_view kSettingLightPick = "light_pick";        // --method sampled
+inline constexpr std::string_view kSettingMaxBounces = "max_bounces";      // path, and indirect's
+inline constexpr std::string_view kSettingTimeLimit = "time_limit";        // path, seconds
+inline constexpr std::string_view kSettingIndirect = "indirect";           // the VPL block:
+inline constexpr std::string_view kSettingVpls = "vpls";                   //   VPL count
+inline constexpr std::string_view kSettingClamp = "clamp";                 //   falloff clamp distance
 
 // What is wrong with `value` for the numeric setting `key` (one of the
 // kSetting* names above, not method), or "" when it is valid. Integer
@@ -38,7 +45,7 @@ inline constexpr std::string_view kSettingLightPick = "light_pick";        // --
 std::string setting_problem(std::string_view key, double value);
 
 // What is wrong with a method name, or "" for "brute", "lightcuts",
-// "sampled" and "stochastic".
+// "sampled", "stochastic" and "path" (the path tracer, CPU only).
 std::string method_problem(std::string_view method);
 
 // True for the methods that select a lightcut per shaded point (and so

@@ -108,6 +108,9 @@ void lc_cut_start(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_
         root_count += 1u;
     }
     stats.cut_size = root_count;
+    // A tree holds one type, so a refinement changes the count of VPL
+    // clusters by one exactly where it splits a VPL node.
+    stats.cut_indirect = f.roots[kLightVpl] != kInvalidIndex ? 1u : 0u;
 }
 
 // Refines the cluster with the largest bound; false (cut unchanged) once the
@@ -132,6 +135,7 @@ bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) he
     lc_add_cluster(sp, m, node.left + 1u, right_shares, unit, f.min_distance2, heap_size,
                    leaf_sum, heap_sum, stats);
     stats.cut_size += 1u;
+    if (lc_node_type(node) == kLightVpl) stats.cut_indirect += 1u;
     return true;
 }
 

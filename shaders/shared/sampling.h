@@ -63,7 +63,7 @@ float lc_cluster_importance(SurfacePoint sp, LightNode node, float min_distance2
     float emission = (positional && kEnableOriented) ? lc_emission_bound(node, sp.p) : 1.0f;
     if (!(emission > 0.0f)) return 0.0f;
     float importance = lc_luminance(lc_node_intensity(node)) * min(cos_bound * kBoundSlack, 1.0f) * emission;
-    if (positional) importance /= max(max(d2, r2), min_distance2);
+    if (positional) importance /= max(max(d2, r2), lc_falloff_clamp2(min_distance2, lc_node_type(node)));
     return importance;
 }
 

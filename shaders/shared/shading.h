@@ -7,6 +7,7 @@
 //   LC_NORMALS(i)    -> TriangleNormals
 //   LC_LIGHT(i)      -> Light
 //   LC_ENVIRONMENT_TEXEL(i) -> vec3 (radiance of environment texel i)
+//   LC_VPL_MIN_DISTANCE2 -> float (FrameParams.vpl_min_distance2)
 // and the feature switches kEnableGgx, kEnableShadows and kEnableOriented
 // (specialization constants on the GPU, so a scene without GGX materials,
 // without occluders or without spot and oriented lights gets a kernel
@@ -141,6 +142,7 @@ bool lc_camera_sample(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint
 // Statistics of one shaded point.
 struct ShadeStats {
     uint cut_size;      // clusters in the final cut
+    uint cut_indirect;  // ... of them virtual point lights (indirect light)
     uint shadow_rays;   // rays actually traced
     uint hit_max_cut;   // 1 if refinement stopped at max_cut, not at the threshold
 };
@@ -189,6 +191,13 @@ float lc_spot_falloff(Light light, float cos_theta) {
     return s * s;
 }
 
+// The clamp of the inverse-square falloff, 1/max(d^2, clamp), for a light of
+// `type`: VPLs may have a larger one (render.indirect.clamp), which bounds
+// what any one of them adds near its surface.
+float lc_falloff_clamp2(float min_distance2, uint type) {
+    return type == kLightVpl ? max(min_distance2, LC_VPL_MIN_DISTANCE2) : min_distance2;
+}
+
 // One light's contribution per unit intensity (material * geometry *
 // emission), with the shadow ray it needs: direction, and length
 // (kRayInfinity for directional lights). Zero when the light is behind the
@@ -213,7 +222,7 @@ vec3 lc_light_unit(SurfacePoint sp, Light light, float min_distance2, LC_OUT(vec
         if (!(d > 0.0f)) return vec3(0.0f);
         wi = to_light / d;
         t_max = d * (1.0f - kShadowEndRelative);
-        factor = 1.0f / max(d2, min_distance2);
+        factor = 1.0f / max(d2, lc_falloff_clamp2(min_distance2, type));
         // cos of the angle between the light's axis and the way to sp.
         float cos_axis = -dot(vec3(light.axis_x, light.axis_y, light.axis_z), wi);
         switch (kEnableOriented ? type : kLightPoint) {
@@ -223,6 +232,7 @@ vec3 lc_light_unit(SurfacePoint sp, Light light, float min_distance2, LC_OUT(vec
                 factor *= lc_spot_falloff(light, cos_axis);
                 break;
             case kLightOriented:
+            case kLightVpl:
                 factor *= (light.type & kLightTwoSided) != 0u ? abs(cos_axis) : max(cos_axis, 0.0f);
                 break;
             default:  // the loader and the tree builder admit no other type
@@ -371,7 +381,7 @@ float lc_emission_bound(LightNode node, vec3 x) {
     float theta_e = lc_safe_acos(node.cos_theta_e);
     if (theta >= theta_e) return 0.0f;
     uint type = lc_node_type(node);
-    if (type == kLightOriented) return min(cos(theta) * kBoundSlack, 1.0f);
+    if (type == kLightOriented || type == kLightVpl) return min(cos(theta) * kBoundSlack, 1.0f);
     if (type != kLightSpot) return 1.0f;
     // cos(theta_e + kAngleSlack), a little below the stored cosine, which
     // went through acos and cos on the host.
@@ -396,7 +406,8 @@ vec3 lc_cluster_bound(SurfacePoint sp, Material m, LightNode node, float min_dis
     if (positional) {
         if (kEnableOriented) factor = lc_emission_bound(node, sp.p);
         if (factor <= 0.0f) return vec3(0.0f);
-        factor *= kBoundSlack / max(lc_box_distance2(box_min, box_max, sp.p), min_distance2);
+        factor *= kBoundSlack / max(lc_box_distance2(box_min, box_max, sp.p),
+                                    lc_falloff_clamp2(min_distance2, lc_node_type(node)));
     }
     vec3 bound = lc_kd(m) * (cos_bound / kPi);
     if (kEnableGgx && (m.flags & kMaterialHasSpecular) != 0u)

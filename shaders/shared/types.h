@@ -31,7 +31,9 @@ LC_CONST uint kLightPoint = 0u;        // position, radiant intensity (W/sr)
 LC_CONST uint kLightDirectional = 1u;  // unit direction towards the light, irradiance (W/m^2)
 LC_CONST uint kLightSpot = 2u;         // position, axis, intensity on the axis, glTF cone falloff
 LC_CONST uint kLightOriented = 3u;     // position, normal, intensity along the normal, cosine falloff
-LC_CONST uint kLightTypeCount = 4u;
+LC_CONST uint kLightVpl = 4u;          // virtual point light: an oriented light left by a light path
+                                       // (indirect light); its falloff has its own clamp
+LC_CONST uint kLightTypeCount = 5u;
 
 // Light.type: the type in bits 0-7, and:
 LC_CONST uint kLightTypeMask = 0xFFu;
@@ -100,6 +102,8 @@ struct Material {
 //   oriented:     position, unit normal, intensity along the normal (W/sr);
 //                 I(w) = I * max(0, cos) (|cos| when two-sided): one point
 //                 sample of an emissive surface
+//   vpl:          as oriented, one-sided: the light a diffuse surface
+//                 reflects where a light path hit it (host/vpls.h)
 struct Light {
     float x, y, z;
     float r, g, b;
@@ -175,7 +179,8 @@ struct FrameParams {
     uint env_width, env_height;   // environment map seen by rays that leave; 0 x 0: black
     uint light_samples;           // sampled: lights per camera sample; stochastic: draws per cluster
     uint light_pick;              // --method sampled: kLightPick*
-    uint pad0, pad1, pad2;
+    float vpl_min_distance2;      // VPLs' inverse-square clamp: min_distance2 or render.indirect.clamp^2
+    uint pad0;
 };
 
 #ifdef __cplusplus

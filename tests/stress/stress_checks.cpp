@@ -215,7 +215,7 @@ void expect_cut_guarantee(const PreparedScene& p, const RenderOptions& o,
     double largest_share = 0.0;  // |difference| / sum of bounds, the tightest point
     for (const ShadingPoint& s : points) {
         const gpu::Material m = p.scene.materials[s.sp.material];
-        Kernel::ShadeStats stats{0u, 0u, 0u};
+        Kernel::ShadeStats stats{0u, 0u, 0u, 0u};
         std::uint32_t heap_size = 0;
         glm::vec3 leaf_sum, heap_sum;
         k.lc_cut_start(s.sp, m, f, heap_size, leaf_sum, heap_sum, stats);

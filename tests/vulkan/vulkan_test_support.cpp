@@ -144,7 +144,7 @@ std::uint64_t count_spilling_samples(const PreparedScene& p, const RenderOptions
             for (std::uint32_t s = 0; s < f.spp; ++s) {
                 cpu::ShadeKernel::SurfacePoint sp;
                 if (!k.lc_camera_hit(f, x, y, s, sp)) continue;
-                cpu::ShadeKernel::ShadeStats stats{0u, 0u, 0u};
+                cpu::ShadeKernel::ShadeStats stats{0u, 0u, 0u, 0u};
                 k.heap_high_water = 0;
                 k.lc_shade_lightcuts(sp, f, stats);
                 spilled += k.heap_high_water > shared_slots ? 1 : 0;

@@ -1,0 +1,50 @@
+// Indirect light as virtual point lights (instant radiosity, Keller 1997;
+// Walter et al. 2005, section 5): light paths traced from the lights leave
+// a VPL at every diffuse bounce, and the VPLs go into the light tree as one
+// more light type (kLightVpl), so lightcuts renders one-bounce-and-more
+// indirect light with the same cuts that render direct light.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "lightcuts/bvh.h"
+#include "lightcuts/scene.h"
+#include "shared/types.h"
+
+namespace lc {
+
+struct VplSet {
+    std::vector<gpu::Light> lights;  // kLightVpl records
+    std::size_t paths = 0;           // light paths traced to leave them
+};
+
+// Traces light paths from `emitters` until they have left settings.vpls VPLs
+// (whole paths: the last may add a few more), or until 64 times as many
+// paths as VPLs found too few surfaces to stop at.
+//
+// `emitters` are the lights the tree holds: the scene's, the area-light
+// samples and the environment's directions, so the VPLs carry exactly the
+// light that lightcuts' direct lighting sees. A path starts at a light
+// chosen in proportion to its power, in a direction drawn from its
+// emission (uniform for a point light, within the cone for a spot,
+// cosine-weighted for an oriented light, from a disk as wide as the scene
+// for a directional light), carrying flux Phi = I(w) / (P(light) pdf(w)).
+// Where it hits a surface with Lambert albedo kd it leaves a one-sided
+// cosine emitter on the side it came from, of intensity Phi kd / pi along
+// the shading normal, divided by the number of paths; then it continues in
+// a cosine-weighted direction with flux Phi kd / q, where q = min(1,
+// max(kd)) is the chance it survives Russian roulette, until it has left
+// settings.max_bounces VPLs (0: until roulette ends it).
+//
+// Only the Lambert lobe reflects light along a path: light that a glossy
+// lobe would reflect on to other surfaces is missing (docs/lightcuts.md);
+// glossy receivers still shade the VPLs with their full BRDF.
+//
+// `scene` holds the triangles in `bvh`'s leaf order. Deterministic for a
+// seed whatever the thread count (0 = all cores).
+VplSet trace_vpls(const Scene& scene, const Bvh& bvh, std::span<const gpu::Light> emitters,
+                  const IndirectSettings& settings, std::uint32_t seed, unsigned threads = 0);
+
+}  // namespace lc
