@@ -2,7 +2,9 @@
 // area lights, an environment map) through the Vulkan path against the CPU
 // reference, with the tolerances of vulkan_test_support.h; brute force
 // against lightcuts at error 0 over the sampled lights on both devices; and
-// the stochastic methods (sampled, stochastic) on both devices.
+// the stochastic methods (sampled, stochastic) on both devices; and all of
+// that again with indirect light as virtual point lights, with and without
+// their falloff clamp.
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -24,7 +26,7 @@ using vulkan_test::Vulkan;
 
 // The random scene with spots aimed at the ground, an emissive box top and
 // a small environment map with a bright texel.
-Scene light_model_scene(std::uint32_t seed, bool spots, bool emitters, bool environment) {
+Scene light_model_scene(std::uint32_t seed, bool spots, bool emitters, bool environment, float vpl_clamp = -1.0f) {
     Scene s = random_scene(seed, spots ? 0 : 20, 0, 40, 32);
     if (spots)
         for (int i = 0; i < 60; ++i) {
@@ -50,13 +52,22 @@ Scene light_model_scene(std::uint32_t seed, bool spots, bool emitters, bool envi
         for (int c = 0; c < 3; ++c) s.environment.rgb[(2 * 16 + 5) * 3 + c] = 40.0f;  // a sun
         s.environment.directions = 200;
     }
+    if (vpl_clamp >= 0.0f) {
+        s.render.indirect.vpls = 1500;
+        s.render.indirect.clamp = vpl_clamp;
+    }
     return s;
 }
 
 struct Case {
     const char* name;
     bool spots, emitters, environment;
+    float vpl_clamp = -1.0f;  // >= 0: with 1500 VPLs and this clamp
 };
+
+Scene light_model_scene(std::uint32_t seed, const Case& c) {
+    return light_model_scene(seed, c.spots, c.emitters, c.environment, c.vpl_clamp);
+}
 
 class VulkanLights : public Vulkan, public ::testing::WithParamInterface<Case> {};
 
@@ -69,20 +80,29 @@ constexpr double kLightModelRelative = 1e-4;
 
 TEST_P(VulkanLights, BruteAndLightcutsMatchCpu) {
     const Case& c = GetParam();
-    PreparedScene p = prepare_scene(light_model_scene(31, c.spots, c.emitters, c.environment), 1);
-    EXPECT_EQ(p.has_oriented, c.spots || c.emitters);
+    PreparedScene p = prepare_scene(light_model_scene(31, c), 1);
+    const bool indirect = c.vpl_clamp >= 0.0f;
+    EXPECT_EQ(p.has_oriented, c.spots || c.emitters || indirect);
+    EXPECT_EQ(p.vpls > 0, indirect);
     const RenderOptions brute = options("brute", 40, 32);
     expect_brute_matches(p, brute, gpu(p, brute), kLightModelRelative);
     RenderOptions lc = options("lightcuts", 40, 32);
     lc.max_cut = 200;
-    expect_lightcuts_matches(p, lc, gpu(p, lc));
+    const RenderResult g = gpu(p, lc);
+    expect_lightcuts_matches(p, lc, g);
+    // The cut's VPL clusters are counted alike (pixels whose cut differs by
+    // rounding may move the sum a little, as the cut sizes).
+    const RenderResult cpu = render_cpu(p, lc);
+    EXPECT_EQ(cpu.stats.cut_indirect_total > 0, indirect);
+    EXPECT_NEAR(double(g.stats.cut_indirect_total), double(cpu.stats.cut_indirect_total),
+                0.01 * double(cpu.stats.cut_indirect_total));
 }
 
 // Lightcuts at error 0 and no cut limit is brute force over the sampled
 // lights, on both devices.
 TEST_P(VulkanLights, ZeroErrorLightcutsIsBruteForce) {
     const Case& c = GetParam();
-    PreparedScene p = prepare_scene(light_model_scene(32, c.spots, c.emitters, c.environment), 1);
+    PreparedScene p = prepare_scene(light_model_scene(32, c), 1);
     RenderOptions lc = options("lightcuts", 40, 32);
     lc.relative_error = 0.0f;
     lc.max_cut = 4000000000u;
@@ -106,7 +126,7 @@ TEST_P(VulkanLights, ZeroErrorLightcutsIsBruteForce) {
 // pixels may differ by a light's contribution; they are only counted.
 TEST_P(VulkanLights, SampledAndStochasticMatchCpu) {
     const Case& c = GetParam();
-    PreparedScene p = prepare_scene(light_model_scene(33, c.spots, c.emitters, c.environment), 1);
+    PreparedScene p = prepare_scene(light_model_scene(33, c), 1);
     struct Method {
         const char* method;
         const char* pick;
@@ -146,7 +166,8 @@ TEST_P(VulkanLights, SampledAndStochasticMatchCpu) {
             << label;
         if (std::string(m.method) == "stochastic") {
             EXPECT_LE(double(vulkan_test::pixels_with_different_cut(g.stats, cpu.stats)),
-                      vulkan_test::kCutsDifferFraction * double(differs.size()));
+                      (p.vpls ? vulkan_test::kVplCutsDifferFraction : vulkan_test::kCutsDifferFraction) *
+                          double(differs.size()));
         }
     }
 }
@@ -157,7 +178,7 @@ TEST_P(VulkanLights, SampledAndStochasticMatchCpu) {
 // images are those of one dispatch, up to the order of the sums.
 TEST_P(VulkanLights, SampledAndStochasticSplitOverDispatches) {
     const Case& c = GetParam();
-    PreparedScene p = prepare_scene(light_model_scene(34, c.spots, c.emitters, c.environment), 1);
+    PreparedScene p = prepare_scene(light_model_scene(34, c), 1);
     vk::Tuning split;
     split.lights_per_dispatch = 2;
     split.refinements_per_dispatch = 5;
@@ -179,7 +200,9 @@ TEST_P(VulkanLights, SampledAndStochasticSplitOverDispatches) {
 
 INSTANTIATE_TEST_SUITE_P(Kinds, VulkanLights,
                          ::testing::Values(Case{"spots", true, false, false}, Case{"area", false, true, false},
-                                           Case{"environment", false, false, true}, Case{"all", true, true, true}),
+                                           Case{"environment", false, false, true}, Case{"all", true, true, true},
+                                           Case{"indirect", false, true, false, 0.0f},
+                                           Case{"indirect_clamped", true, true, true, 0.5f}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 }  // namespace

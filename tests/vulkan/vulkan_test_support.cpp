@@ -39,12 +39,13 @@ void write_failure_images(const std::string& label, const Image& image, const Im
                 stem.c_str());
 }
 
-void expect_shadow_rays_match(const RenderStats& g, const RenderStats& c, const char* method) {
+void expect_shadow_rays_match(const RenderStats& g, const RenderStats& c, const char* method,
+                              double relative = kShadowRaysRelative) {
     const double gpu = double(g.shadow_rays), cpu = double(c.shadow_rays);
     std::printf("[ measured ] %s shadow rays: gpu %.0f, cpu %.0f, relative difference %.3g\n",
                 method, gpu, cpu, std::abs(gpu - cpu) / std::max(cpu, 1.0));
     // A grazing shadow ray may be skipped on one side only (zero contribution).
-    EXPECT_NEAR(gpu, cpu, kShadowRaysRelative * cpu + 1.0) << method;
+    EXPECT_NEAR(gpu, cpu, relative * cpu + 1.0) << method;
 }
 
 }  // namespace
@@ -116,11 +117,13 @@ void expect_lightcuts_matches(const PreparedScene& p, const RenderOptions& o,
         cut_differs[i] = g.stats.cut_size[i] != c.stats.cut_size[i];
     const std::size_t differing = pixels_with_different_cut(g.stats, c.stats);
     std::printf("[ measured ] lightcuts: cut size differs at %zu of %zu pixels (tolerance %.3g)\n",
-                differing, cut_differs.size(), kCutsDifferFraction * double(cut_differs.size()));
-    EXPECT_LE(double(differing), kCutsDifferFraction * double(cut_differs.size()));
+                differing, cut_differs.size(),
+                (p.vpls ? kVplCutsDifferFraction : kCutsDifferFraction) * double(cut_differs.size()));
+    const double cuts_differ = p.vpls ? kVplCutsDifferFraction : kCutsDifferFraction;
+    EXPECT_LE(double(differing), cuts_differ * double(cut_differs.size()));
     EXPECT_LE(max_relative_difference(g.image, c.image, "lightcuts", kLightcutsRelative, cut_differs),
               kLightcutsRelative);
-    expect_shadow_rays_match(g.stats, c.stats, "lightcuts");
+    expect_shadow_rays_match(g.stats, c.stats, "lightcuts", p.vpls ? kVplShadowRaysRelative : kShadowRaysRelative);
     // Whether refinement stopped at max_cut can only differ where the cut does.
     EXPECT_NEAR(double(g.stats.max_cut_pixels), double(c.stats.max_cut_pixels),
                 double(differing) * o.spp + 1.0);
