@@ -9,6 +9,7 @@ clear shadows on the floor and walls. Outputs, all committed:
   scenes/room/torus.obj              torus with vertex normals (material in JSON)
   scenes/room/room_lights.csv        1000 lights (gen_lights.py --shape room)
   scenes/room/room.json              the default scene (lightcuts)
+  scenes/room/room_indirect.json     the default scene with indirect light (100000 VPLs)
   scenes/room/room_1e3/1e4/1e5.json  the same room for scaling runs; their light
                                      sets (lights_1eN.csv) are generated on demand:
       scripts/gen_lights.py --shape room --count 100000 --out scenes/room/lights_1e5.csv
@@ -221,6 +222,10 @@ def main(argv):
 
     with open(os.path.join(out, "room.json"), "w", encoding="ascii", newline="\n") as f:
         f.write(dump_scene(scene("room_lights.csv", {"method": "lightcuts", "spp": 1})))
+    with open(os.path.join(out, "room_indirect.json"), "w", encoding="ascii", newline="\n") as f:
+        f.write(dump_scene(scene("room_lights.csv", {
+            "method": "lightcuts", "spp": 1,
+            "indirect": {"vpls": 100000, "max_bounces": 3, "clamp": 0}})))
     # Scaling variants: same room, light sets of 10^3..10^5 with the same total
     # power. The CSVs are large, so they are generated on demand (gitignored).
     for exponent in (3, 4, 5):

@@ -67,6 +67,10 @@ accept --width 1 --height 1 --max-cut 4294967295 --method lightcuts
 accept --width 2 --height 2 --method sampled --light-samples 1 --light-pick uniform
 accept --width 2 --height 2 --method sampled --light-samples 65536 --light-pick power
 accept --width 2 --height 2 --method stochastic --spp 4 --light-pick tree
+accept --width 2 --height 2 --method lightcuts --vpls 0 --vpl-bounces 0 --vpl-clamp 0
+accept --width 2 --height 2 --method lightcuts --vpls 100 --vpl-bounces 1024 --vpl-clamp 0.5
+accept --width 2 --height 2 --method path --spp 2 --max-bounces 0 --time-limit 0
+accept --width 2 --height 2 --method path --max-bounces 1024 --time-limit 1e30
 accept --width 16384 --height 1 --method brute
 accept --width 1 --height 16384 --method brute
 integer="must be an integer from"
@@ -82,7 +86,14 @@ for side in width height; do for bad in 0 16385; do
   expect_error "--$side: $integer 1 to 16384" render "$mini" -o "$tmp/edge2.exr" "--$side=$bad"; done; done
 for bad in "--light-samples=0" "--light-samples=65537"; do
   expect_error "--light-samples: $integer 1 to 65536" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
-expect_error '--method: must be "brute", "lightcuts", "sampled" or "stochastic", got "fast"' render "$mini" -o "$tmp/edge2.exr" --method fast
+for bad in "--vpls=-1" "--vpls=16777217" "--vpls=2.5"; do
+  expect_error "--vpls: $integer 0 to 16777216" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
+for bad in "--max-bounces=1025" "--vpl-bounces=-1"; do
+  expect_error "$integer 0 to 1024" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
+for bad in "--vpl-clamp=-0.5" "--time-limit=nan" "--time-limit=-1"; do
+  expect_error "must be a finite number, 0 or more" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
+expect_error "method path (the path tracer) runs on the CPU only" render "$mini" -o "$tmp/edge2.exr" --method path --device vulkan
+expect_error '--method: must be "brute", "lightcuts", "sampled", "stochastic" or "path", got "fast"' render "$mini" -o "$tmp/edge2.exr" --method fast
 expect_error '--light-pick: must be "tree", "uniform" or "power", got "random"' render "$mini" -o "$tmp/edge2.exr" --light-pick random
 expect_error '--device: must be "auto", "cpu" or "vulkan"' render "$mini" -o "$tmp/edge2.exr" --device gpu
 [ -e "$tmp/edge2.exr" ] && fail "a refused render left edge2.exr behind"

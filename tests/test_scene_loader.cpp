@@ -1,5 +1,7 @@
 // Scene loading: the shipped scenes, every documented input error, the CSV
 // light format, materials, transforms and degenerate geometry.
+#include <limits>
+
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -531,6 +533,10 @@ const BadSetting kBadSettings[] = {
     {"seed", "4294967296", 4294967296.0},
     {"light_samples", "0", 0.0},
     {"light_samples", "65537", 65537.0},
+    {"max_bounces", "1025", 1025.0},
+    {"max_bounces", "-1", -1.0},
+    {"time_limit", "-2", -2.0},
+    {"time_limit", "1e39", 1e39},
 };
 
 INSTANTIATE_TEST_SUITE_P(Cases, RenderSettingRange, ::testing::ValuesIn(kBadSettings),
@@ -558,6 +564,46 @@ TEST(SceneLoader, SamplingSettings) {
     const fs::path bad = scene_with_render(dir, R"({"light_pick": "random"})");
     EXPECT_EQ(input_error_of([&] { load_scene(bad); }),
               bad.lexically_normal().string() + ": render.light_pick: " + light_pick_problem("random"));
+}
+
+TEST(SceneLoader, IndirectAndPathSettings) {
+    TempDir dir;
+    const Scene scene = load_scene(scene_with_render(
+        dir, R"({"method": "path", "max_bounces": 4, "time_limit": 2.5,
+                 "indirect": {"vpls": 16777216, "max_bounces": 0, "clamp": 0.05}})"));
+    EXPECT_EQ(scene.render.method, "path");
+    EXPECT_EQ(scene.render.max_bounces, 4u);
+    EXPECT_DOUBLE_EQ(scene.render.time_limit, 2.5);
+    EXPECT_EQ(scene.render.indirect.vpls, 16777216u);
+    EXPECT_EQ(scene.render.indirect.max_bounces, 0u);
+    EXPECT_FLOAT_EQ(scene.render.indirect.clamp, 0.05f);
+    // Absent: direct light only, 3 bounces, no clamp.
+    const Scene plain = load_scene(scene_with_render(dir, R"({"method": "lightcuts"})"));
+    EXPECT_EQ(plain.render.indirect.vpls, 0u);
+    EXPECT_EQ(plain.render.indirect.max_bounces, 3u);
+    EXPECT_EQ(plain.render.indirect.clamp, 0.0f);
+    // Each bad value is named with its path inside the block.
+    struct Bad {
+        const char* json;
+        const char* field;
+        std::string problem;
+    };
+    for (const Bad& b : {Bad{R"({"indirect": {"vpls": 16777217}})", "render.indirect.vpls",
+                             setting_problem(kSettingVpls, 16777217.0)},
+                         Bad{R"({"indirect": {"vpls": 1.5}})", "render.indirect.vpls",
+                             setting_problem(kSettingVpls, 1.5)},
+                         Bad{R"({"indirect": {"clamp": -1}})", "render.indirect.clamp",
+                             setting_problem(kSettingClamp, -1.0)},
+                         Bad{R"({"indirect": {"max_bounces": 2000}})", "render.indirect.max_bounces",
+                             setting_problem(kSettingMaxBounces, 2000.0)},
+                         Bad{R"({"indirect": {"vpl": 10}})", "render.indirect.vpl", ""},
+                         Bad{R"({"indirect": 100})", "render.indirect", ""}}) {
+        const fs::path file = scene_with_render(dir, b.json);
+        const std::string message = input_error_of([&] { load_scene(file); });
+        const std::string start = file.lexically_normal().string() + ": " + b.field + ": ";
+        EXPECT_EQ(message.rfind(start, 0), 0u) << message;
+        if (!b.problem.empty()) EXPECT_EQ(message, start + b.problem);
+    }
 }
 
 TEST(SceneLoader, RenderSettingProblemTextMatchesTheCommandLine) {

@@ -1,4 +1,5 @@
 #include "fuzz_input.h"
+#include "lightcuts/settings.h"
 
 #include <cmath>
 #include <fstream>
@@ -79,11 +80,16 @@ std::string check_scene_contract(const Scene& s) {
     }
     if (!finite(s.bounds_min) || !finite(s.bounds_max)) return "bounds not finite";
     const RenderSettings& r = s.render;
-    if (r.method != "brute" && r.method != "lightcuts" && r.method != "sampled" && r.method != "stochastic")
+    if (r.method != "brute" && r.method != "lightcuts" && r.method != "sampled" && r.method != "stochastic" &&
+        r.method != "path")
         return "unknown method";
     if (r.light_pick != "tree" && r.light_pick != "uniform" && r.light_pick != "power") return "unknown light pick";
     if (r.spp < 1 || r.max_cut < 1 || r.light_samples < 1) return "spp, max_cut or light_samples below 1";
     if (!(r.relative_error >= 0.0f) || !std::isfinite(r.relative_error)) return "relative_error invalid";
+    if (r.max_bounces > kMaxBounces || r.indirect.max_bounces > kMaxBounces) return "max_bounces out of range";
+    if (r.indirect.vpls > kMaxVpls) return "vpls out of range";
+    if (!(r.indirect.clamp >= 0.0f) || !std::isfinite(r.indirect.clamp)) return "clamp invalid";
+    if (!(r.time_limit >= 0.0) || !std::isfinite(r.time_limit)) return "time_limit invalid";
     return {};
 }
 
