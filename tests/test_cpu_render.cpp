@@ -165,7 +165,7 @@ TEST(CpuRender, SameImageBitForBitWhateverTheThreadCount) {
 TEST(CpuRender, UnknownMethodIsRejected) {
     Scene s = test::room_scene({test::point_light({0, 1, 0}, glm::vec3(1))}, 8);
     PreparedScene p = prepare_scene(std::move(s), 1);
-    EXPECT_THROW(render_cpu(p, test::options("path", 8)), std::invalid_argument);
+    EXPECT_THROW(render_cpu(p, test::options("path_tracing", 8)), std::invalid_argument);
 }
 
 

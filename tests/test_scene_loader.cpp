@@ -466,7 +466,7 @@ const BadInput kBadInputs[] = {
     {"bad_kd_override.json", "bad_kd_override.json", "meshes[0].material.kd[1]: ", "at most 1"},
     // Render block.
     {"bad_render_method.json", "bad_render_method.json", "render.method: ",
-     "\"brute\", \"lightcuts\", \"sampled\" or \"stochastic\""},
+     "\"brute\", \"lightcuts\", \"sampled\", \"stochastic\" or \"path\""},
     {"bad_render_spp.json", "bad_render_spp.json", "render.spp: ", "must be an integer from 1 to 65536"},
     {"bad_render_relative_error.json", "bad_render_relative_error.json", "render.relative_error: ",
      "must be a number from 0 to 1"},
