@@ -55,6 +55,10 @@ CompareResult compare_images(const Image& image, const Image& reference) {
     const double lum_floor = (mean_lum > 0.0 && std::isfinite(mean_lum)) ? 1e-3 * mean_lum : 1e-30;
 
     result.per_pixel.resize(pixels);
+    double sum_image_lum = 0.0;
+    for (std::size_t p = 0; p < pixels; ++p) sum_image_lum += luminance_d(&image.rgb[p * 3]);
+    result.mean_difference = sum_ref_lum > 0.0 ? sum_image_lum / sum_ref_lum - 1.0
+                             : sum_image_lum == 0.0 ? 0.0 : std::numeric_limits<double>::infinity();
     std::size_t above1 = 0, above2 = 0, above5 = 0;
     double max_error = 0.0;
     bool any_nan = false;

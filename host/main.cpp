@@ -115,7 +115,8 @@ int run_compare(const std::string& image, const std::string& reference, const st
                             {"fraction_above_1pct", c.fraction_above_1pct},
                             {"fraction_above_2pct", c.fraction_above_2pct},
                             {"fraction_above_5pct", c.fraction_above_5pct},
-                            {"max_relative_error", c.max_relative_error}};
+                            {"max_relative_error", c.max_relative_error},
+                            {"mean_difference", c.mean_difference}};
         std::printf("%s\n", j.dump(2).c_str());
     } else {
         std::printf("relative RMSE        %.6g\n", c.relative_rmse);
@@ -123,6 +124,8 @@ int run_compare(const std::string& image, const std::string& reference, const st
         std::printf("pixels above 2%%      %.4f%%\n", 100.0 * c.fraction_above_2pct);
         std::printf("pixels above 5%%      %.4f%%\n", 100.0 * c.fraction_above_5pct);
         std::printf("max relative error   %.6g\n", c.max_relative_error);
+        std::printf("mean difference      %+.4f%% (image mean luminance over the reference's)\n",
+                    100.0 * c.mean_difference);
     }
     // The heatmap's scale runs from 0 to 10% relative luminance error.
     if (!heatmap.empty()) lc::write_heatmap_png(heatmap, a.width, a.height, c.per_pixel, 0.1f);

@@ -218,6 +218,8 @@ TEST(CompareImages, KnownErrorsGiveKnownMetrics) {
     const double sum_d2 = 3.0 * (0.5 * 0.5 + 0.0625 * 0.0625 + 0.03125 * 0.03125);
     const double sum_r2 = 60.0 * 4.0;
     EXPECT_NEAR(r.relative_rmse, std::sqrt(sum_d2 / sum_r2), 1e-15);
+    // Grey pixels: luminance = value. (0.5 + 0.0625 + 0.03125) / (20 * 2).
+    EXPECT_NEAR(r.mean_difference, 0.59375 / 40.0, 1e-12);
 }
 
 TEST(CompareImages, DarkReferencePixelsUseTheMeanFloor) {

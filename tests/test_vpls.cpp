@@ -215,5 +215,59 @@ TEST(Furnace, LightcutsWithVplsReachesTheClosedForm) {
     }
 }
 
+// Relative RMSE of `image` against `reference` over blocks of b x b pixels
+// (block means): averages the reference's noise down while keeping the
+// VPLs' low-frequency error.
+double block_rmse(const Image& image, const Image& reference, std::uint32_t b) {
+    double diff2 = 0.0, ref2 = 0.0;
+    for (std::uint32_t by = 0; by + b <= image.height; by += b)
+        for (std::uint32_t bx = 0; bx + b <= image.width; bx += b) {
+            double a = 0.0, r = 0.0;
+            for (std::uint32_t y = by; y < by + b; ++y)
+                for (std::uint32_t x = bx; x < bx + b; ++x) {
+                    const std::size_t i = 3 * (std::size_t(y) * image.width + x);
+                    a += gpu::lc_luminance(glm::vec3(image.rgb[i], image.rgb[i + 1], image.rgb[i + 2]));
+                    r += gpu::lc_luminance(glm::vec3(reference.rgb[i], reference.rgb[i + 1], reference.rgb[i + 2]));
+                }
+            diff2 += (a - r) * (a - r);
+            ref2 += r * r;
+        }
+    return std::sqrt(diff2 / ref2);
+}
+
+// VPLs converge: on the shipped Cornell box (diffuse only, so VPLs miss
+// nothing), lightcuts with 10^3, 10^4 and 10^5 VPLs at a small threshold
+// against the path tracer with unlimited bounces, whose noise over 4 x 4
+// blocks is well below the VPLs' error at 10^5 (measured below).
+TEST(VplConvergence, ErrorAgainstThePathTracerFallsWithTheVplCount) {
+    Scene s = load_scene(std::string(LC_SOURCE_DIR) + "/scenes/cornell/cornell.json");
+    s.render.area_light_samples = 16384;
+    s.render.indirect.max_bounces = 0;
+    const std::uint32_t size = 24;
+    PreparedScene direct = prepare_scene(s, 1);
+    RenderOptions path = test::options("path", size);
+    path.spp = 2048;
+    const Image reference = render_cpu(direct, path).image;
+    path.spp = 512;
+    path.seed = 2;
+    // A second render at a quarter of the spp: the difference has variance
+    // 5 sigma^2 (sigma: the reference's noise).
+    const double noise = block_rmse(render_cpu(direct, path).image, reference, 4) / std::sqrt(5.0);
+    std::vector<double> errors;
+    for (std::uint32_t vpls : {1000u, 10000u, 100000u}) {
+        s.render.indirect.vpls = vpls;
+        PreparedScene p = prepare_scene(s, 1);
+        RenderOptions o = test::options("lightcuts", size);
+        o.relative_error = 0.005f;
+        errors.push_back(block_rmse(render_cpu(p, o).image, reference, 4));
+        std::printf("[ measured ] %u VPLs: relative RMSE over 4x4 blocks %.4f (reference noise %.4f)\n", vpls,
+                    errors.back(), noise);
+    }
+    EXPECT_LT(errors[1], errors[0]);
+    EXPECT_LT(errors[2], errors[1]);
+    EXPECT_LT(errors[2], 0.5 * errors[0]);
+    EXPECT_LT(noise, 0.5 * errors[2]);  // the reference resolves the last step
+}
+
 }  // namespace
 }  // namespace lc

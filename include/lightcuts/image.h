@@ -55,6 +55,9 @@ struct CompareResult {
     double fraction_above_2pct = 0.0;
     double fraction_above_5pct = 0.0;
     double max_relative_error = 0.0;
+    // Mean luminance of the image over the reference's, minus 1: the bias
+    // of the whole image (e.g. what a VPL clamp takes away).
+    double mean_difference = 0.0;
     std::vector<float> per_pixel;     // relative luminance error per pixel
 };
 
