@@ -1,0 +1,94 @@
+// The unbiased CPU path tracer (--method path): the reference for indirect
+// light. render_path (include/lightcuts/render.h) runs it over the image;
+// this header exposes the parts the tests check on their own.
+//
+// Per path vertex: next-event estimation towards one true emitter
+// (host/path_emitters.h) and one direction drawn from the BRDF, the two
+// combined by multiple importance sampling (Veach 1997, power heuristic)
+// where both can find the light: emissive triangles and the environment.
+// Point, spot and directional lights are deltas, found by NEE alone.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "cpu_kernel.h"
+#include "lightcuts/render.h"
+#include "path_emitters.h"
+
+namespace lc::path {
+
+using Kernel = cpu::ShadeKernel;
+using SurfacePoint = Kernel::SurfacePoint;
+
+// Probabilities of drawing a direction from the Lambert lobe and from the
+// GGX lobe, in proportion to the luminance of kd and ks; the GGX lobe only
+// where the material has one and wo is above the shading normal (elsewhere
+// lc_brdf_cos has no GGX term). Both 0 for a black material.
+struct LobeWeights {
+    float diffuse = 0.0f;
+    float specular = 0.0f;
+};
+LobeWeights lobe_weights(const gpu::Material& m, glm::vec3 n, glm::vec3 wo);
+
+// A direction drawn from a material's lobes at a shaded point.
+struct BsdfSample {
+    glm::vec3 wi{0.0f};
+    float pdf = 0.0f;         // of the lobe mixture, per unit solid angle; 0: none (the path ends)
+    glm::vec3 weight{0.0f};   // lc_brdf_cos / pdf
+};
+
+// Lambert: cosine-weighted. GGX: a half vector h from D(h) cos(theta_h),
+// wi = wo reflected about h, with density D cos(theta_h) / (4 wo.h) (Walter
+// et al. 2007). `u_lobe` picks the lobe, (u1, u2) the direction; all in [0, 1).
+// `k` only provides the shared BRDF formulas (no scene data is read).
+BsdfSample sample_bsdf(Kernel& k, const gpu::Material& m, const LobeWeights& lobes, glm::vec3 n,
+                       glm::vec3 wo, float u_lobe, float u1, float u2);
+
+// The density sample_bsdf draws `wi` with (0 below the shading normal).
+float bsdf_pdf(Kernel& k, const gpu::Material& m, const LobeWeights& lobes, glm::vec3 n, glm::vec3 wo,
+               glm::vec3 wi);
+
+// Veach's power heuristic for one sample of each of two techniques: the
+// weight of the technique with density `pdf` against the other's `other`.
+float power_heuristic(float pdf, float other);
+
+// One path tracer bound to a prepared scene (which must outlive it) and a
+// set of options. sample() is const and thread-safe.
+class PathTracer {
+public:
+    PathTracer(const PreparedScene& prepared, const RenderOptions& options);
+
+    const gpu::FrameParams& frame() const { return frame_; }
+
+    // The radiance estimate of one path: camera sample `s` of pixel (x, y),
+    // the same camera ray as every other method's sample s. Its random
+    // numbers are hashes of (seed, x, y, s, bounce, dimension), so the
+    // result depends on nothing else. Adds the shadow rays it cast to
+    // `shadow_rays`.
+    glm::vec3 sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, std::uint64_t& shadow_rays) const;
+
+private:
+    class VertexRandom;
+
+    glm::vec3 next_event(Kernel& k, const SurfacePoint& sp, const LobeWeights& lobes, VertexRandom& rnd,
+                         std::uint64_t& shadow_rays) const;
+    glm::vec3 light_sample(Kernel& k, const SurfacePoint& sp, std::uint32_t light, float pmf,
+                           std::uint64_t& shadow_rays) const;
+    glm::vec3 triangle_sample(Kernel& k, const SurfacePoint& sp, const LobeWeights& lobes, std::uint32_t tri,
+                              VertexRandom& rnd, std::uint64_t& shadow_rays) const;
+    glm::vec3 environment_sample(Kernel& k, const SurfacePoint& sp, const LobeWeights& lobes, float pmf,
+                                 VertexRandom& rnd, std::uint64_t& shadow_rays) const;
+    // Density with which NEE picks the point of triangle `tri` hit at
+    // distance t along wi, per unit solid angle.
+    float triangle_light_pdf(std::uint32_t tri, glm::vec3 wi, float t) const;
+
+    const PreparedScene& prepared_;
+    gpu::FrameParams frame_;
+    std::uint32_t max_bounces_;  // 0: unlimited
+    EmitterTable emitters_;
+    Kernel kernel_;              // copied per path: the kernel's functions are not const
+};
+
+}  // namespace lc::path
