@@ -151,10 +151,3 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
 
 }  // namespace lc
 
-// TEMPORARY until host/path_tracer.cpp lands (branch wip-path): the link
-// fails with a duplicate symbol once it does, so this cannot outlive it.
-namespace lc {
-RenderResult render_path(const PreparedScene&, const RenderOptions&) {
-    throw std::runtime_error("method path: the path tracer is not built in yet");
-}
-}  // namespace lc

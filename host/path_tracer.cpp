@@ -354,21 +354,10 @@ void for_each_tile(std::uint32_t tile_count, std::vector<Worker>& workers, Work 
         if (e) std::rethrow_exception(e);
 }
 
-void validate_path_options(const RenderOptions& options) {
-    // The ranges every method shares. validate_render_options does not know
-    // the method name "path" yet (host/settings.cpp), so it is shown the
-    // options under brute force's name, whose checks are the same.
-    RenderOptions shared = options;
-    shared.method = "brute";
-    validate_render_options(shared);
-    if (!(std::isfinite(options.time_limit) && options.time_limit >= 0.0))
-        throw std::invalid_argument("time_limit must be a finite number of seconds, at least 0");
-}
-
 }  // namespace
 
 RenderResult render_path(const PreparedScene& prepared, const RenderOptions& options) {
-    validate_path_options(options);
+    validate_render_options(options);
     const auto start = Clock::now();
     const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
     const path::PathTracer tracer(prepared, options);
