@@ -88,6 +88,8 @@ int run_render(RenderArgs a) {
     if (a.vpls) scene.render.indirect.vpls = *a.vpls;
     if (a.vpl_bounces) scene.render.indirect.max_bounces = *a.vpl_bounces;
     if (a.vpl_clamp) scene.render.indirect.clamp = *a.vpl_clamp;
+    // The path tracer finds indirect light itself: VPLs would only cost time.
+    if (options.method == "path") scene.render.indirect.vpls = 0;
     lc::validate_render_options(options);
     // Every output is checked and reserved before the render; none is left if any fails.
     lc::OutputSet outputs = lc::reserve_render_outputs(a.outputs, a.scene, options.method);
@@ -177,7 +179,7 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
         ->check(setting(lc::kSettingAreaLightSamples));
     render->add_option("--light-samples", r.light_samples,
                        "sampled: lights drawn per camera sample; stochastic: representatives drawn per cluster "
-                       "of the cut (default 1)")
+                       "of the cut; path: paths per camera ray (default 1)")
         ->check(setting(lc::kSettingLightSamples));
     render->add_option("--light-pick", r.light_pick,
                        "sampled: how lights are drawn: tree (importance through the light tree, the default), "

@@ -152,7 +152,8 @@ PathTracer::PathTracer(const PreparedScene& prepared, const RenderOptions& optio
       emitters_(prepared.scene),
       kernel_(cpu::make_shade_kernel(prepared, nullptr)) {}
 
-glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, std::uint64_t& shadow_rays) const {
+glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, std::uint64_t& shadow_rays,
+                             std::uint32_t j) const {
     Kernel k = kernel_;
     SurfacePoint sp;
     glm::vec3 seen;
@@ -161,7 +162,8 @@ glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, 
     // reaches the first surface.
     glm::vec3 radiance = seen;
     if (!hit) return radiance;
-    const std::uint32_t stream = k.lc_sample_stream(frame_.seed, x, y, s);
+    std::uint32_t stream = k.lc_sample_stream(frame_.seed, x, y, s);
+    if (j > 0) stream = k.lc_substream(stream, 0x70617468u + j);  // further paths of the same camera ray
     glm::vec3 throughput(1.0f);
     // Bounce b is the b-th surface interaction: light reflected there, found
     // by NEE or by the ray its BRDF sample sends, has been reflected b times.
@@ -356,13 +358,23 @@ void for_each_tile(std::uint32_t tile_count, std::vector<Worker>& workers, Work 
 
 }  // namespace
 
+// spp x light_samples; the sample order and counters are 32-bit.
+constexpr std::uint64_t kMaxPathsPerPixel = 1u << 24;
+
 RenderResult render_path(const PreparedScene& prepared, const RenderOptions& options) {
     validate_render_options(options);
+    if (std::uint64_t(options.spp) * options.light_samples > kMaxPathsPerPixel)
+        throw std::invalid_argument("path: spp x light_samples (paths per pixel) must be at most " +
+                                    std::to_string(kMaxPathsPerPixel));
     const auto start = Clock::now();
     const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
     const path::PathTracer tracer(prepared, options);
     const gpu::FrameParams& frame = tracer.frame();
-    const std::uint32_t spp = frame.spp;
+    // Paths per pixel: light_samples paths along each of the spp camera
+    // rays (--spp 1 --light-samples N: N paths through the pixel centre, the
+    // reference for the other methods at 1 spp).
+    const std::uint32_t camera_spp = frame.spp;
+    const std::uint32_t spp = camera_spp * std::max(frame.light_samples, 1u);
 
     const std::uint32_t tiles_x = (frame.width + kTile - 1) / kTile;
     const std::uint32_t tile_count = tiles_x * ((frame.height + kTile - 1) / kTile);
@@ -386,7 +398,10 @@ RenderResult render_path(const PreparedScene& prepared, const RenderOptions& opt
             for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); ++y)
                 for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); ++x) {
                     glm::dvec3& sum = sums[std::size_t(y) * frame.width + x];
-                    for (std::uint32_t i = done; i < end; ++i) sum += glm::dvec3(tracer.sample(x, y, order(i), w.shadow_rays));
+                    for (std::uint32_t i = done; i < end; ++i) {
+                        const std::uint32_t k = order(i);
+                        sum += glm::dvec3(tracer.sample(x, y, k % camera_spp, w.shadow_rays, k / camera_spp));
+                    }
                 }
             // Done: the samples' share, or the time limit's if that ends the render sooner.
             const double tiles = double(tiles_done.fetch_add(1) + 1) / tile_count;

@@ -62,12 +62,13 @@ public:
 
     const gpu::FrameParams& frame() const { return frame_; }
 
-    // The radiance estimate of one path: camera sample `s` of pixel (x, y),
-    // the same camera ray as every other method's sample s. Its random
-    // numbers are hashes of (seed, x, y, s, bounce, dimension), so the
-    // result depends on nothing else. Adds the shadow rays it cast to
-    // `shadow_rays`.
-    glm::vec3 sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, std::uint64_t& shadow_rays) const;
+    // The radiance estimate of one path: path `j` (of light_samples) of
+    // camera sample `s` of pixel (x, y), the same camera ray as every other
+    // method's sample s. Its random numbers are hashes of (seed, x, y, s, j,
+    // bounce, dimension), so the result depends on nothing else. Adds the
+    // shadow rays it cast to `shadow_rays`.
+    glm::vec3 sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, std::uint64_t& shadow_rays,
+                     std::uint32_t j = 0) const;
 
 private:
     class VertexRandom;

@@ -110,7 +110,8 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
     r.width = result.image.width;
     r.height = result.image.height;
     r.spp = s.spp_done ? s.spp_done : options.spp;
-    r.spp_requested = options.spp;
+    // The path tracer's samples are paths: light_samples along each camera ray.
+    r.spp_requested = options.method == "path" ? options.spp * options.light_samples : options.spp;
     if (options.method == "path") r.max_bounces = options.max_bounces;
     r.triangles = prepared.scene.triangles.size();
     r.lights = prepared.tree.lights.size();
@@ -155,8 +156,9 @@ std::string report_text(const RenderReport& r) {
     if (r.spp != r.spp_requested)
         text += format("  stopped at the time limit after %u of %u spp\n", r.spp, r.spp_requested);
     if (r.method == "path")
-        text += r.max_bounces ? format("  paths of at most %u bounce(s)\n", r.max_bounces)
-                              : std::string("  paths of any length (Russian roulette)\n");
+        text += format("  %u path(s) per pixel, %s\n", r.spp,
+                       r.max_bounces ? format("at most %u bounce(s)", r.max_bounces).c_str()
+                                     : "of any length (Russian roulette)");
     const std::string black =
         r.black_lights ? format(" (and %zu black, left out of the tree)", r.black_lights) : std::string();
     text += format("  triangles %zu, lights %zu%s, BVH %zu nodes built in %.3f s\n", r.triangles, r.lights,
