@@ -2,6 +2,7 @@
 // shaders/shared/shading.h, so comparing them cannot catch a wrong formula:
 // these tests check the formula itself against closed forms written
 // differently from the kernel's.
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -101,6 +102,32 @@ TEST(ShadingGgx, BrdfIsReciprocalAndNonNegative) {
             ASSERT_GE(fab[c], 0.0f);
             ASSERT_NEAR(fab[c], fba[c], 1e-4f * std::max(1.0f, fab[c])) << trial;
         }
+    }
+}
+
+// Camera samples cover the whole pixel for every spp: over many seeds, each
+// of 16 x 16 cells of the pixel is hit, and the mean position is the
+// centre. (A grid of ceil(sqrt(spp)) columns that spp does not fill left
+// cells unseen: spp 8 never reached the bottom-right ninth of a pixel.)
+TEST(PixelSamples, EverySppCoversThePixel) {
+    Kernel k;
+    for (std::uint32_t spp : {2u, 3u, 5u, 7u, 8u, 12u, 16u, 17u}) {
+        std::vector<int> hits(16 * 16, 0);
+        double mx = 0.0, my = 0.0;
+        const std::uint32_t seeds = 4000;  // at least 31 samples per cell on average
+        for (std::uint32_t seed = 0; seed < seeds; ++seed)
+            for (std::uint32_t s = 0; s < spp; ++s) {
+                const glm::vec2 p = k.lc_pixel_sample(3, 5, s, spp, seed) - glm::vec2(3.0f, 5.0f);
+                ASSERT_TRUE(p.x >= 0.0f && p.x < 1.0f && p.y >= 0.0f && p.y < 1.0f) << spp;
+                hits[std::min(15, int(p.y * 16.0f)) * 16 + std::min(15, int(p.x * 16.0f))] += 1;
+                mx += p.x;
+                my += p.y;
+            }
+        const double n = double(seeds) * spp;
+        EXPECT_EQ(std::count(hits.begin(), hits.end(), 0), 0) << "spp " << spp;
+        // Uniform positions: standard error sqrt(1/12 / n) <= 0.0023; 5 of them.
+        EXPECT_NEAR(mx / n, 0.5, 0.012) << "spp " << spp;
+        EXPECT_NEAR(my / n, 0.5, 0.012) << "spp " << spp;
     }
 }
 

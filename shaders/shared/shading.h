@@ -23,11 +23,18 @@ LC_KCONST float kCosineAbsSlack = 1e-6f;
 
 // Position on the image plane of sample `s` of `spp` in pixel (x, y):
 // spp = 1 is the pixel centre; otherwise stratified over a cols x rows grid,
-// jittered within each stratum by the seeded hash.
+// jittered within each stratum by the seeded hash. Where spp does not fill
+// the grid of about sqrt(spp) columns (spp 8 would leave one cell of a
+// 3 x 3 grid empty, and that part of the pixel unseen: a bias), the strata
+// are spp columns of full height.
 vec2 lc_pixel_sample(uint x, uint y, uint s, uint spp, uint seed) {
     if (spp <= 1u) return vec2(float(x) + 0.5f, float(y) + 0.5f);
     uint cols = uint(ceil(sqrt(float(spp))));
     uint rows = (spp + cols - 1u) / cols;
+    if (cols * rows != spp) {
+        cols = spp;
+        rows = 1u;
+    }
     uint h = lc_hash(seed ^ lc_hash(x ^ lc_hash(y ^ lc_hash(s))));
     float jx = lc_unit_float(h);
     float jy = lc_unit_float(lc_hash(h));
