@@ -11,11 +11,10 @@
 #include "cpu_kernel.h"
 #include "lightcuts/render.h"
 #include "progress.h"
+#include "tile_pool.h"
 
 namespace lc {
 namespace {
-
-constexpr std::uint32_t kTile = 8;  // small, so small images still use every core
 
 // What each worker thread owns: its cut heap and its counters.
 struct Worker {
@@ -77,28 +76,6 @@ PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Meth
     return {sum / float(frame.spp), float(double(cut_sum) / frame.spp)};
 }
 
-// Runs work(tile, worker) for every tile, one thread per worker. An
-// exception in any worker (out of memory, say) stops the others at their
-// next tile and reaches the caller as itself, not as std::terminate.
-template <typename Work>
-void for_each_tile(std::uint32_t tile_count, std::vector<Worker>& workers, Work work) {
-    std::atomic<std::uint32_t> next_tile{0};
-    std::vector<std::exception_ptr> errors(workers.size());
-    auto worker = [&](std::size_t index) {
-        try {
-            for (std::uint32_t tile; (tile = next_tile.fetch_add(1)) < tile_count;) work(tile, workers[index]);
-        } catch (...) {
-            errors[index] = std::current_exception();
-            next_tile.store(tile_count);
-        }
-    };
-    std::vector<std::thread> pool;
-    for (std::size_t i = 1; i < workers.size(); ++i) pool.emplace_back(worker, i);
-    worker(0);
-    for (auto& th : pool) th.join();
-    for (const auto& e : errors)
-        if (e) std::rethrow_exception(e);
-}
 
 }  // namespace
 

@@ -122,7 +122,8 @@ double light_power(const gpu::Light& light, double radius) {
             const double cos_mid = std::min(0.5 * (double(light.cos_inner) + double(light.cos_outer)), 1.0 - 1e-6);
             return 2.0 * kPi * (1.0 - cos_mid) * lum;
         }
-        case gpu::kLightOriented: return ((light.type & gpu::kLightTwoSided) != 0u ? 2.0 : 1.0) * kPi * lum;
+        case gpu::kLightOriented:
+        case gpu::kLightVpl: return ((light.type & gpu::kLightTwoSided) != 0u ? 2.0 : 1.0) * kPi * lum;
         case gpu::kLightDirectional: return kPi * radius * radius * lum;
         default: return 0.0;  // the loader admits no other type
     }

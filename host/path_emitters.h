@@ -109,7 +109,9 @@ private:
 };
 
 // The weight EmitterTable gives one of the scene's lights; `radius` is that
-// of the sphere around the scene, for directional lights.
+// of the sphere around the scene, for directional lights. The light paths
+// that leave VPLs (host/vpls.cpp) choose their lights by it too, from all
+// the tree's lights (oriented area-light samples included).
 double light_power(const gpu::Light& light, double radius);
 
 }  // namespace lc::path

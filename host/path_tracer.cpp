@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "progress.h"
+#include "tile_pool.h"
 
 namespace lc::path {
 namespace {
@@ -299,7 +300,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr std::uint32_t kTile = 8;  // as render_cpu: small, so small images still use every core
 
 // The order a pixel's camera samples are taken in: the i-th is sample
 // (i * stride) mod spp, the stride coprime to spp and near spp / golden
@@ -333,28 +333,6 @@ struct alignas(64) Worker {
     std::uint64_t shadow_rays = 0;
 };
 
-// Runs work(tile, worker) for every tile, one thread per worker; an
-// exception in any worker stops the others at their next tile and reaches
-// the caller. (render_cpu has its own copy; both could share one.)
-template <typename Work>
-void for_each_tile(std::uint32_t tile_count, std::vector<Worker>& workers, Work work) {
-    std::atomic<std::uint32_t> next_tile{0};
-    std::vector<std::exception_ptr> errors(workers.size());
-    auto worker = [&](std::size_t index) {
-        try {
-            for (std::uint32_t tile; (tile = next_tile.fetch_add(1)) < tile_count;) work(tile, workers[index]);
-        } catch (...) {
-            errors[index] = std::current_exception();
-            next_tile.store(tile_count);
-        }
-    };
-    std::vector<std::thread> pool;
-    for (std::size_t i = 1; i < workers.size(); ++i) pool.emplace_back(worker, i);
-    worker(0);
-    for (auto& th : pool) th.join();
-    for (const auto& e : errors)
-        if (e) std::rethrow_exception(e);
-}
 
 }  // namespace
 

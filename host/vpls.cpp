@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "cpu_kernel.h"
+#include "path_emitters.h"
 #include "shared/color.h"
 
 namespace lc {
@@ -133,25 +134,10 @@ public:
     }
 
 private:
-    // Rough power for choosing a light: any positive value keeps the flux
-    // unbiased; in proportion to the real power, each path carries about
-    // the same.
-    double power(const gpu::Light& l) const {
-        const double lum = gpu::lc_luminance(intensity(l));
-        if (!(lum > 0.0)) return 0.0;
-        switch (type_of(l)) {
-            case gpu::kLightPoint: return 4.0 * kPi * lum;
-            case gpu::kLightSpot: {
-                const double width = std::max(1e-3f, l.cos_inner - l.cos_outer);
-                return 2.0 * kPi * lum * (width / 3.0 + std::max(0.0, 1.0 - double(l.cos_inner)));
-            }
-            case gpu::kLightOriented:
-            case gpu::kLightVpl:
-                return kPi * lum * ((l.type & gpu::kLightTwoSided) ? 2.0 : 1.0);
-            case gpu::kLightDirectional: return kPi * double(radius_) * radius_ * lum;
-            default: return 0.0;
-        }
-    }
+    // The path tracer's estimate of a light's power (host/path_emitters.h):
+    // any positive value keeps the flux unbiased; in proportion to the real
+    // power, each path carries about the same.
+    double power(const gpu::Light& l) const { return path::light_power(l, radius_); }
 
     // A ray origin off an emitting surface, as lc_offset_hit_point moves hit points.
     static glm::vec3 offset(glm::vec3 p, glm::vec3 n) {
