@@ -58,7 +58,9 @@ struct Build {
 
 // Walter 2005 §4.1: I_C * (alpha_C^2 + c^2 (1 - cos beta_C)^2) for the
 // cluster a and b would make.
-double merge_cost(const Build& b, const Cluster& x, const Cluster& y) {
+// (Cluster, or the CostKey the fast builder gathers: the same fields.)
+template <typename C>
+double merge_cost(const Build& b, const C& x, const C& y) {
     glm::dvec3 d = glm::dvec3(glm::max(x.hi, y.hi)) - glm::dvec3(glm::min(x.lo, y.lo));
     double size = glm::dot(d, d);
     if (b.cone_weight > 0.0) {
@@ -152,16 +154,25 @@ void sort_morton(const std::vector<Cluster>& all, std::vector<std::uint32_t>& ac
 // every cost is equal, which they are for coincident lights (cost 0):
 // O(n^2) rounds' work and a tree as deep as n (8000 coincident lights took
 // 5 s).
-std::size_t best_partner(const Build& b, const std::vector<std::uint32_t>& active, std::size_t i) {
-    const std::vector<Cluster>& all = b.all;
-    const std::size_t n = active.size();
+// What merge_cost reads of a cluster. The fast builder gathers these in
+// Morton order every round, so a window of partners is contiguous memory,
+// not clusters scattered over Build::all (10^7 lights: most of the time went
+// to cache misses there).
+struct CostKey {
+    glm::vec3 lo, hi;
+    double weight;
+    EmissionCone cone;
+};
+
+std::size_t best_partner(const Build& b, const std::vector<CostKey>& keys, std::size_t i) {
+    const std::size_t n = keys.size();
     const std::size_t jb = i >= std::size_t(kWindow) ? i - kWindow : 0;
     const std::size_t je = std::min(n, i + kWindow + 1);
     double best_cost = std::numeric_limits<double>::infinity();
     std::size_t best_j = i == 0 ? 1 : i - 1;
     for (std::size_t j = jb; j < je; ++j) {
         if (j == i) continue;
-        const double cost = merge_cost(b, all[active[i]], all[active[j]]);
+        const double cost = merge_cost(b, keys[i], keys[j]);
         const std::size_t dist = j > i ? j - i : i - j;
         const std::size_t best_dist = best_j > i ? best_j - i : i - best_j;
         const bool prefer_right = (i / dist) % 2 == 0;
@@ -178,13 +189,21 @@ std::size_t best_partner(const Build& b, const std::vector<std::uint32_t>& activ
 std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
     sort_morton(build.all, active, build.cone_weight > 0.0);
     std::vector<std::uint32_t> best(active.size());
+    std::vector<CostKey> keys(active.size());
     std::vector<std::uint32_t> next;
     while (active.size() > 1) {
         const std::size_t n = active.size();
         best.resize(n);
+        keys.resize(n);
+        parallel_for(n, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i) {
+                const Cluster& c = build.all[active[i]];
+                keys[i] = CostKey{c.lo, c.hi, c.weight, c.cone};
+            }
+        });
         parallel_for(n, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i)
-                best[i] = static_cast<std::uint32_t>(best_partner(build, active, i));
+                best[i] = static_cast<std::uint32_t>(best_partner(build, keys, i));
         });
         // Mutual best pairs merge (in place of their first member, so the
         // Morton order holds); the others wait for the next round.
