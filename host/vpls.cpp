@@ -25,6 +25,13 @@ public:
         state_ = gpu::lc_hash(state_);
         return gpu::lc_unit_float(state_);
     }
+    // 53 bits in [0, 1), for the choice among millions of lights (with 24
+    // bits a light of probability below 2^-24 could never be drawn).
+    double fine() {
+        const std::uint32_t h1 = gpu::lc_hash(state_);
+        state_ = gpu::lc_hash(h1);
+        return (double(h1 >> 5) * 67108864.0 + double(state_ >> 6)) * (1.0 / 9007199254740992.0);
+    }
 
 private:
     std::uint32_t state_;
@@ -34,28 +41,19 @@ glm::vec3 intensity(const gpu::Light& l) { return {l.r, l.g, l.b}; }
 glm::vec3 axis(const gpu::Light& l) { return {l.axis_x, l.axis_y, l.axis_z}; }
 std::uint32_t type_of(const gpu::Light& l) { return l.type & gpu::kLightTypeMask; }
 
-// A unit vector at cosine `c` from n, at azimuth 2 pi u.
-glm::vec3 around(glm::vec3 n, float c, float u) {
+// A unit vector at cosine `c` from n, at azimuth 2 pi u (the kernel's basis, lc_basis).
+glm::vec3 around(cpu::ShadeKernel& k, glm::vec3 n, float c, float u) {
     glm::vec3 t, b;
-    const float sign = n.z >= 0.0f ? 1.0f : -1.0f;  // Duff et al., as lc_basis
-    const float a = -1.0f / (sign + n.z);
-    const float xy = n.x * n.y * a;
-    t = glm::vec3(1.0f + sign * n.x * n.x * a, sign * xy, -sign * n.x);
-    b = glm::vec3(xy, sign + n.y * n.y * a, -n.y);
+    k.lc_basis(n, t, b);
     const float s = std::sqrt(std::max(0.0f, 1.0f - c * c));
     const float phi = 2.0f * kPi * u;
     return glm::normalize(s * std::cos(phi) * t + s * std::sin(phi) * b + c * n);
 }
 
 // Cosine-weighted direction around n (pdf cos / pi).
-glm::vec3 cosine_direction(glm::vec3 n, PathRandom& rng) {
+glm::vec3 cosine_direction(cpu::ShadeKernel& k, glm::vec3 n, PathRandom& rng) {
     const float c = std::sqrt(rng.next());
-    return around(n, c, rng.next());
-}
-
-float spot_falloff(const gpu::Light& l, float c) {
-    const float s = std::clamp((c - l.cos_outer) / std::max(1e-3f, l.cos_inner - l.cos_outer), 0.0f, 1.0f);
-    return s * s;
+    return around(k, n, c, rng.next());
 }
 
 // What the emitters add up to, and how a path starts from one of them.
@@ -64,43 +62,40 @@ public:
     Emitters(std::span<const gpu::Light> lights, const Scene& scene) : lights_(lights) {
         centre_ = 0.5f * (scene.bounds_min + scene.bounds_max);
         radius_ = std::max(0.5f * glm::length(scene.bounds_max - scene.bounds_min), 1e-6f);
-        cdf_.reserve(lights.size());
-        double total = 0.0;
-        for (const gpu::Light& l : lights) {
-            total += power(l);
-            cdf_.push_back(total);
-        }
-        total_ = total;
+        std::vector<double> weights;
+        weights.reserve(lights.size());
+        // The path tracer's estimate of a light's power (host/path_emitters.h):
+        // any positive value keeps the flux unbiased; in proportion to the
+        // real power, each path carries about the same.
+        for (const gpu::Light& l : lights) weights.push_back(path::light_power(l, radius_));
+        power_ = path::Distribution1D(weights);
     }
 
-    bool empty() const { return !(total_ > 0.0); }
+    bool empty() const { return !(power_.total() > 0.0); }
 
     // A ray leaving a light in proportion to power: origin, direction and
     // the flux it carries, I(w) / (P(light) pdf(w)). False when the draw
     // carries nothing.
-    bool start(PathRandom& rng, glm::vec3& org, glm::vec3& dir, glm::vec3& flux) const {
-        const double pick = double(rng.next()) * total_;
-        std::size_t i = std::size_t(std::upper_bound(cdf_.begin(), cdf_.end(), pick) - cdf_.begin());
-        i = std::min(i, cdf_.size() - 1);
-        while (i > 0 && cdf_[i] == cdf_[i - 1]) --i;  // never a light of zero power
+    bool start(cpu::ShadeKernel& k, PathRandom& rng, glm::vec3& org, glm::vec3& dir, glm::vec3& flux) const {
+        const std::uint32_t i = power_.sample(rng.fine());  // never a light of zero power
         const gpu::Light& l = lights_[i];
-        const double p_light = power(l) / total_;
+        const double p_light = power_.pmf(i);
         if (!(p_light > 0.0)) return false;
         const glm::vec3 position(l.x, l.y, l.z);
         float emitted = 1.0f;  // I(w) / I, over pdf(w)
         switch (type_of(l)) {
             case gpu::kLightPoint: {
                 const float c = 1.0f - 2.0f * rng.next();
-                dir = around(glm::vec3(0, 0, 1), c, rng.next());
+                dir = around(k, glm::vec3(0, 0, 1), c, rng.next());
                 org = position;
                 emitted = 4.0f * kPi;
                 break;
             }
             case gpu::kLightSpot: {
                 const float c = 1.0f - rng.next() * (1.0f - l.cos_outer);
-                dir = around(axis(l), c, rng.next());
+                dir = around(k, axis(l), c, rng.next());
                 org = position;
-                emitted = spot_falloff(l, c) * 2.0f * kPi * (1.0f - l.cos_outer);
+                emitted = k.lc_spot_falloff(l, c) * 2.0f * kPi * (1.0f - l.cos_outer);
                 break;
             }
             case gpu::kLightOriented:
@@ -111,7 +106,7 @@ public:
                     sides = 2.0f;
                     if (rng.next() < 0.5f) n = -n;
                 }
-                dir = cosine_direction(n, rng);
+                dir = cosine_direction(k, n, rng);
                 org = offset(position, n);
                 emitted = sides * kPi;
                 break;
@@ -121,7 +116,7 @@ public:
                 const glm::vec3 towards(l.x, l.y, l.z);
                 dir = -towards;
                 const float r = radius_ * std::sqrt(rng.next());
-                const glm::vec3 across = around(towards, 0.0f, rng.next());
+                const glm::vec3 across = around(k, towards, 0.0f, rng.next());
                 org = centre_ + towards * (2.0f * radius_) + across * r;
                 emitted = kPi * radius_ * radius_;
                 break;
@@ -134,11 +129,6 @@ public:
     }
 
 private:
-    // The path tracer's estimate of a light's power (host/path_emitters.h):
-    // any positive value keeps the flux unbiased; in proportion to the real
-    // power, each path carries about the same.
-    double power(const gpu::Light& l) const { return path::light_power(l, radius_); }
-
     // A ray origin off an emitting surface, as lc_offset_hit_point moves hit points.
     static glm::vec3 offset(glm::vec3 p, glm::vec3 n) {
         const glm::vec3 m = glm::abs(p);
@@ -146,8 +136,7 @@ private:
     }
 
     std::span<const gpu::Light> lights_;
-    std::vector<double> cdf_;
-    double total_ = 0.0;
+    path::Distribution1D power_;
     glm::vec3 centre_;
     float radius_;
 };
@@ -157,8 +146,8 @@ void trace_path(const cpu::ShadeKernel& k, const Emitters& emitters, std::uint32
                 std::uint32_t max_bounces, std::vector<gpu::Light>& out) {
     PathRandom rng(seed, index);
     glm::vec3 org, dir, flux;
-    if (!emitters.start(rng, org, dir, flux)) return;
-    cpu::ShadeKernel kernel = k;  // the trace functions are members
+    cpu::ShadeKernel kernel = k;  // the kernel's functions are non-const members
+    if (!emitters.start(kernel, rng, org, dir, flux)) return;
     for (std::uint32_t bounce = 1;; ++bounce) {
         float t, b1, b2;
         const std::uint32_t tri = kernel.lc_trace_closest(org, dir, cpu::ShadeKernel::kRayInfinity, t, b1, b2);
@@ -179,7 +168,7 @@ void trace_path(const cpu::ShadeKernel& k, const Emitters& emitters, std::uint32
         if (rng.next() >= survive) return;
         flux *= kd / survive;
         org = sp.p;
-        dir = cosine_direction(sp.n, rng);
+        dir = cosine_direction(kernel, sp.n, rng);
     }
 }
 

@@ -55,22 +55,22 @@ double vpl_power(const std::vector<gpu::Light>& vpls) {
     return sum;
 }
 
-struct Traced {
-    PreparedScene prepared;
-    std::vector<gpu::Light> emitters;
-};
+// The test room with every surface grey (albedo 0.5): closed, so every
+// light path hits a wall.
+PreparedScene grey_room(std::vector<gpu::Light> lights) {
+    Scene s = test::room_scene(std::move(lights), 16);
+    s.materials = {test::lambert(glm::vec3(0.5f))};
+    for (auto& t : s.triangles) t.material = 0;
+    return prepare_scene(s, 1);
+}
 
 // Inside a closed box every path hits a wall, so with one bounce each path
 // leaves one VPL carrying rho times the flux it started with, and grey
 // lights chosen by power all start with the total: the VPLs emit exactly
 // rho times what the lights emit. A point light of intensity I emits 4 pi I.
 TEST(Vpls, OneBounceCarriesAlbedoTimesTheLightsPower) {
-    Scene s = test::room_scene({test::point_light({0.2f, 1.5f, 0.1f}, glm::vec3(2.0f)),
-                                test::point_light({-0.5f, 0.5f, -0.4f}, glm::vec3(1.0f))},
-                               16);
-    s.materials = {test::lambert(glm::vec3(0.5f))};  // everything grey
-    for (auto& t : s.triangles) t.material = 0;
-    PreparedScene p = prepare_scene(s, 1);
+    PreparedScene p = grey_room({test::point_light({0.2f, 1.5f, 0.1f}, glm::vec3(2.0f)),
+                                 test::point_light({-0.5f, 0.5f, -0.4f}, glm::vec3(1.0f))});
     IndirectSettings settings;
     settings.vpls = 5000;
     settings.max_bounces = 1;
@@ -84,13 +84,10 @@ TEST(Vpls, OneBounceCarriesAlbedoTimesTheLightsPower) {
 
 // Two bounces: the second VPL is left with probability rho (roulette) and
 // the same flux, so the expected total is rho (1 + rho) times the lights'.
-// 20000 paths; the standard error of the second bounce's share is
+// About 20000 paths; the standard error of the second bounce's share is
 // sqrt(rho (1 - rho) / paths) = 0.35% of the total, checked within 4.
 TEST(Vpls, BouncesAddAlbedoPowers) {
-    Scene s = test::room_scene({test::point_light({0.2f, 1.5f, 0.1f}, glm::vec3(1.0f))}, 16);
-    s.materials = {test::lambert(glm::vec3(0.5f))};
-    for (auto& t : s.triangles) t.material = 0;
-    PreparedScene p = prepare_scene(s, 1);
+    PreparedScene p = grey_room({test::point_light({0.2f, 1.5f, 0.1f}, glm::vec3(1.0f))});
     IndirectSettings settings;
     settings.vpls = 30000;
     settings.max_bounces = 2;
@@ -191,7 +188,7 @@ TEST(Furnace, LightcutsWithVplsReachesTheClosedForm) {
     };
     // Measured relative errors of the image mean (32 x 32, 24576 area-light
     // samples, 20000 VPLs, seed 1): direct light only +0.82%, 1 bounce
-    // +0.75%, 2 bounces +1.05%, unlimited +1.0%. Most of it is in the direct
+    // +0.73%, 2 bounces +1.43%, unlimited +0.69%. Most of it is in the direct
     // light already, and not from the cut: brute force over the same
     // area-light samples gives +0.61%, lightcuts at error 0.002 +0.68%
     // (point samples of the walls near a receiver at the box's edges give
@@ -239,8 +236,8 @@ double block_rmse(const Image& image, const Image& reference, std::uint32_t b) {
 // nothing), lightcuts with 10^3, 10^4 and 10^5 VPLs at a small threshold
 // against the path tracer with unlimited bounces through the same pixel
 // centres (spp 1, light_samples paths per camera ray), whose noise over
-// 4 x 4 blocks is below the VPLs' error at 10^5. Measured: 2.08%, 0.72%,
-// 0.20% (about 1/sqrt(N)), the reference's noise 0.08%.
+// 4 x 4 blocks is below the VPLs' error at 10^5. Measured: 1.21%, 0.57%,
+// 0.24%, the reference's noise 0.08%.
 TEST(VplConvergence, ErrorAgainstThePathTracerFallsWithTheVplCount) {
     Scene s = load_scene(std::string(LC_SOURCE_DIR) + "/scenes/cornell/cornell.json");
     s.render.area_light_samples = 16384;
