@@ -206,10 +206,13 @@ private:
 
 }  // namespace
 
-Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNormals>& normals) {
+Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNormals>& normals,
+              std::vector<gpu::TriangleUvs>* uvs) {
     const auto start = std::chrono::steady_clock::now();
     if (normals.size() != triangles.size())
         throw std::invalid_argument("build_bvh: triangles and normals differ in count");
+    if (uvs && uvs->size() != triangles.size())
+        throw std::invalid_argument("build_bvh: triangles and uvs differ in count");
     // Node indices are 32-bit and a tree holds up to 2n - 1 nodes.
     if (triangles.size() >= std::size_t(std::numeric_limits<std::uint32_t>::max() / 2))
         throw std::invalid_argument("build_bvh: too many triangles for 32-bit node indices");
@@ -257,6 +260,11 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
     }
     triangles.swap(sorted_triangles);
     normals.swap(sorted_normals);
+    if (uvs) {
+        std::vector<gpu::TriangleUvs> sorted_uvs(n);
+        for (std::uint32_t i = 0; i < n; ++i) sorted_uvs[i] = (*uvs)[order[i]];
+        uvs->swap(sorted_uvs);
+    }
 
     bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;

@@ -47,7 +47,10 @@ struct BasicShadeKernel {
     const BvhNode* bvh_nodes = nullptr;
     const Triangle* triangles = nullptr;
     const TriangleNormals* normals = nullptr;
+    const TriangleUvs* uvs = nullptr;
     const Material* materials = nullptr;
+    const TextureInfo* textures = nullptr;
+    const uint* texels = nullptr;
     const Light* lights = nullptr;
     const LightNode* light_nodes = nullptr;
     const float* environment = nullptr;  // RGB texels of the environment map
@@ -63,11 +66,15 @@ struct BasicShadeKernel {
     static constexpr bool kEnableGgx = true;
     static constexpr bool kEnableShadows = true;
     static constexpr bool kEnableOriented = true;
+    static constexpr bool kEnableTextures = true;
 
 #define LC_BVH_NODE(i) bvh_nodes[i]
 #define LC_TRIANGLE(i) triangles[i]
 #define LC_NORMALS(i) normals[i]
 #define LC_MATERIAL(i) materials[i]
+#define LC_UVS(i) uvs[i]
+#define LC_TEXTURE(i) textures[i]
+#define LC_TEXEL(i) texels[i]
 #define LC_LIGHT(i) lights[i]
 #define LC_LIGHT_NODE(i) light_nodes[i]
 #define LC_ENVIRONMENT_TEXEL(i) vec3(environment[3u * (i)], environment[3u * (i) + 1u], environment[3u * (i) + 2u])
@@ -77,6 +84,7 @@ struct BasicShadeKernel {
 #define LC_ON_SHADOW_RAY(o, d, t) \
     if constexpr (kRecordRays) ray_log->push_back({o, d, t})
 #include "shared/trace.h"
+#include "shared/textures.h"
 #include "shared/shading.h"
 #include "shared/brute.h"
 #include "shared/sampling.h"
@@ -85,6 +93,9 @@ struct BasicShadeKernel {
 #undef LC_TRIANGLE
 #undef LC_NORMALS
 #undef LC_MATERIAL
+#undef LC_UVS
+#undef LC_TEXTURE
+#undef LC_TEXEL
 #undef LC_LIGHT
 #undef LC_LIGHT_NODE
 #undef LC_ENVIRONMENT_TEXEL
@@ -103,7 +114,10 @@ BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, CutEntry
     k.bvh_nodes = p.bvh.nodes.data();
     k.triangles = p.scene.triangles.data();
     k.normals = p.scene.normals.data();
+    k.uvs = p.scene.uvs.data();
     k.materials = p.scene.materials.data();
+    k.textures = p.scene.textures.data();
+    k.texels = p.scene.texels.data();
     k.lights = p.tree.lights.data();
     k.light_nodes = p.tree.nodes.data();
     k.environment = p.scene.environment.rgb.data();

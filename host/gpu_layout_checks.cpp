@@ -19,7 +19,18 @@ static_assert(offsetof(Triangle, material) == 36);
 static_assert(sizeof(TriangleNormals) == 48);
 static_assert(offsetof(TriangleNormals, n2_z) == 32);
 
-static_assert(sizeof(Material) == 48);
+static_assert(sizeof(TriangleUvs) == 24);
+static_assert(offsetof(TriangleUvs, v2) == 20);
+
+static_assert(sizeof(Material) == 96);
+static_assert(offsetof(Material, roughness) == 44);
+static_assert(offsetof(Material, sheen) == 60);
+static_assert(offsetof(Material, normal_scale) == 76);
+static_assert(offsetof(Material, base_color_texture) == 80);
+static_assert(offsetof(Material, normal_texture) == 92);
+
+static_assert(sizeof(TextureInfo) == 16);
+static_assert(offsetof(TextureInfo, height) == 8);
 static_assert(offsetof(Material, emission_r) == 32);
 static_assert(offsetof(Material, ks_r) == 12);
 static_assert(offsetof(Material, alpha) == 24);
@@ -44,6 +55,7 @@ static_assert(sizeof(GBufferTexel) == 48);
 static_assert(offsetof(GBufferTexel, nx) == 12);
 static_assert(offsetof(GBufferTexel, wo_x) == 24);
 static_assert(offsetof(GBufferTexel, material) == 36);
+static_assert(offsetof(GBufferTexel, v) == 44);
 
 static_assert(sizeof(CutEntry) == 20);
 static_assert(offsetof(CutEntry, unit_r) == 8);

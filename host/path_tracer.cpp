@@ -170,7 +170,7 @@ glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, 
     // by NEE or by the ray its BRDF sample sends, has been reflected b times.
     for (std::uint32_t bounce = 1;; ++bounce) {
         VertexRandom rnd(k, stream, bounce);
-        const gpu::Material& m = prepared_.scene.materials[sp.material];
+        const gpu::Material& m = sp.mat;
         const LobeWeights lobes = lobe_weights(m, sp.n, sp.wo);
         add(radiance, throughput * next_event(k, sp, lobes, rnd, shadow_rays));
 
@@ -190,7 +190,7 @@ glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, 
             }
             break;
         }
-        const glm::vec3 emitted = k.lc_surface_emission(tri, b.wi);
+        const glm::vec3 emitted = k.lc_surface_emission(tri, b1, b2, b.wi);
         if (!black(emitted))
             add(radiance, throughput * emitted * power_heuristic(b.pdf, triangle_light_pdf(tri, b.wi, t)));
 
@@ -251,11 +251,11 @@ glm::vec3 PathTracer::triangle_sample(Kernel& k, const SurfacePoint& sp, const L
     const glm::vec3 wi = to_light / d;
     const float cos_i = glm::dot(sp.n, wi);
     if (!(cos_i > 0.0f)) return glm::vec3(0.0f);
-    const glm::vec3 emitted = k.lc_surface_emission(tri, wi);
+    const glm::vec3 emitted = k.lc_surface_emission(tri, su * (1.0f - v), su * v, wi);
     if (black(emitted)) return glm::vec3(0.0f);  // sp sees its back
     const float light_pdf = triangle_light_pdf(tri, wi, d);
     if (!(light_pdf > 0.0f && std::isfinite(light_pdf))) return glm::vec3(0.0f);  // seen edge-on
-    const gpu::Material& m = prepared_.scene.materials[sp.material];
+    const gpu::Material& m = sp.mat;
     const float weight = power_heuristic(light_pdf, bsdf_pdf(k, m, lobes, sp.n, sp.wo, wi));
     ++shadow_rays;
     if (k.lc_trace_any(sp.p, wi, d * (1.0f - Kernel::kShadowEndRelative))) return glm::vec3(0.0f);
@@ -284,7 +284,7 @@ glm::vec3 PathTracer::environment_sample(Kernel& k, const SurfacePoint& sp, cons
     if (!(cos_i > 0.0f) || !(light_pdf > 0.0f)) return glm::vec3(0.0f);
     const glm::vec3 sky = k.lc_environment_radiance(frame_, wi);
     if (black(sky)) return glm::vec3(0.0f);
-    const gpu::Material& m = prepared_.scene.materials[sp.material];
+    const gpu::Material& m = sp.mat;
     const float weight = power_heuristic(light_pdf, bsdf_pdf(k, m, lobes, sp.n, sp.wo, wi));
     ++shadow_rays;
     if (k.lc_trace_any(sp.p, wi, Kernel::kRayInfinity)) return glm::vec3(0.0f);

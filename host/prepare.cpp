@@ -46,7 +46,9 @@ bool all_coplanar(const std::vector<gpu::Triangle>& tris) {
 PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
     PreparedScene prepared;
     prepared.has_occluders = !all_coplanar(scene.triangles);
-    prepared.bvh = build_bvh(scene.triangles, scene.normals);
+    // A scene without texture coordinates gets zeros: every kernel reads them.
+    if (scene.uvs.size() != scene.triangles.size()) scene.uvs.assign(scene.triangles.size(), gpu::TriangleUvs{});
+    prepared.bvh = build_bvh(scene.triangles, scene.normals, &scene.uvs);
     // Walter 2005 §5: area lights and the environment become many point and
     // directional lights, in the one tree with the scene's own.
     const auto start = std::chrono::steady_clock::now();
@@ -74,8 +76,10 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
         prepared.has_oriented |= type == gpu::kLightSpot || type == gpu::kLightOriented || type == gpu::kLightVpl;
     }
     prepared.tree = build_light_tree(lights, seed);
-    for (const auto& m : scene.materials)
+    for (const auto& m : scene.materials) {
         prepared.has_specular |= (m.flags & gpu::kMaterialHasSpecular) != 0u;
+        prepared.has_textures |= (m.flags & gpu::kMaterialTextured) != 0u;
+    }
     // The geometry's size alone (Scene::bounds), in double: a far-away
     // light or the size of the light set must not change it.
     const glm::dvec3 extent = glm::dvec3(scene.bounds_max) - glm::dvec3(scene.bounds_min);
@@ -131,7 +135,10 @@ std::vector<SceneArray> scene_arrays(const PreparedScene& p) {
         array("bvh_nodes", p.bvh.nodes),
         array("triangles", p.scene.triangles),
         array("normals", p.scene.normals),
+        array("uvs", p.scene.uvs),
         array("materials", p.scene.materials),
+        array("textures", p.scene.textures),
+        array("texels", p.scene.texels),
         array("lights", p.tree.lights),
         array("light_tree_nodes", p.tree.nodes),
         array("environment", p.scene.environment.rgb),

@@ -153,7 +153,7 @@ void trace_path(const cpu::ShadeKernel& k, const Emitters& emitters, std::uint32
         const std::uint32_t tri = kernel.lc_trace_closest(org, dir, cpu::ShadeKernel::kRayInfinity, t, b1, b2);
         if (tri == gpu::kInvalidIndex) return;
         const auto sp = kernel.lc_surface_point(tri, b1, b2, dir);
-        const gpu::Material& m = k.materials[sp.material];
+        const gpu::Material& m = sp.mat;
         const glm::vec3 kd(m.kd_r, m.kd_g, m.kd_b);
         const float survive = std::min(1.0f, std::max({kd.x, kd.y, kd.z}));
         if (!(survive > 0.0f)) return;
@@ -184,7 +184,10 @@ VplSet trace_vpls(const Scene& scene, const Bvh& bvh, std::span<const gpu::Light
     k.bvh_nodes = bvh.nodes.data();
     k.triangles = scene.triangles.data();
     k.normals = scene.normals.data();
+    k.uvs = scene.uvs.data();
     k.materials = scene.materials.data();
+    k.textures = scene.textures.data();
+    k.texels = scene.texels.data();
 
     if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
     const std::size_t wanted = settings.vpls;

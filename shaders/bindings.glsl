@@ -20,17 +20,20 @@ LC_CONST uint kWorkgroupSize = 64u;
 LC_CONST uint kBindingBvhNodes = 0u;
 LC_CONST uint kBindingTriangles = 1u;
 LC_CONST uint kBindingNormals = 2u;
-LC_CONST uint kBindingMaterials = 3u;
-LC_CONST uint kBindingLights = 4u;        // leaf order of the light tree
-LC_CONST uint kBindingLightNodes = 5u;
-LC_CONST uint kBindingEnvironment = 6u;   // RGB floats of the environment map (one black texel if none)
-LC_CONST uint kBindingFrame = 7u;         // one FrameParams
-LC_CONST uint kBindingGBuffer = 8u;       // GBufferTexel per tile pixel
-LC_CONST uint kBindingRadiance = 9u;      // 3 floats per tile pixel, summed over samples
-LC_CONST uint kBindingPixelStats = 10u;   // PixelStats per tile pixel, summed over samples
-LC_CONST uint kBindingHeapSpill = 11u;    // CutEntry slots of every invocation (see heap.glsl)
-LC_CONST uint kBindingCutState = 12u;     // CutState per tile pixel, between Lightcuts dispatches
-LC_CONST uint kBindingCount = 13u;
+LC_CONST uint kBindingUvs = 3u;           // TriangleUvs, parallel to the triangles
+LC_CONST uint kBindingMaterials = 4u;
+LC_CONST uint kBindingTextures = 5u;      // TextureInfo per texture (one zeroed record if none)
+LC_CONST uint kBindingTexels = 6u;        // RGBA8 texels of every texture, one uint each
+LC_CONST uint kBindingLights = 7u;        // leaf order of the light tree
+LC_CONST uint kBindingLightNodes = 8u;
+LC_CONST uint kBindingEnvironment = 9u;   // RGB floats of the environment map (one black texel if none)
+LC_CONST uint kBindingFrame = 10u;        // one FrameParams
+LC_CONST uint kBindingGBuffer = 11u;      // GBufferTexel per tile pixel
+LC_CONST uint kBindingRadiance = 12u;     // 3 floats per tile pixel, summed over samples
+LC_CONST uint kBindingPixelStats = 13u;   // PixelStats per tile pixel, summed over samples
+LC_CONST uint kBindingHeapSpill = 14u;    // CutEntry slots of every invocation (see heap.glsl)
+LC_CONST uint kBindingCutState = 15u;     // CutState per tile pixel, between Lightcuts dispatches
+LC_CONST uint kBindingCount = 16u;
 
 // Specialization constant ids.
 LC_CONST uint kSpecWorkgroupSize = 0u;    // local_size_x
@@ -42,6 +45,7 @@ LC_CONST uint kSpecHeapCapacity = 4u;     // all cut-heap slots per invocation,
 LC_CONST uint kSpecSpillStride = 5u;      // invocations the spill buffer is laid out for
 LC_CONST uint kSpecEnableOriented = 6u;   // any spot or oriented light (emission cones)
 LC_CONST uint kSpecStochastic = 7u;       // lightcuts.comp: Stochastic Lightcuts' fresh representatives
+LC_CONST uint kSpecEnableTextures = 8u;   // any material has a texture
 
 // PixelStats.flags
 LC_CONST uint kPixelHeapOverflow = 1u;  // a heap outgrew its capacity (a bug: the capacity

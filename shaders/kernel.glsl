@@ -13,6 +13,7 @@ layout(local_size_x_id = kSpecWorkgroupSize) in;
 layout(constant_id = kSpecEnableGgx) const bool kEnableGgx = true;
 layout(constant_id = kSpecEnableShadows) const bool kEnableShadows = true;
 layout(constant_id = kSpecEnableOriented) const bool kEnableOriented = true;
+layout(constant_id = kSpecEnableTextures) const bool kEnableTextures = true;
 
 // PushConstants of bindings.glsl: this dispatch's tile, sample and split.
 layout(push_constant) uniform Push { PushConstants push; };
@@ -21,7 +22,10 @@ layout(std430, binding = kBindingFrame) readonly buffer Frame { FrameParams fram
 layout(std430, binding = kBindingBvhNodes) readonly buffer BvhNodes { BvhNode bvh_nodes[]; };
 layout(std430, binding = kBindingTriangles) readonly buffer Triangles { Triangle triangles[]; };
 layout(std430, binding = kBindingNormals) readonly buffer Normals { TriangleNormals normals[]; };
+layout(std430, binding = kBindingUvs) readonly buffer Uvs { TriangleUvs uvs[]; };
 layout(std430, binding = kBindingMaterials) readonly buffer Materials { Material materials[]; };
+layout(std430, binding = kBindingTextures) readonly buffer Textures { TextureInfo textures[]; };
+layout(std430, binding = kBindingTexels) readonly buffer Texels { uint texels[]; };
 layout(std430, binding = kBindingLights) readonly buffer Lights { Light lights[]; };
 layout(std430, binding = kBindingLightNodes) readonly buffer LightNodes { LightNode light_nodes[]; };
 layout(std430, binding = kBindingEnvironment) readonly buffer Environment { float environment[]; };
@@ -32,6 +36,9 @@ layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_sta
 #define LC_BVH_NODE(i) bvh_nodes[i]
 #define LC_TRIANGLE(i) triangles[i]
 #define LC_MATERIAL(i) materials[i]
+#define LC_UVS(i) uvs[i]
+#define LC_TEXTURE(i) textures[i]
+#define LC_TEXEL(i) texels[i]
 #define LC_NORMALS(i) normals[i]
 #define LC_LIGHT_NODE(i) light_nodes[i]
 #define LC_VPL_MIN_DISTANCE2 frame.vpl_min_distance2
@@ -42,6 +49,7 @@ layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_sta
 #include "shared/color.h"
 #include "shared/octahedral.h"
 #include "shared/trace.h"
+#include "shared/textures.h"
 #include "shared/shading.h"
 
 // Index of this invocation's pixel inside the tile, or kInvalidIndex for the
@@ -56,12 +64,8 @@ uint lc_tile_x(uint i) { return push.tile_x + i % push.tile_width; }
 uint lc_tile_y(uint i) { return push.tile_y + i / push.tile_width; }
 
 SurfacePoint lc_texel_surface(GBufferTexel g) {
-    SurfacePoint sp;
-    sp.p = vec3(g.px, g.py, g.pz);
-    sp.n = vec3(g.nx, g.ny, g.nz);
-    sp.wo = vec3(g.wo_x, g.wo_y, g.wo_z);
-    sp.material = g.material;
-    return sp;
+    return lc_make_surface(vec3(g.px, g.py, g.pz), vec3(g.nx, g.ny, g.nz), vec3(g.wo_x, g.wo_y, g.wo_z), g.material,
+                           vec2(g.u, g.v));
 }
 
 // llvmpipe (lavapipe) ends every loop of a shader invocation for good once

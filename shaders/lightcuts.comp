@@ -29,7 +29,7 @@ void main() {
     GBufferTexel g = gbuffer[i];
     if (g.material == kInvalidIndex) return;  // the camera ray left the scene: black
     SurfacePoint sp = lc_texel_surface(g);
-    Material m = LC_MATERIAL(sp.material);
+    Material m = sp.mat;
 
     ShadeStats stats;
     stats.cut_size = 0u;

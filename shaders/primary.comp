@@ -24,14 +24,16 @@ void main() {
         g.nx = 0.0f; g.ny = 0.0f; g.nz = 0.0f;
         g.wo_x = 0.0f; g.wo_y = 0.0f; g.wo_z = 0.0f;
         g.material = kInvalidIndex;
+        g.u = 0.0f;
+        g.v = 0.0f;
     } else {
         g.px = sp.p.x; g.py = sp.p.y; g.pz = sp.p.z;
         g.nx = sp.n.x; g.ny = sp.n.y; g.nz = sp.n.z;
         g.wo_x = sp.wo.x; g.wo_y = sp.wo.y; g.wo_z = sp.wo.z;
         g.material = sp.material;
+        g.u = sp.uv.x;
+        g.v = sp.uv.y;
     }
-    g.pad0 = 0u;
-    g.pad1 = 0u;
     gbuffer[i] = g;
     if (lc_loops_were_cut_short()) pixel_stats[i].flags |= kPixelLoopLimit;
 }

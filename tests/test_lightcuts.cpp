@@ -73,7 +73,7 @@ TEST(LightcutsBounds, EveryBoundIsConservative) {
         sp.p = x;
         sp.n = n;
         sp.wo = wo;
-        sp.material = 0;
+        sp = k.lc_make_surface(sp.p, sp.n, sp.wo, 0, glm::vec2(0.0f));
         glm::vec3 bound = k.lc_cluster_bound(
             sp, m, test::node_with_box(lo, hi, directional ? gpu::kLightDirectional : gpu::kLightPoint),
             min_distance2);

@@ -11,7 +11,8 @@
 namespace lc::loader {
 namespace {
 
-// GGX alpha floor: below this the fp32 NDF peak (1 / (pi alpha^2)) gets large
+// GGX alpha floor (gpu::kMinGgxAlpha of shared/textures.h, which textures
+// respect too): below this the fp32 NDF peak (1 / (pi alpha^2)) gets large
 // enough that single point-light highlights turn into isolated fireflies.
 constexpr float kMinGgxAlpha = 1e-3f;
 
@@ -26,8 +27,32 @@ gpu::Material make_material(glm::vec3 kd, glm::vec3 ks, float alpha) {
     m.ks_g = ks.g;
     m.ks_b = ks.b;
     m.alpha = std::clamp(alpha, kMinGgxAlpha, 1.0f);
+    m.roughness = std::sqrt(m.alpha);
     m.flags = (ks.r > 0.0f || ks.g > 0.0f || ks.b > 0.0f) ? gpu::kMaterialHasSpecular : 0u;
+    m.specular = 0.5f;
+    m.normal_scale = 1.0f;
+    m.base_color_texture = m.metallic_roughness_texture = m.emissive_texture = m.normal_texture = gpu::kInvalidIndex;
     return m;
+}
+
+gpu::Material make_disney_material(const DisneyParams& p) {
+    gpu::Material m = make_material(p.base_color, glm::vec3(0.0f), p.roughness * p.roughness);
+    m.flags = gpu::kMaterialDisney | (p.sheen > 0.0f ? gpu::kMaterialHasSheen : 0u) |
+              (p.clearcoat > 0.0f ? gpu::kMaterialHasClearcoat : 0u);
+    m.roughness = p.roughness;
+    m.metallic = p.metallic;
+    m.specular = p.specular;
+    m.specular_tint = p.specular_tint;
+    m.sheen = p.sheen;
+    m.sheen_tint = p.sheen_tint;
+    m.clearcoat = p.clearcoat;
+    m.clearcoat_gloss = p.clearcoat_gloss;
+    return m;
+}
+
+void set_texture(gpu::Material& m, std::uint32_t gpu::Material::*slot, std::uint32_t index) {
+    m.*slot = index;
+    m.flags |= gpu::kMaterialTextured;
 }
 
 void set_emission(gpu::Material& m, glm::vec3 radiance, bool both_sides) {

@@ -23,6 +23,7 @@ struct SpecData {
     std::uint32_t spill_stride;
     VkBool32 enable_oriented;
     VkBool32 stochastic;
+    VkBool32 enable_textures;
 };
 
 Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const KernelCode& code,
@@ -46,6 +47,7 @@ Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const Ker
         {gpu::kSpecSpillStride, offsetof(SpecData, spill_stride), sizeof(std::uint32_t)},
         {gpu::kSpecEnableOriented, offsetof(SpecData, enable_oriented), sizeof(VkBool32)},
         {gpu::kSpecStochastic, offsetof(SpecData, stochastic), sizeof(VkBool32)},
+        {gpu::kSpecEnableTextures, offsetof(SpecData, enable_textures), sizeof(VkBool32)},
     };
     VkSpecializationInfo spec_info{};
     spec_info.mapEntryCount = std::uint32_t(std::size(entries));
@@ -80,6 +82,7 @@ Kernels::Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMetho
     spec.spill_stride = switches.spill_stride;
     spec.enable_oriented = switches.oriented;
     spec.stochastic = method.stochastic();
+    spec.enable_textures = switches.textures;
     primary_ = compute_pipeline(
         ctx, layout, {lc_spirv_primary, sizeof lc_spirv_primary, "primary.comp (camera rays)"}, spec);
     shading_ = compute_pipeline(ctx, layout, method.kernel(), spec);

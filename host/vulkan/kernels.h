@@ -15,6 +15,7 @@ struct KernelSwitches {
     bool ggx = true;                 // compile the GGX lobe in
     bool shadows = true;             // compile shadow rays in
     bool oriented = true;            // compile spot and oriented lights (emission cones) in
+    bool textures = true;            // compile texture lookups in
     std::uint32_t spill_stride = 1;  // invocations the heap spill buffer is laid out for
 };
 

@@ -84,7 +84,8 @@ RenderSetup::RenderSetup(const Context& context, const PreparedScene& prepared,
                 std::uint64_t(frame.width) * frame.height, tuning.max_tile_pixels),
       kernels(context, resources.pipeline_layout(), *method,
               {tuning.force_ggx || prepared.has_specular, tuning.force_shadows || prepared.has_occluders,
-               tuning.force_oriented || prepared.has_oriented, resources.tiles().invocations}),
+               tuning.force_oriented || prepared.has_oriented, tuning.force_textures || prepared.has_textures,
+               resources.tiles().invocations}),
       pass(context, resources, kernels, *method, timestamps) {}
 
 RenderSetup::~RenderSetup() { ctx.fn().vkDeviceWaitIdle(ctx.device().get()); }
@@ -97,6 +98,7 @@ Tuning Tuning::from_environment() {
         tuning.force_ggx = all || features.find("ggx") != std::string::npos;
         tuning.force_shadows = all || features.find("shadows") != std::string::npos;
         tuning.force_oriented = all || features.find("oriented") != std::string::npos;
+        tuning.force_textures = all || features.find("textures") != std::string::npos;
     }
     if (const char* v = std::getenv("LC_VK_MAX_TILE_PIXELS"))
         tuning.max_tile_pixels = std::uint32_t(std::strtoul(v, nullptr, 10));

@@ -13,9 +13,10 @@ struct Bvh {
     double build_seconds = 0.0;
 };
 
-// Builds the BVH and reorders `triangles` and `normals` (same permutation) so
-// that each leaf references a contiguous range. Depth stays below
-// gpu::kBvhStackSize so fixed-size traversal stacks never overflow.
-Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNormals>& normals);
+// Builds the BVH and reorders `triangles`, `normals` and `uvs` when given
+// (same permutation) so that each leaf references a contiguous range. Depth
+// stays below gpu::kBvhStackSize so fixed-size traversal stacks never overflow.
+Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNormals>& normals,
+              std::vector<gpu::TriangleUvs>* uvs = nullptr);
 
 }  // namespace lc

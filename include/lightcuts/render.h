@@ -26,6 +26,7 @@ struct PreparedScene {
     bool has_specular = false;   // any material with a GGX lobe
     bool has_occluders = true;   // false: no triangle can block a light
     bool has_oriented = false;   // any spot or oriented light (emission cones matter)
+    bool has_textures = false;   // any material with a texture
     // Lights made from emissive triangles and from the environment (they are
     // in the tree, after the scene's own lights), and the time that took.
     std::size_t area_lights = 0;

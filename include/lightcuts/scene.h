@@ -61,7 +61,10 @@ struct Scene {
     Camera camera;
     std::vector<gpu::Triangle> triangles;        // material index inside
     std::vector<gpu::TriangleNormals> normals;   // parallel to triangles
+    std::vector<gpu::TriangleUvs> uvs;           // parallel to triangles (zeros without UVs)
     std::vector<gpu::Material> materials;
+    std::vector<gpu::TextureInfo> textures;      // Material.*_texture index these
+    std::vector<std::uint32_t> texels;           // RGBA8 texels of all textures (TextureInfo.offset)
     std::vector<gpu::Light> lights;              // all types, in file order
     Environment environment;
     RenderSettings render;

@@ -160,7 +160,7 @@ void lc_select_cut(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap
 }
 
 vec3 lc_shade_lightcuts(SurfacePoint sp, FrameParams f, LC_INOUT(ShadeStats) stats) {
-    Material m = LC_MATERIAL(sp.material);
+    Material m = sp.mat;
     uint heap_size = 0u;
     vec3 leaf_sum = vec3(0.0f);
     lc_select_cut(sp, m, f, heap_size, leaf_sum, stats);
@@ -176,7 +176,7 @@ vec3 lc_shade_lightcuts(SurfacePoint sp, FrameParams f, LC_INOUT(ShadeStats) sta
 // is unbiased given the cut, so the pixel is, and the mean over samples
 // converges to the exact image.
 vec3 lc_shade_stochastic(SurfacePoint sp, FrameParams f, uint stream, LC_INOUT(ShadeStats) stats) {
-    Material m = LC_MATERIAL(sp.material);
+    Material m = sp.mat;
     uint heap_size = 0u;
     vec3 result = vec3(0.0f);
     lc_select_cut(sp, m, f, heap_size, result, stats);

@@ -5,10 +5,11 @@
 // The includer defines:
 //   LC_MATERIAL(i)   -> Material
 //   LC_NORMALS(i)    -> TriangleNormals
+//   LC_UVS(i), LC_TEXTURE(i), LC_TEXEL(i) (textures.h, included before this)
 //   LC_LIGHT(i)      -> Light
 //   LC_ENVIRONMENT_TEXEL(i) -> vec3 (radiance of environment texel i)
 //   LC_VPL_MIN_DISTANCE2 -> float (FrameParams.vpl_min_distance2)
-// and the feature switches kEnableGgx, kEnableShadows and kEnableOriented
+// and the feature switches kEnableGgx, kEnableShadows, kEnableOriented and kEnableTextures
 // (specialization constants on the GPU, so a scene without GGX materials,
 // without occluders or without spot and oriented lights gets a kernel
 // without that code; always true on the CPU).
@@ -52,13 +53,29 @@ vec3 lc_camera_ray_dir(FrameParams f, vec2 pixel) {
 }
 
 // A shaded point: position offset off the surface, shading normal and view
-// direction both on the camera's side.
+// direction both on the camera's side, and its material with the textures
+// at its texture coordinates applied (lc_material_at), looked up once
+// before any light is shaded.
 struct SurfacePoint {
     vec3 p;
     vec3 n;
     vec3 wo;
-    uint material;
+    uint material;  // index of the material record
+    vec2 uv;
+    Material mat;   // lc_material_at(material, uv)
 };
+
+// A shaded point from its parts (the G-buffer's, or a test's).
+SurfacePoint lc_make_surface(vec3 p, vec3 n, vec3 wo, uint material, vec2 uv) {
+    SurfacePoint sp;
+    sp.p = p;
+    sp.n = n;
+    sp.wo = wo;
+    sp.material = material;
+    sp.uv = uv;
+    sp.mat = lc_material_at(material, uv);
+    return sp;
+}
 
 SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) {
     Triangle tri = LC_TRIANGLE(tri_index);
@@ -74,6 +91,9 @@ SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) 
               b2 * vec3(tn.n2_x, tn.n2_y, tn.n2_z);
     float ns_len = length(ns);
     ns = ns_len > 1e-12f ? ns / ns_len : ng;
+    vec2 uv = lc_triangle_uv(tri_index, b1, b2);
+    Material mat = lc_material_at(tri.material, uv);
+    ns = lc_normal_mapped(mat, uv, ns, v0, v1, v2, LC_UVS(tri_index));
     // Two-sided surfaces: both normals turn to the side the ray came from.
     if (dot(ng, ray_dir) > 0.0f) ng = -ng;
     if (dot(ns, ng) < 0.0f) ns = -ns;
@@ -82,6 +102,8 @@ SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) 
     sp.n = ns;
     sp.wo = -ray_dir;
     sp.material = tri.material;
+    sp.uv = uv;
+    sp.mat = mat;
     return sp;
 }
 
@@ -96,17 +118,20 @@ vec3 lc_environment_radiance(FrameParams f, vec3 d) {
     return LC_ENVIRONMENT_TEXEL(row * f.env_width + col);
 }
 
-// Radiance a triangle emits towards -ray_dir: its material's emission on
-// the side its geometric normal (counter-clockwise winding) points to, or on
-// both sides.
-vec3 lc_surface_emission(uint tri_index, vec3 ray_dir) {
+// Radiance a triangle emits at barycentrics (b1, b2) towards -ray_dir: its
+// material's emission (times its emissive texture) on the side its
+// geometric normal (counter-clockwise winding) points to, or on both sides.
+vec3 lc_surface_emission(uint tri_index, float b1, float b2, vec3 ray_dir) {
     Triangle tri = LC_TRIANGLE(tri_index);
     Material m = LC_MATERIAL(tri.material);
     if ((m.flags & kMaterialEmissive) == 0u) return vec3(0.0f);
     vec3 ng = cross(lc_tri_v1(tri) - lc_tri_v0(tri), lc_tri_v2(tri) - lc_tri_v0(tri));
     bool front = dot(ng, ray_dir) < 0.0f;
     if (!front && (m.flags & kMaterialEmitsBothSides) == 0u) return vec3(0.0f);
-    return vec3(m.emission_r, m.emission_g, m.emission_b);
+    vec3 e = vec3(m.emission_r, m.emission_g, m.emission_b);
+    if (lc_has_texture(m, m.emissive_texture))
+        e *= vec3(lc_texture_sample(m.emissive_texture, lc_triangle_uv(tri_index, b1, b2), true));
+    return e;
 }
 
 // Sample `s` of pixel (x, y) traced into the scene: the triangle hit
@@ -142,7 +167,7 @@ bool lc_camera_sample(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint
         return false;
     }
     sp = lc_surface_point(tri, b1, b2, dir);
-    seen = lc_surface_emission(tri, dir);
+    seen = lc_surface_emission(tri, b1, b2, dir);
     return true;
 }
 
@@ -248,7 +273,7 @@ vec3 lc_light_unit(SurfacePoint sp, Light light, float min_distance2, LC_OUT(vec
     }
     float cos_i = dot(sp.n, wi);
     if (cos_i <= 0.0f || !(factor > 0.0f)) return vec3(0.0f);
-    return lc_brdf_cos(LC_MATERIAL(sp.material), sp.n, wi, sp.wo, cos_i) * factor;
+    return lc_brdf_cos(sp.mat, sp.n, wi, sp.wo, cos_i) * factor;
 }
 
 bool lc_visible(SurfacePoint sp, vec3 wi, float t_max) {

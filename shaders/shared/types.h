@@ -47,9 +47,13 @@ LC_CONST uint kNodeTypeShift = 8u;
 LC_CONST uint kNodeTypeMask = 0xFFu;
 
 // Material.flags
-LC_CONST uint kMaterialHasSpecular = 1u;
+LC_CONST uint kMaterialHasSpecular = 1u;     // Lambert + GGX: the GGX lobe is on
 LC_CONST uint kMaterialEmissive = 2u;        // emission is not black
 LC_CONST uint kMaterialEmitsBothSides = 4u;  // emits on both sides of the triangle
+LC_CONST uint kMaterialDisney = 8u;          // the Disney BRDF (else Lambert + GGX)
+LC_CONST uint kMaterialHasSheen = 16u;       // Disney: sheen > 0
+LC_CONST uint kMaterialHasClearcoat = 32u;   // Disney: clearcoat > 0
+LC_CONST uint kMaterialTextured = 64u;       // some *_texture is not kInvalidIndex
 
 // ---------------------------------------------------------------------------
 // BVH over triangles (32 bytes). Interior: child0 = first_or_left,
@@ -81,16 +85,46 @@ struct TriangleNormals {
     uint pad0, pad1, pad2;
 };
 
-// Lambert albedo kd plus an optional GGX lobe with reflectance ks and
-// roughness alpha (GGX alpha = roughness^2), and the radiance a surface
-// emits (W/(sr m^2)), on the side of its geometric normal unless
-// kMaterialEmitsBothSides (48 bytes).
+// Texture coordinates (UV set 0), one pair per vertex, same order as
+// Triangle (24 bytes); zero where the mesh has none.
+struct TriangleUvs {
+    float u0, v0, u1, v1, u2, v2;
+};
+
+// A material is one of two kinds (flags & kMaterialDisney):
+//   Lambert + GGX: albedo kd (kd_*) plus an optional GGX lobe with
+//     reflectance ks and GGX alpha (kMaterialHasSpecular);
+//   Disney (Burley 2012, isotropic, no transmission): base colour in kd_*,
+//     roughness, metallic, specular, specular_tint, sheen, sheen_tint,
+//     clearcoat, clearcoat_gloss; alpha = roughness^2 (ks_* unused).
+// Both emit `emission` (W/(sr m^2)) on the side of the geometric normal, or
+// on both sides with kMaterialEmitsBothSides. Textures (indices into the
+// TextureInfo array, kInvalidIndex for none) multiply the factors at the
+// shaded point's UV: base colour (sRGB) scales kd, metallic-roughness (glTF:
+// roughness in G, metallic in B) scales roughness and metallic, emissive
+// (sRGB) scales emission; the normal map (tangent space, scaled in x and y
+// by normal_scale) bends the shading normal. 96 bytes.
 struct Material {
     float kd_r, kd_g, kd_b;
     float ks_r, ks_g, ks_b;
     float alpha;
     uint flags;
     float emission_r, emission_g, emission_b;
+    float roughness;
+    float metallic, specular, specular_tint, sheen;
+    float sheen_tint, clearcoat, clearcoat_gloss, normal_scale;
+    uint base_color_texture;
+    uint metallic_roughness_texture;
+    uint emissive_texture;
+    uint normal_texture;
+};
+
+// One texture (16 bytes): width x height texels, row 0 at the top (v = 0),
+// RGBA8 packed one per uint (R in the low byte) from texel `offset` of the
+// texel buffer. Sampled bilinearly with wrapping (shared/textures.h).
+struct TextureInfo {
+    uint offset;
+    uint width, height;
     uint pad0;
 };
 
@@ -141,7 +175,7 @@ struct GBufferTexel {
     float nx, ny, nz;        // shading normal, flipped to face the camera
     float wo_x, wo_y, wo_z;  // unit direction towards the camera
     uint material;
-    uint pad0, pad1;
+    float u, v;              // texture coordinates of the hit
 };
 
 // One entry of the per-pixel cut heap (20 bytes): a refinable interior node,

@@ -107,10 +107,7 @@ std::vector<NodeRange> check_tree(const PreparedScene& p) {
 
 std::vector<ShadingPoint> shading_points(const PreparedScene& p, const RenderOptions& o) {
     const gpu::FrameParams f = make_frame_params(p, o);
-    Kernel k;
-    k.bvh_nodes = p.bvh.nodes.data();
-    k.triangles = p.scene.triangles.data();
-    k.normals = p.scene.normals.data();
+    Kernel k = cpu::make_shade_kernel(p, nullptr);
     std::vector<ShadingPoint> points;
     for (std::uint32_t y = 0; y < f.height; ++y)
         for (std::uint32_t x = 0; x < f.width; ++x) {
@@ -123,9 +120,7 @@ std::vector<ShadingPoint> shading_points(const PreparedScene& p, const RenderOpt
 BoundStats check_bounds(const PreparedScene& p, const std::vector<NodeRange>& ranges,
                         const std::vector<ShadingPoint>& points, const BoundCheck& how) {
     const LightTree& tree = p.tree;
-    Kernel k;
-    k.materials = p.scene.materials.data();
-    k.lights = tree.lights.data();
+    Kernel k = cpu::make_shade_kernel(p, nullptr);
     BoundStats stats;
     int reports = 0;
     std::uint64_t failures = 0;
@@ -144,7 +139,7 @@ BoundStats check_bounds(const PreparedScene& p, const std::vector<NodeRange>& ra
     }
     for (std::size_t pi = 0; pi < points.size(); pi += std::max<std::size_t>(how.pixel_stride, 1)) {
         const ShadingPoint& s = points[pi];
-        const gpu::Material& m = p.scene.materials[s.sp.material];
+        const gpu::Material& m = s.sp.mat;
         for (std::uint32_t ni : nodes) {
             const gpu::LightNode& n = tree.nodes[ni];
             const std::uint32_t type = (n.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask;
@@ -214,7 +209,7 @@ void expect_cut_guarantee(const PreparedScene& p, const RenderOptions& o,
     std::size_t violations = 0;
     double largest_share = 0.0;  // |difference| / sum of bounds, the tightest point
     for (const ShadingPoint& s : points) {
-        const gpu::Material m = p.scene.materials[s.sp.material];
+        const gpu::Material m = s.sp.mat;
         Kernel::ShadeStats stats{0u, 0u, 0u, 0u};
         std::uint32_t heap_size = 0;
         glm::vec3 leaf_sum, heap_sum;

@@ -223,6 +223,7 @@ TEST_F(Vulkan, FeatureSwitchesDoNotChangeTheImage) {
     all.force_ggx = true;
     all.force_shadows = true;
     all.force_oriented = true;
+    all.force_textures = true;
     for (const char* method : {"brute", "lightcuts"}) {
         RenderOptions o = options(method, 24, 24);
         RenderResult off = gpu(p, o), on = gpu(p, o, all);

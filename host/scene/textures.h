@@ -1,0 +1,28 @@
+// Textures the materials sample (shaders/shared/textures.h): decoded once to
+// RGBA8 and appended to Scene::texels, one TextureInfo each.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "lightcuts/scene.h"
+
+namespace lc::loader {
+
+// Appends a width x height RGBA8 image (row 0 at the top, 4 bytes a texel)
+// and returns its index into scene.textures. Throws InputError naming
+// `file` and `field` when the image is empty or the scene's texels would
+// pass kMaxTexels.
+std::uint32_t add_texture(Scene& scene, std::uint32_t width, std::uint32_t height, const std::uint8_t* rgba,
+                          const std::string& file, const std::string& field);
+
+// Loads a PNG or JPEG (stb_image; grey, grey-alpha and RGB get alpha 1) and
+// adds it. Throws InputError naming `image` when it is missing or cannot
+// be decoded; `field` is the scene key that named it.
+std::uint32_t load_texture(Scene& scene, const std::filesystem::path& image, const std::string& field);
+
+// All textures of a scene together hold at most this many texels (512 MiB).
+inline constexpr std::uint64_t kMaxTexels = std::uint64_t(1) << 27;
+
+}  // namespace lc::loader
