@@ -5,6 +5,7 @@
 
 #include <glm/glm.hpp>
 
+#include "cpu_kernel.h"
 #include "shared/color.h"
 
 namespace lc {
@@ -19,6 +20,10 @@ glm::vec3 emission(const gpu::Material& m) { return {m.emission_r, m.emission_g,
 
 bool emits(const gpu::Material& m) { return (m.flags & gpu::kMaterialEmissive) != 0u; }
 
+bool lc_has_emissive_texture(const gpu::Material& m) {
+    return (m.flags & gpu::kMaterialTextured) != 0u && m.emissive_texture != gpu::kInvalidIndex;
+}
+
 // Radical inverse in base 2 (van der Corput): with (k + jitter) / m in the
 // other coordinate, m points stratified over the unit square.
 float radical_inverse(std::uint32_t k) {
@@ -32,21 +37,22 @@ float radical_inverse(std::uint32_t k) {
 }
 
 // m stratified samples on one triangle, appended to `out`.
-void sample_triangle(const gpu::Triangle& t, const gpu::Material& m, std::uint32_t samples,
-                     std::uint32_t hash, std::vector<gpu::Light>& out) {
+void sample_triangle(const TriangleEmission& source, std::size_t index, const gpu::Triangle& t,
+                     const gpu::Material& m, std::uint32_t samples, std::uint32_t hash,
+                     std::vector<gpu::Light>& out) {
     const glm::vec3 a = vertex(t, 0), b = vertex(t, 1), c = vertex(t, 2);
     const glm::vec3 cross = glm::cross(b - a, c - a);
     const float area = 0.5f * glm::length(cross);
     const glm::vec3 normal = glm::normalize(cross);
-    const glm::vec3 intensity = emission(m) * (area / float(samples));
+    const bool textured = lc_has_emissive_texture(m);
+    const glm::vec3 constant = emission(m) * (area / float(samples));
     // A random shift of the whole pattern (Cranley-Patterson rotation).
     const float shift_u = gpu::lc_unit_float(hash), shift_v = gpu::lc_unit_float(gpu::lc_hash(hash));
     for (std::uint32_t k = 0; k < samples; ++k) {
-        const float u = std::fmod((float(k) + 0.5f) / float(samples) + shift_u, 1.0f);
-        const float v = std::fmod(radical_inverse(k) + shift_v, 1.0f);
-        // Area-preserving square-to-triangle map (Shirley and Chiu).
-        const float su = std::sqrt(u);
-        const glm::vec3 p = (1.0f - su) * a + su * (1.0f - v) * b + su * v * c;
+        const glm::vec2 bary = triangle_sample_barycentrics(k, samples, shift_u, shift_v);
+        const glm::vec3 p = (1.0f - bary.x - bary.y) * a + bary.x * b + bary.y * c;
+        const glm::vec3 intensity =
+            textured ? source.at(index, bary.x, bary.y) * (area / float(samples)) : constant;
         gpu::Light l{};
         l.x = p.x; l.y = p.y; l.z = p.z;
         l.r = intensity.x; l.g = intensity.y; l.b = intensity.z;
@@ -58,19 +64,65 @@ void sample_triangle(const gpu::Triangle& t, const gpu::Material& m, std::uint32
 
 }  // namespace
 
-std::vector<gpu::Light> sample_area_lights(std::span<const gpu::Triangle> triangles,
+glm::vec2 triangle_sample_barycentrics(std::uint32_t k, std::uint32_t m, float shift_u, float shift_v) {
+    const float u = std::fmod((float(k) + 0.5f) / float(m) + shift_u, 1.0f);
+    const float v = std::fmod(radical_inverse(k) + shift_v, 1.0f);
+    const float su = std::sqrt(u);
+    return {su * (1.0f - v), su * v};
+}
+
+TriangleEmission::TriangleEmission(std::span<const gpu::Triangle> triangles, std::span<const gpu::Material> materials,
+                                   std::span<const gpu::TriangleUvs> uvs, std::span<const gpu::TextureInfo> textures,
+                                   std::span<const std::uint32_t> texels)
+    : triangles_(triangles), materials_(materials), uvs_(uvs), textures_(textures), texels_(texels) {}
+
+glm::vec3 TriangleEmission::at(std::size_t i, float b1, float b2) const {
+    const gpu::Material& m = materials_[triangles_[i].material];
+    if (!emits(m)) return glm::vec3(0.0f);
+    if (!lc_has_emissive_texture(m) || uvs_.size() != triangles_.size()) return emission(m);
+    cpu::TextureKernel k;
+    k.materials = materials_.data();
+    k.uvs = uvs_.data();
+    k.textures = textures_.data();
+    k.texels = texels_.data();
+    const glm::vec2 uv = k.lc_triangle_uv(std::uint32_t(i), b1, b2);
+    return emission(m) * glm::vec3(k.lc_texture_sample(m.emissive_texture, uv, true));
+}
+
+glm::vec3 TriangleEmission::mean(std::size_t i) const {
+    const gpu::Material& m = materials_[triangles_[i].material];
+    if (!emits(m)) return glm::vec3(0.0f);
+    if (!lc_has_emissive_texture(m) || uvs_.size() != triangles_.size()) return emission(m);
+    glm::dvec3 sum(0.0);
+    for (std::uint32_t k = 0; k < kMeanPoints; ++k) {
+        const glm::vec2 b = triangle_sample_barycentrics(k, kMeanPoints, 0.0f, 0.5f / float(kMeanPoints));
+        sum += glm::dvec3(at(i, b.x, b.y));
+    }
+    return glm::vec3(sum / double(kMeanPoints));
+}
+
+double TriangleEmission::power(std::size_t i) const {
+    const gpu::Triangle& t = triangles_[i];
+    const gpu::Material& m = materials_[t.material];
+    if (!emits(m)) return 0.0;
+    const glm::dvec3 a(vertex(t, 0)), b(vertex(t, 1)), c(vertex(t, 2));
+    const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
+    const double sides = (m.flags & gpu::kMaterialEmitsBothSides) ? 2.0 : 1.0;
+    return 3.14159265358979323846 * area * sides * double(gpu::lc_luminance(mean(i)));
+}
+
+std::vector<gpu::Light> sample_area_lights(const Scene& scene, std::uint32_t count, std::uint32_t seed) {
+    return sample_area_lights(TriangleEmission(scene), scene.triangles, scene.materials, count, seed);
+}
+
+std::vector<gpu::Light> sample_area_lights(const TriangleEmission& emission, std::span<const gpu::Triangle> triangles,
                                            std::span<const gpu::Material> materials, std::uint32_t count,
                                            std::uint32_t seed) {
     // Power of each emitting triangle, in double: many small triangles add up.
     std::vector<double> power(triangles.size(), 0.0);
     double total = 0.0;
     for (std::size_t i = 0; i < triangles.size(); ++i) {
-        const gpu::Triangle& t = triangles[i];
-        const gpu::Material& m = materials[t.material];
-        if (!emits(m)) continue;
-        const double area = 0.5 * double(glm::length(glm::cross(vertex(t, 1) - vertex(t, 0), vertex(t, 2) - vertex(t, 0))));
-        const double sides = (m.flags & gpu::kMaterialEmitsBothSides) ? 2.0 : 1.0;
-        power[i] = double(gpu::lc_luminance(emission(m))) * area * sides;
+        power[i] = emission.power(i);
         total += power[i];
     }
     std::vector<gpu::Light> lights;
@@ -92,7 +144,7 @@ std::vector<gpu::Light> sample_area_lights(std::span<const gpu::Triangle> triang
         before = after;
         const auto samples = std::uint32_t(std::max(0.0, last - first));
         if (samples == 0) continue;
-        sample_triangle(triangles[i], materials[triangles[i].material], samples,
+        sample_triangle(emission, i, triangles[i], materials[triangles[i].material], samples,
                         gpu::lc_hash(seed ^ gpu::lc_hash(std::uint32_t(i))), lights);
     }
     return lights;

@@ -7,20 +7,61 @@
 #include <span>
 #include <vector>
 
+#include <glm/glm.hpp>
+
+#include "lightcuts/scene.h"
 #include "shared/types.h"
 
 namespace lc {
 
+// What emissive triangles emit, their materials' emissive textures applied
+// (shaders/shared/textures.h): at a point, and on average over a triangle.
+// Without uvs/textures (empty spans) emission is each material's constant.
+class TriangleEmission {
+public:
+    TriangleEmission(std::span<const gpu::Triangle> triangles, std::span<const gpu::Material> materials,
+                     std::span<const gpu::TriangleUvs> uvs = {}, std::span<const gpu::TextureInfo> textures = {},
+                     std::span<const std::uint32_t> texels = {});
+    explicit TriangleEmission(const Scene& scene)
+        : TriangleEmission(scene.triangles, scene.materials, scene.uvs, scene.textures, scene.texels) {}
+
+    // Radiance triangle i emits at barycentrics (b1, b2) on its emitting
+    // side(s); black when its material does not emit.
+    glm::vec3 at(std::size_t i, float b1, float b2) const;
+    // The mean of `at` over the triangle: exact without an emissive texture;
+    // with one, the mean over kMeanPoints stratified points.
+    glm::vec3 mean(std::size_t i) const;
+    // Emitted power pi A lum(mean) per emitting side (0: does not emit).
+    double power(std::size_t i) const;
+
+    static constexpr std::uint32_t kMeanPoints = 256;
+
+private:
+    std::span<const gpu::Triangle> triangles_;
+    std::span<const gpu::Material> materials_;
+    std::span<const gpu::TriangleUvs> uvs_;
+    std::span<const gpu::TextureInfo> textures_;
+    std::span<const std::uint32_t> texels_;
+};
+
+// Point (b1, b2) in barycentrics of sample k of m on a triangle, for the
+// pattern's random shift (su, sv): the area-preserving square-to-triangle
+// map (Shirley and Chiu) of a stratified point set.
+glm::vec2 triangle_sample_barycentrics(std::uint32_t k, std::uint32_t m, float shift_u, float shift_v);
+
 // `count` samples over every triangle whose material emits, distributed in
-// proportion to power (emitted luminance x area, twice for two-sided
-// emitters) by systematic sampling along the triangles, and stratified over
-// each triangle. A sample carries I = Le * A / m along its triangle's
-// geometric normal (counter-clockwise winding, right-handed), m being the
-// samples its triangle got, so the samples' total power is the emitters'.
-// Deterministic for a seed; as count grows the lighting converges to the
-// exact area-light integral. Empty when nothing emits or count is 0.
-std::vector<gpu::Light> sample_area_lights(std::span<const gpu::Triangle> triangles,
+// proportion to power (TriangleEmission::power: mean emitted luminance x
+// area, twice for two-sided emitters) by systematic sampling along the
+// triangles, and stratified over each triangle. A sample carries
+// I = Le(x) * A / m along its triangle's geometric normal (counter-clockwise
+// winding, right-handed), Le(x) the radiance at its point (the emissive
+// texture's there) and m the samples its triangle got, so the samples'
+// total power is the emitters'. Deterministic for a seed; as count grows the
+// lighting converges to the exact area-light integral. Empty when nothing
+// emits or count is 0.
+std::vector<gpu::Light> sample_area_lights(const TriangleEmission& emission, std::span<const gpu::Triangle> triangles,
                                            std::span<const gpu::Material> materials, std::uint32_t count,
                                            std::uint32_t seed);
+std::vector<gpu::Light> sample_area_lights(const Scene& scene, std::uint32_t count, std::uint32_t seed);
 
 }  // namespace lc

@@ -30,6 +30,26 @@ struct TraceKernel {
 #undef LC_TRIANGLE
 };
 
+// Texture lookups and materials at a point only (shared/textures.h): what
+// the host needs to sample textured emitters.
+struct TextureKernel {
+    const Material* materials = nullptr;
+    const TriangleUvs* uvs = nullptr;
+    const TextureInfo* textures = nullptr;
+    const uint* texels = nullptr;
+    static constexpr bool kEnableTextures = true;
+
+#define LC_MATERIAL(i) materials[i]
+#define LC_UVS(i) uvs[i]
+#define LC_TEXTURE(i) textures[i]
+#define LC_TEXEL(i) texels[i]
+#include "shared/textures.h"
+#undef LC_MATERIAL
+#undef LC_UVS
+#undef LC_TEXTURE
+#undef LC_TEXEL
+};
+
 // A shadow ray as the kernels cast it (origin, unit direction, length).
 struct ShadowRayRecord {
     vec3 org;

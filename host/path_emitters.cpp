@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "area_lights.h"
+
 namespace lc::path {
 namespace {
 
@@ -20,21 +22,6 @@ void texel_of(glm::vec3 d, std::uint32_t width, std::uint32_t height, std::uint3
     const float v = std::acos(std::clamp(d.y, -1.0f, 1.0f)) * (1.0f / kPiF);
     column = std::min(std::uint32_t(std::max(u, 0.0f) * float(width)), width - 1u);
     row = std::min(std::uint32_t(std::max(v, 0.0f) * float(height)), height - 1u);
-}
-
-glm::vec3 vertex(const gpu::Triangle& t, int i) {
-    return i == 0 ? glm::vec3(t.v0_x, t.v0_y, t.v0_z)
-                  : i == 1 ? glm::vec3(t.v1_x, t.v1_y, t.v1_z) : glm::vec3(t.v2_x, t.v2_y, t.v2_z);
-}
-
-// Power of an emissive triangle, pi A lum(Le) per emitting side; 0 if it
-// does not emit.
-double triangle_power(const gpu::Triangle& t, const gpu::Material& m) {
-    if ((m.flags & gpu::kMaterialEmissive) == 0u) return 0.0;
-    const glm::dvec3 a(vertex(t, 0)), b(vertex(t, 1)), c(vertex(t, 2));
-    const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
-    const double sides = (m.flags & gpu::kMaterialEmitsBothSides) != 0u ? 2.0 : 1.0;
-    return sides * kPi * area * luminance(m.emission_r, m.emission_g, m.emission_b);
 }
 
 }  // namespace
@@ -141,9 +128,9 @@ EmitterTable::EmitterTable(const Scene& scene) : environment_(scene.environment)
         emitters_.push_back({EmitterKind::kLight, i});
         weights.push_back(w);
     }
+    const TriangleEmission emission(scene);
     for (std::uint32_t i = 0; i < scene.triangles.size(); ++i) {
-        const gpu::Triangle& t = scene.triangles[i];
-        const double w = triangle_power(t, scene.materials[t.material]);
+        const double w = emission.power(i);
         if (!(w > 0.0)) continue;
         emitters_.push_back({EmitterKind::kTriangle, i});
         weights.push_back(w);

@@ -47,14 +47,14 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
     PreparedScene prepared;
     prepared.has_occluders = !all_coplanar(scene.triangles);
     // A scene without texture coordinates gets zeros: every kernel reads them.
-    if (scene.uvs.size() != scene.triangles.size()) scene.uvs.assign(scene.triangles.size(), gpu::TriangleUvs{});
+    if (scene.uvs.empty()) scene.uvs.assign(scene.triangles.size(), gpu::TriangleUvs{});
     prepared.bvh = build_bvh(scene.triangles, scene.normals, &scene.uvs);
     // Walter 2005 §5: area lights and the environment become many point and
     // directional lights, in the one tree with the scene's own.
     const auto start = std::chrono::steady_clock::now();
     std::vector<gpu::Light> lights = scene.lights;
     const std::vector<gpu::Light> area =
-        sample_area_lights(scene.triangles, scene.materials, scene.render.area_light_samples, seed);
+        sample_area_lights(scene, scene.render.area_light_samples, seed);
     const std::vector<gpu::Light> sky = environment_lights(scene.environment, scene.environment.directions);
     lights.insert(lights.end(), area.begin(), area.end());
     lights.insert(lights.end(), sky.begin(), sky.end());

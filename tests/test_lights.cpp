@@ -213,7 +213,7 @@ TEST(AreaLight, SquareEmitterMatchesTheClosedForm) {
         return gpu::Triangle{p.x, p.y, p.z, q.x, q.y, q.z, r.x, r.y, r.z, 0u, 0u, 0u};
     };
     const std::vector<gpu::Triangle> triangles = {tri(a, b, c), tri(a, c, d)};
-    const std::vector<gpu::Light> lights = sample_area_lights(triangles, materials, 65536, 1);
+    const std::vector<gpu::Light> lights = sample_area_lights(TriangleEmission(triangles, materials), triangles, materials, 65536, 1);
     ASSERT_EQ(lights.size(), 65536u);
     ASSERT_LT(lights[0].axis_y, -0.99f);
     const std::vector<glm::dvec3> square = {glm::dvec3(a), glm::dvec3(b), glm::dvec3(c), glm::dvec3(d)};

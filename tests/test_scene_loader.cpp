@@ -25,38 +25,10 @@ namespace lc {
 namespace {
 
 namespace fs = std::filesystem;
+using test::TempDir;
 
 const fs::path kFixtures = fs::path(LC_TEST_DATA_DIR) / "scenes";
 const fs::path kScenes = fs::path(LC_SOURCE_DIR) / "scenes";
-
-// A fresh directory under the system temp dir, removed with everything in it.
-class TempDir {
-public:
-    TempDir() {
-        static std::atomic<unsigned> counter{0};
-        std::random_device entropy;
-        path_ = fs::temp_directory_path() /
-                ("lc_scene_test_" + std::to_string(entropy()) + "_" + std::to_string(counter++));
-        fs::create_directories(path_);
-    }
-    ~TempDir() {
-        std::error_code ignored;
-        fs::remove_all(path_, ignored);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-
-    fs::path write(const std::string& name, const std::string& text) const {
-        const fs::path file = path_ / name;
-        std::ofstream(file, std::ios::binary) << text;
-        return file;
-    }
-
-    const fs::path& path() const { return path_; }
-
-private:
-    fs::path path_;
-};
 
 // Runs `load` and returns the InputError message; fails the test if nothing
 // (or something else) was thrown.
@@ -602,7 +574,9 @@ TEST(SceneLoader, IndirectAndPathSettings) {
         const std::string message = input_error_of([&] { load_scene(file); });
         const std::string start = file.lexically_normal().string() + ": " + b.field + ": ";
         EXPECT_EQ(message.rfind(start, 0), 0u) << message;
-        if (!b.problem.empty()) EXPECT_EQ(message, start + b.problem);
+        if (!b.problem.empty()) {
+            EXPECT_EQ(message, start + b.problem);
+        }
     }
 }
 

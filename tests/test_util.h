@@ -1,8 +1,12 @@
 // Small scene builders and helpers shared by the tests.
 #pragma once
 
+#include <atomic>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -12,10 +16,45 @@
 
 namespace lc::test {
 
+// A fresh directory under the system temp dir, removed with everything in it.
+class TempDir {
+public:
+    TempDir() {
+        static std::atomic<unsigned> counter{0};
+        std::random_device entropy;
+        path_ = std::filesystem::temp_directory_path() /
+                ("lc_scene_test_" + std::to_string(entropy()) + "_" + std::to_string(counter++));
+        std::filesystem::create_directories(path_);
+    }
+    ~TempDir() {
+        std::error_code ignored;
+        std::filesystem::remove_all(path_, ignored);
+    }
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+
+    std::filesystem::path write(const std::string& name, const std::string& text) const {
+        const std::filesystem::path file = path_ / name;
+        std::ofstream(file, std::ios::binary) << text;
+        return file;
+    }
+
+    const std::filesystem::path& path() const { return path_; }
+
+private:
+    std::filesystem::path path_;
+};
+
+// Materials as the loader makes them (host/scene/materials.cpp), without
+// its clamp of alpha: roughness = sqrt(alpha), no textures.
 inline gpu::Material lambert(glm::vec3 kd) {
     gpu::Material m{};
     m.kd_r = kd.x; m.kd_g = kd.y; m.kd_b = kd.z;
     m.alpha = 1.0f;
+    m.roughness = 1.0f;
+    m.specular = 0.5f;
+    m.normal_scale = 1.0f;
+    m.base_color_texture = m.metallic_roughness_texture = m.emissive_texture = m.normal_texture = gpu::kInvalidIndex;
     return m;
 }
 
@@ -23,6 +62,7 @@ inline gpu::Material glossy(glm::vec3 kd, glm::vec3 ks, float alpha) {
     gpu::Material m = lambert(kd);
     m.ks_r = ks.x; m.ks_g = ks.y; m.ks_b = ks.z;
     m.alpha = alpha;
+    m.roughness = std::sqrt(alpha);
     m.flags = gpu::kMaterialHasSpecular;
     return m;
 }

@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cmath>
+#include <map>
 #include <string>
 
 #include <tiny_obj_loader.h>
@@ -10,6 +11,7 @@
 #include "input_file.h"
 #include "lightcuts/error.h"
 #include "materials.h"
+#include "textures.h"
 
 namespace lc::loader {
 namespace {
@@ -65,7 +67,7 @@ class FaceConverter {
 public:
     FaceConverter(const tinyobj::ObjReader& reader, const MeshTransform& transform,
                   const std::optional<gpu::Material>& override_material, MeshTarget& target,
-                  const std::string& obj_name)
+                  const std::filesystem::path& file, const std::string& obj_name)
         : attrib_(reader.GetAttrib()), transform_(transform), target_(target), obj_name_(obj_name),
           override_(override_material.has_value()),
           mtl_count_(override_ ? 0 : reader.GetMaterials().size()),
@@ -74,8 +76,11 @@ public:
             target_.scene.materials.push_back(*override_material);
             return;
         }
+        std::map<std::string, std::uint32_t> loaded;  // texture file -> index
         for (const tinyobj::material_t& m : reader.GetMaterials()) {
-            target_.scene.materials.push_back(convert_mtl(m, obj_name_));
+            gpu::Material material = convert_mtl(m, obj_name_);
+            add_textures(material, m, file.parent_path(), loaded);
+            target_.scene.materials.push_back(material);
         }
     }
 
@@ -108,10 +113,33 @@ private:
     std::size_t mtl_count_;
     std::uint32_t material_base_;
 
+    // The MTL's texture maps (docs/scene-format.md): map_Kd scales the
+    // albedo (base colour), map_Ke the emission (black or absent Ke counts
+    // as 1 where there is a map_Ke), norm is a tangent-space normal map.
+    // Paths are relative to the OBJ's folder; each file is loaded once.
+    void add_textures(gpu::Material& m, const tinyobj::material_t& mtl, const std::filesystem::path& folder,
+                      std::map<std::string, std::uint32_t>& loaded) {
+        const auto texture = [&](const std::string& name, const char* key, std::uint32_t gpu::Material::*slot) {
+            if (name.empty()) return;
+            const auto [at, added] = loaded.try_emplace(name, 0u);
+            if (added)
+                at->second = load_texture(target_.scene, folder / name, obj_name_,
+                                          "material '" + mtl.name + "'." + key);
+            set_texture(m, slot, at->second);
+        };
+        texture(mtl.diffuse_texname, "map_Kd", &gpu::Material::base_color_texture);
+        texture(mtl.normal_texname, "norm", &gpu::Material::normal_texture);
+        if (!mtl.emissive_texname.empty()) {
+            if ((m.flags & gpu::kMaterialEmissive) == 0u) set_emission(m, glm::vec3(1.0f), false);
+            texture(mtl.emissive_texname, "map_Ke", &gpu::Material::emissive_texture);
+        }
+    }
+
     // tinyobj only warns about out-of-range indices and keeps them.
     void check_indices(const Corners& idx, std::size_t f, const tinyobj::shape_t& shape) const {
         const std::size_t vertex_count = attrib_.vertices.size() / 3;
         const std::size_t normal_count = attrib_.normals.size() / 3;
+        const std::size_t texcoord_count = attrib_.texcoords.size() / 2;
         for (const tinyobj::index_t& i : idx) {
             if (i.vertex_index < 0 || static_cast<std::size_t>(i.vertex_index) >= vertex_count) {
                 throw InputError(obj_name_, face_name(f, shape),
@@ -123,7 +151,32 @@ private:
                                  "normal index " + std::to_string(i.normal_index + 1) + " out of range (" +
                                      std::to_string(normal_count) + " normals)");
             }
+            if (i.texcoord_index >= 0 && static_cast<std::size_t>(i.texcoord_index) >= texcoord_count) {
+                throw InputError(obj_name_, face_name(f, shape),
+                                 "texture coordinate index " + std::to_string(i.texcoord_index + 1) +
+                                     " out of range (" + std::to_string(texcoord_count) + " vt)");
+            }
         }
+    }
+
+    // The corners' texture coordinates, v turned to grow downwards (OBJ's
+    // v grows upwards, the renderer's as in glTF); zeros where a corner has
+    // none.
+    gpu::TriangleUvs texcoords(const Corners& idx, std::size_t f, const tinyobj::shape_t& shape) const {
+        float uv[6] = {};
+        for (std::size_t c = 0; c < 3; ++c) {
+            if (idx[c].texcoord_index < 0) continue;
+            const auto k = static_cast<std::size_t>(idx[c].texcoord_index) * 2;
+            const float u = static_cast<float>(attrib_.texcoords[k]);
+            const float v = static_cast<float>(attrib_.texcoords[k + 1]);
+            if (!std::isfinite(u) || !std::isfinite(v) || std::abs(u) > 1e6f || std::abs(v) > 1e6f)
+                throw InputError(obj_name_, face_name(f, shape),
+                                 "texture coordinate " + std::to_string(idx[c].texcoord_index + 1) +
+                                     " must be finite and within 1e6");
+            uv[2 * c] = u;
+            uv[2 * c + 1] = 1.0f - v;
+        }
+        return gpu::TriangleUvs{uv[0], uv[1], uv[2], uv[3], uv[4], uv[5]};
     }
 
     glm::vec3 position(int index) const {
@@ -193,6 +246,7 @@ private:
                                                         v[2].x, v[2].y, v[2].z, material, 0u, 0u});
         target_.scene.normals.push_back(gpu::TriangleNormals{n[0].x, n[0].y, n[0].z, n[1].x, n[1].y, n[1].z,
                                                              n[2].x, n[2].y, n[2].z, 0u, 0u, 0u});
+        target_.scene.uvs.push_back(texcoords(idx, f, shape));
         return true;
     }
 };
@@ -205,7 +259,7 @@ void load_obj(const std::filesystem::path& file, const MeshTransform& transform,
     tinyobj::ObjReader reader;
     read_obj(file, obj_name, !override_material, reader);
 
-    FaceConverter faces(reader, transform, override_material, target, obj_name);
+    FaceConverter faces(reader, transform, override_material, target, file, obj_name);
     std::size_t kept = 0;
     for (const tinyobj::shape_t& shape : reader.GetShapes()) kept += faces.add_shape(shape);
     if (kept == 0) throw InputError(obj_name, "", "no usable triangles (after dropping degenerate ones)");

@@ -1,7 +1,9 @@
 // PNG and JPEG textures through Debian's libstb (no *_IMPLEMENTATION macro here).
 #include "textures.h"
 
+#include <filesystem>
 #include <memory>
+#include <system_error>
 
 #include <stb_image.h>
 
@@ -31,8 +33,17 @@ std::uint32_t add_texture(Scene& scene, std::uint32_t width, std::uint32_t heigh
     return std::uint32_t(scene.textures.size() - 1);
 }
 
-std::uint32_t load_texture(Scene& scene, const std::filesystem::path& image, const std::string& field) {
-    const std::string bytes = read_input_file(image);  // names the file when missing
+std::uint32_t load_texture(Scene& scene, const std::filesystem::path& image, const std::string& referrer,
+                           const std::string& field) {
+    const std::string name = "texture '" + display(image) + "'";
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(image, ec)) throw InputError(referrer, field, name + " not found");
+    std::string bytes;
+    try {
+        bytes = read_input_file(image);
+    } catch (const InputError&) {
+        throw InputError(referrer, field, name + " cannot be read");
+    }
     int w = 0, h = 0, channels = 0;
     std::unique_ptr<stbi_uc, void (*)(void*)> pixels(
         stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()), int(bytes.size()), &w, &h, &channels,
@@ -40,11 +51,10 @@ std::uint32_t load_texture(Scene& scene, const std::filesystem::path& image, con
         stbi_image_free);
     if (!pixels) {
         const char* why = stbi_failure_reason();
-        throw InputError(display(image), field,
-                         std::string("cannot decode image (PNG or JPEG expected)") + (why ? ": " : "") +
-                             (why ? why : ""));
+        throw InputError(referrer, field,
+                         name + " cannot be decoded as PNG or JPEG" + (why ? std::string(" (") + why + ")" : ""));
     }
-    return add_texture(scene, std::uint32_t(w), std::uint32_t(h), pixels.get(), display(image), field);
+    return add_texture(scene, std::uint32_t(w), std::uint32_t(h), pixels.get(), referrer, field);
 }
 
 }  // namespace lc::loader

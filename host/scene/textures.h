@@ -18,9 +18,11 @@ std::uint32_t add_texture(Scene& scene, std::uint32_t width, std::uint32_t heigh
                           const std::string& file, const std::string& field);
 
 // Loads a PNG or JPEG (stb_image; grey, grey-alpha and RGB get alpha 1) and
-// adds it. Throws InputError naming `image` when it is missing or cannot
-// be decoded; `field` is the scene key that named it.
-std::uint32_t load_texture(Scene& scene, const std::filesystem::path& image, const std::string& field);
+// adds it. When it is missing or cannot be decoded, throws InputError
+// "REFERRER: FIELD: texture 'IMAGE' ...": the file and key that named it,
+// and the image.
+std::uint32_t load_texture(Scene& scene, const std::filesystem::path& image, const std::string& referrer,
+                           const std::string& field);
 
 // All textures of a scene together hold at most this many texels (512 MiB).
 inline constexpr std::uint64_t kMaxTexels = std::uint64_t(1) << 27;

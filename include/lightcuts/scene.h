@@ -61,7 +61,7 @@ struct Scene {
     Camera camera;
     std::vector<gpu::Triangle> triangles;        // material index inside
     std::vector<gpu::TriangleNormals> normals;   // parallel to triangles
-    std::vector<gpu::TriangleUvs> uvs;           // parallel to triangles (zeros without UVs)
+    std::vector<gpu::TriangleUvs> uvs;           // parallel to triangles (zeros without UVs), or empty
     std::vector<gpu::Material> materials;
     std::vector<gpu::TextureInfo> textures;      // Material.*_texture index these
     std::vector<std::uint32_t> texels;           // RGBA8 texels of all textures (TextureInfo.offset)

@@ -1,0 +1,338 @@
+// Textures (shaders/shared/textures.h, host/scene/textures.h): lookups
+// against hand-made textures with known texels (texel centres, bilinear
+// weights, wrapping, sRGB decoding), the material at a point, normal maps,
+// MTL texture maps and their errors, textured area lights, and a textured
+// plane rendered against its closed form.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <stb_image_write.h>
+
+#include "area_lights.h"
+#include "cpu_kernel.h"
+#include "lightcuts/error.h"
+#include "lightcuts/render.h"
+#include "lightcuts/scene.h"
+#include "scene/materials.h"
+#include "scene/textures.h"
+#include "test_util.h"
+
+namespace lc {
+namespace {
+
+using test::TempDir;
+
+std::vector<std::uint8_t> rgba_bytes(const std::vector<std::uint32_t>& texels) {
+    std::vector<std::uint8_t> bytes;
+    for (std::uint32_t t : texels)
+        for (int c = 0; c < 4; ++c) bytes.push_back(std::uint8_t(t >> (8 * c)));
+    return bytes;
+}
+
+std::uint32_t rgba(std::uint32_t r, std::uint32_t g, std::uint32_t b, std::uint32_t a = 255) {
+    return r | g << 8 | b << 16 | a << 24;
+}
+
+// A scene holding textures and materials, and the kernel that reads them.
+struct TextureScene {
+    Scene scene;
+    cpu::TextureKernel k;
+
+    std::uint32_t add(std::uint32_t w, std::uint32_t h, const std::vector<std::uint32_t>& texels) {
+        return loader::add_texture(scene, w, h, rgba_bytes(texels).data(), "test", "texture");
+    }
+    cpu::TextureKernel& kernel() {
+        k.materials = scene.materials.data();
+        k.uvs = scene.uvs.data();
+        k.textures = scene.textures.data();
+        k.texels = scene.texels.data();
+        return k;
+    }
+};
+
+double srgb_to_linear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
+
+// 2 x 2 texels, row 0 on top: A B / C D.
+const std::vector<std::uint32_t> kTwoByTwo = {rgba(10, 20, 30, 40), rgba(50, 60, 70, 80), rgba(90, 100, 110, 120),
+                                              rgba(130, 140, 150, 160)};
+
+glm::vec4 unpack(std::uint32_t t) {
+    return glm::vec4(float(t & 255u), float(t >> 8 & 255u), float(t >> 16 & 255u), float(t >> 24)) / 255.0f;
+}
+
+void expect_vec4_near(glm::vec4 got, glm::vec4 want, float tol, const std::string& what) {
+    for (int c = 0; c < 4; ++c) EXPECT_NEAR(got[c], want[c], tol) << what << " channel " << c;
+}
+
+TEST(TextureLookup, TexelCentresGiveTheTexels) {
+    TextureScene t;
+    const std::uint32_t tex = t.add(2, 2, kTwoByTwo);
+    auto& k = t.kernel();
+    for (int y = 0; y < 2; ++y)
+        for (int x = 0; x < 2; ++x) {
+            const glm::vec2 uv((float(x) + 0.5f) / 2.0f, (float(y) + 0.5f) / 2.0f);
+            expect_vec4_near(k.lc_texture_sample(tex, uv, false), unpack(kTwoByTwo[std::size_t(2 * y + x)]), 1e-6f,
+                             "texel " + std::to_string(x) + "," + std::to_string(y));
+        }
+}
+
+TEST(TextureLookup, BilinearWeightsBetweenCentres) {
+    TextureScene t;
+    const std::uint32_t tex = t.add(2, 2, kTwoByTwo);
+    auto& k = t.kernel();
+    const glm::vec4 a = unpack(kTwoByTwo[0]), b = unpack(kTwoByTwo[1]), c = unpack(kTwoByTwo[2]),
+                    d = unpack(kTwoByTwo[3]);
+    // Halfway between A and B on row 0; the centre of all four; a quarter
+    // of the way from A towards D in both directions.
+    expect_vec4_near(k.lc_texture_sample(tex, {0.5f, 0.25f}, false), 0.5f * (a + b), 1e-6f, "A-B");
+    expect_vec4_near(k.lc_texture_sample(tex, {0.5f, 0.5f}, false), 0.25f * (a + b + c + d), 1e-6f, "centre");
+    const glm::vec4 quarter = 0.75f * (0.75f * a + 0.25f * b) + 0.25f * (0.75f * c + 0.25f * d);
+    expect_vec4_near(k.lc_texture_sample(tex, {0.375f, 0.375f}, false), quarter, 1e-6f, "quarter");
+}
+
+TEST(TextureLookup, WrapsInBothDirections) {
+    TextureScene t;
+    const std::uint32_t tex = t.add(2, 2, kTwoByTwo);
+    auto& k = t.kernel();
+    const glm::vec4 a = unpack(kTwoByTwo[0]), b = unpack(kTwoByTwo[1]), c = unpack(kTwoByTwo[2]);
+    // u = 0 lies between the last column's centre and the first's.
+    expect_vec4_near(k.lc_texture_sample(tex, {0.0f, 0.25f}, false), 0.5f * (a + b), 1e-6f, "u edge");
+    expect_vec4_near(k.lc_texture_sample(tex, {0.25f, 0.0f}, false), 0.5f * (a + c), 1e-6f, "v edge");
+    for (glm::vec2 shift : {glm::vec2(3.0f, -2.0f), glm::vec2(-1.0f, 5.0f), glm::vec2(-7.0f, -7.0f)})
+        for (glm::vec2 uv : {glm::vec2(0.25f, 0.75f), glm::vec2(0.6f, 0.1f), glm::vec2(0.9f, 0.95f)})
+            expect_vec4_near(k.lc_texture_sample(tex, uv + shift, false), k.lc_texture_sample(tex, uv, false), 2e-5f,
+                             "shifted by " + std::to_string(shift.x) + "," + std::to_string(shift.y));
+}
+
+TEST(TextureLookup, SrgbDecodedPerTexelBeforeFiltering) {
+    TextureScene t;
+    const std::uint32_t tex = t.add(2, 1, {rgba(188, 10, 255, 128), rgba(0, 0, 0, 0)});
+    auto& k = t.kernel();
+    const glm::vec4 c = k.lc_texture_sample(tex, {0.25f, 0.5f}, true);
+    EXPECT_NEAR(c.x, srgb_to_linear(188.0 / 255.0), 1e-6);  // 0.5029
+    EXPECT_NEAR(c.y, 10.0 / 255.0 / 12.92, 1e-7);            // the linear segment
+    EXPECT_NEAR(c.z, 1.0, 1e-6);
+    EXPECT_NEAR(c.w, 128.0 / 255.0, 1e-7);                   // alpha is linear
+    // Halfway between 255 and 0: the mean of the decoded values (0.5),
+    // not the decoding of the mean (0.21).
+    EXPECT_NEAR(k.lc_texture_sample(tex, {0.5f, 0.5f}, true).z, 0.5, 1e-6);
+    EXPECT_NEAR(k.lc_texture_sample(tex, {0.25f, 0.5f}, false).x, 188.0 / 255.0, 1e-6);
+}
+
+TEST(TextureLookup, MaterialAtAppliesEveryTexture) {
+    TextureScene t;
+    const std::uint32_t colour = t.add(1, 1, {rgba(188, 255, 0)});
+    const std::uint32_t mr = t.add(1, 1, {rgba(0, 128, 64)});
+    const std::uint32_t glow = t.add(1, 1, {rgba(255, 188, 0)});
+    loader::DisneyParams d;
+    d.base_color = {0.5f, 0.8f, 1.0f};
+    d.roughness = 0.6f;
+    d.metallic = 0.9f;
+    gpu::Material m = loader::make_disney_material(d);
+    loader::set_emission(m, {2.0f, 4.0f, 8.0f}, false);
+    loader::set_texture(m, &gpu::Material::base_color_texture, colour);
+    loader::set_texture(m, &gpu::Material::metallic_roughness_texture, mr);
+    loader::set_texture(m, &gpu::Material::emissive_texture, glow);
+    t.scene.materials = {m};
+    const gpu::Material at = t.kernel().lc_material_at(0, {0.3f, 0.7f});
+    const double c188 = srgb_to_linear(188.0 / 255.0);
+    EXPECT_NEAR(at.kd_r, 0.5 * c188, 1e-6);
+    EXPECT_NEAR(at.kd_g, 0.8, 1e-6);
+    EXPECT_EQ(at.kd_b, 0.0f);
+    EXPECT_NEAR(at.roughness, 0.6 * 128.0 / 255.0, 1e-6);  // green
+    EXPECT_NEAR(at.metallic, 0.9 * 64.0 / 255.0, 1e-6);    // blue
+    EXPECT_NEAR(at.alpha, at.roughness * at.roughness, 1e-7);
+    EXPECT_NEAR(at.emission_r, 2.0, 1e-6);
+    EXPECT_NEAR(at.emission_g, 4.0 * c188, 1e-5);
+    EXPECT_EQ(at.emission_b, 0.0f);
+    // A black roughness texel cannot take alpha below the floor.
+    t.scene.texels[t.scene.textures[mr].offset] = rgba(0, 0, 0);
+    EXPECT_EQ(t.kernel().lc_material_at(0, {0.3f, 0.7f}).alpha, 1e-3f);
+}
+
+// A triangle in the z = 0 plane facing +z, u along +x and v along -y (v
+// grows downwards in the image, so the image's "up" is +y).
+struct NormalMapCase {
+    TextureScene t;
+    glm::vec3 v0{0, 0, 0}, v1{1, 0, 0}, v2{0, 1, 0};
+    gpu::TriangleUvs uvs{0.0f, 1.0f, 1.0f, 1.0f, 0.0f, 0.0f};
+
+    glm::vec3 bent(std::uint32_t texel, float scale = 1.0f) {
+        t.scene.textures.clear();
+        t.scene.texels.clear();
+        const std::uint32_t tex = t.add(1, 1, {texel});
+        gpu::Material m = loader::make_material(glm::vec3(0.5f), glm::vec3(0.0f), 1.0f);
+        loader::set_texture(m, &gpu::Material::normal_texture, tex);
+        m.normal_scale = scale;
+        t.scene.materials = {m};
+        return t.kernel().lc_normal_mapped(m, {0.3f, 0.4f}, {0, 0, 1}, v0, v1, v2, uvs);
+    }
+};
+
+TEST(NormalMap, TangentSpaceFollowsUAndImageUp) {
+    NormalMapCase c;
+    const glm::vec3 flat = c.bent(rgba(128, 128, 255));
+    EXPECT_NEAR(flat.z, 1.0f, 1e-4f);
+    const glm::vec3 right = c.bent(rgba(255, 128, 128));  // +x in tangent space: +u
+    EXPECT_GT(right.x, 0.99f);
+    const glm::vec3 up = c.bent(rgba(128, 255, 128));     // +y: image up, -v, here +y
+    EXPECT_GT(up.y, 0.99f);
+    const glm::vec3 tilted = c.bent(rgba(218, 128, 218));  // 45 degrees towards +u
+    EXPECT_NEAR(tilted.x, tilted.z, 1e-2f);
+    EXPECT_NEAR(glm::length(tilted), 1.0f, 1e-5f);
+    // normal_scale scales the tangent part.
+    const glm::vec3 scaled = c.bent(rgba(218, 128, 218), 0.0f);
+    EXPECT_NEAR(scaled.z, 1.0f, 1e-5f);
+    // Mirrored UVs (u running along -x) turn the tangent round.
+    c.uvs = {1.0f, 1.0f, 0.0f, 1.0f, 1.0f, 0.0f};
+    EXPECT_LT(c.bent(rgba(255, 128, 128)).x, -0.99f);
+    // Degenerate UVs keep the interpolated normal.
+    c.uvs = {0.5f, 0.5f, 0.5f, 0.5f, 0.5f, 0.5f};
+    EXPECT_EQ(c.bent(rgba(255, 128, 128)), glm::vec3(0, 0, 1));
+}
+
+void write_png(const std::filesystem::path& file, int w, int h, const std::vector<std::uint32_t>& texels) {
+    const std::vector<std::uint8_t> bytes = rgba_bytes(texels);
+    ASSERT_NE(stbi_write_png(file.string().c_str(), w, h, 4, bytes.data(), w * 4), 0);
+}
+
+const char* kTexturedObj =
+    "mtllib quad.mtl\n"
+    "v -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n"
+    "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+    "usemtl paint\n"
+    "f 1/1 4/4 3/3\nf 1/1 3/3 2/2\n";
+
+std::string quad_scene_json() {
+    return R"({"camera": {"position": [0, 3, 0.01], "look_at": [0, 0, 0], "fov_y_degrees": 60, "width": 8, "height": 8},
+               "meshes": [{"obj": "quad.obj"}],
+               "lights": [{"type": "point", "position": [0, 2, 0], "intensity": [1, 1, 1]}]})";
+}
+
+TEST(ObjTextures, MapKdLoadsAndVtTurnsToGrowDownwards) {
+    TempDir dir;
+    write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
+    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd paint.png\n");
+    dir.write("quad.obj", kTexturedObj);
+    const Scene s = load_scene(dir.write("scene.json", quad_scene_json()));
+    ASSERT_EQ(s.textures.size(), 1u);
+    EXPECT_EQ(s.textures[0].width, 2u);
+    EXPECT_EQ(s.textures[0].height, 1u);
+    ASSERT_EQ(s.texels.size(), 2u);
+    EXPECT_EQ(s.texels[1], rgba(0, 0, 255));
+    ASSERT_EQ(s.uvs.size(), s.triangles.size());
+    // Corner 1 has vt (0, 0): v = 1 after the turn; corner 4 has (0, 1): v = 0.
+    EXPECT_EQ(s.uvs[0].u0, 0.0f);
+    EXPECT_EQ(s.uvs[0].v0, 1.0f);
+    EXPECT_EQ(s.uvs[0].v1, 0.0f);
+    const gpu::Material& m = s.materials[s.triangles[0].material];
+    EXPECT_NE(m.flags & gpu::kMaterialTextured, 0u);
+    EXPECT_EQ(m.base_color_texture, 0u);
+    EXPECT_EQ(m.normal_texture, gpu::kInvalidIndex);
+}
+
+TEST(ObjTextures, MissingOrBrokenTextureNamesTheFiles) {
+    TempDir dir;
+    dir.write("quad.obj", kTexturedObj);
+    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd nowhere.png\n");
+    const std::filesystem::path scene = dir.write("scene.json", quad_scene_json());
+    const std::string obj = (dir.path() / "quad.obj").lexically_normal().string();
+    try {
+        load_scene(scene);
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        EXPECT_EQ(std::string(e.what()), obj + ": material 'paint'.map_Kd: texture '" +
+                                             (dir.path() / "nowhere.png").lexically_normal().string() + "' not found");
+    }
+    dir.write("garbage.png", "this is not an image");
+    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nnorm garbage.png\n");
+    try {
+        load_scene(scene);
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        const std::string message = e.what();
+        EXPECT_EQ(message.rfind(obj + ": material 'paint'.norm: texture '", 0), 0u) << message;
+        EXPECT_NE(message.find("garbage.png' cannot be decoded as PNG or JPEG"), std::string::npos) << message;
+    }
+}
+
+// Two triangles share an emissive material whose texture is white on its
+// left half and black on its right; one triangle maps into each half. The
+// samples all go to the white one, and carry its power.
+TEST(TexturedAreaLights, SamplesFollowTheEmissiveTexture) {
+    TextureScene t;
+    const std::uint32_t tex = t.add(4, 1, {rgba(255, 255, 255), rgba(255, 255, 255), rgba(0, 0, 0), rgba(0, 0, 0)});
+    gpu::Material m = loader::make_material(glm::vec3(0.0f), glm::vec3(0.0f), 1.0f);
+    loader::set_emission(m, {2.0f, 2.0f, 2.0f}, false);
+    loader::set_texture(m, &gpu::Material::emissive_texture, tex);
+    t.scene.materials = {m};
+    test::add_triangle(t.scene, {0, 1, 0}, {1, 1, 0}, {0, 1, 1}, 0);  // area 0.5
+    test::add_triangle(t.scene, {2, 1, 0}, {3, 1, 0}, {2, 1, 1}, 0);
+    // Texel centres of the white half are u = 0.125 and 0.375: a triangle
+    // between them sees white only.
+    t.scene.uvs = {{0.13f, 0.5f, 0.37f, 0.5f, 0.13f, 0.6f}, {0.63f, 0.5f, 0.87f, 0.5f, 0.63f, 0.6f}};
+    const TriangleEmission emission(t.scene);
+    EXPECT_NEAR(emission.mean(0).x, 2.0f, 1e-5f);
+    EXPECT_EQ(emission.mean(1).x, 0.0f);
+    EXPECT_GT(emission.power(0), 0.0);
+    EXPECT_EQ(emission.power(1), 0.0);
+    const std::vector<gpu::Light> lights = sample_area_lights(t.scene, 1000, 7);
+    ASSERT_EQ(lights.size(), 1000u);
+    double total = 0.0;
+    for (const gpu::Light& l : lights) {
+        EXPECT_LT(l.x, 1.5f);
+        total += l.r;
+    }
+    EXPECT_NEAR(total, 2.0 * 0.5, 1e-4);  // Le * area
+}
+
+// A plane seen from straight above, lit by a directional light along -y,
+// with a base-colour texture of 2 x 2 blocks (white, black / black, white)
+// of 4 x 4 texels each: away from the block edges bilinear filtering sees
+// one colour, so the radiance is exactly albedo * E / pi or zero.
+TEST(TexturedRender, PlaneShowsItsTextureOnBothHalves) {
+    Scene s;
+    std::vector<std::uint32_t> texels(64);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) texels[std::size_t(8 * y + x)] = (x < 4) == (y < 4) ? rgba(255, 255, 255) : rgba(0, 0, 0);
+    const std::uint32_t tex = loader::add_texture(s, 8, 8, rgba_bytes(texels).data(), "test", "texture");
+    gpu::Material m = loader::make_material(glm::vec3(0.5f), glm::vec3(0.0f), 1.0f);
+    loader::set_texture(m, &gpu::Material::base_color_texture, tex);
+    s.materials = {m};
+    // x in [-1, 1] is u in [0, 1]; z in [-1, 1] is v in [0, 1].
+    test::add_quad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0);
+    s.uvs = {{0, 0, 0, 1, 1, 1}, {0, 0, 1, 1, 1, 0}};
+    s.lights = {test::directional_light({0, -1, 0}, glm::vec3(3.0f))};
+    // tan(fov / 2) = 1 / 4: the image spans x and z in [-1, 1].
+    s.camera = test::camera({0, 4, 0}, {0, 0, 0}, float(2.0 * std::atan(0.25) * 180.0 / 3.14159265358979), 16, 16);
+    s.camera.up = {0, 0, -1};
+    update_bounds(s);
+    PreparedScene p = prepare_scene(std::move(s), 1);
+    ASSERT_TRUE(p.has_textures);
+    const RenderResult r = render_cpu(p, test::options("brute", 16));
+    const float lit = 0.5f * 3.0f / 3.14159265f;
+    int white = 0, black = 0;
+    for (std::uint32_t y = 0; y < 16; ++y)
+        for (std::uint32_t x = 0; x < 16; ++x) {
+            // Which block this pixel's hit lies in, from the image: the
+            // camera looks down -y with +x to the right and -z up.
+            const float px = (float(x) + 0.5f) / 8.0f - 1.0f, pz = (float(y) + 0.5f) / 8.0f - 1.0f;
+            // Within half a texel (0.125) of a block edge the filter blends,
+            // also across the wrap at the plane's border.
+            const float inner = std::min(std::abs(px), std::abs(pz)), outer = std::max(std::abs(px), std::abs(pz));
+            if (inner < 0.2f || outer > 0.8f) continue;
+            const float value = r.image.at(x, y).x;
+            const bool expect_white = (px < 0.0f) == (pz < 0.0f);
+            EXPECT_NEAR(value, expect_white ? lit : 0.0f, 1e-5f * lit) << x << "," << y;
+            (expect_white ? white : black) += 1;
+        }
+    EXPECT_GT(white, 10);
+    EXPECT_GT(black, 10);
+}
+
+}  // namespace
+}  // namespace lc
