@@ -343,11 +343,12 @@ def main():
         write(name + ".gltf", doc)
     with open(os.path.join(HERE, "bad_json.gltf"), "w", encoding="ascii") as f:
         f.write('{"asset": {"version": "2.0"}, "nodes": [\n')
-    # A JSON scene with the room's glTF placed by a transform, next to its own lights.
+    # A JSON scene with an OBJ and two glTF files (one placed by a transform), next to its own lights.
     with open(os.path.join(HERE, "with_json.json"), "w", encoding="ascii") as f:
         f.write(json.dumps({
             "camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0], "width": 16, "height": 16},
-            "meshes": [{"gltf": "hierarchy.gltf", "transform": {"translate": [0, 0, -1]}},
+            "meshes": [{"obj": "../scenes/tri.obj"},
+                       {"gltf": "hierarchy.gltf", "transform": {"translate": [0, 0, -1]}},
                        {"gltf": "triangle.glb"}],
             "lights": [{"type": "point", "position": [0, 1, 1], "intensity": [1, 1, 1]}]}, indent=1) + "\n")
     return 0
