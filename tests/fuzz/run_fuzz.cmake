@@ -1,6 +1,6 @@
 # Configures tests/fuzz as its own project with clang, builds one fuzz
 # target, and runs it for SECONDS seconds. Fails on any finding; the input
-# that caused it is left in BUILD_DIR/artifacts/TARGET/.
+# that caused it is left in BUILD_DIR/runs/TARGET/artifacts/.
 #   cmake -DSOURCE_DIR=tests/fuzz -DBUILD_DIR=<dir> -DCXX=clang++ -DSECONDS=60 \
 #         [-DTARGET=lc_fuzz_scene_loader -DDICT=scene.dict -DCORPUS=corpus -DREGRESSIONS=regressions] \
 #         -P run_fuzz.cmake
@@ -33,7 +33,7 @@ endif()
 # and regressions in the source tree are only read. A fixed seed makes a CI
 # run repeat the same mutations (up to how many fit in the time); fuzz
 # longer with another seed by hand (docs/testing.md).
-set(work ${BUILD_DIR}/${TARGET})
+set(work ${BUILD_DIR}/runs/${TARGET})
 file(MAKE_DIRECTORY ${work}/corpus ${work}/artifacts)
 execute_process(
   COMMAND ${BUILD_DIR}/${TARGET}
