@@ -52,137 +52,154 @@ std::uint32_t GltfMaterials::material(int index, const std::string& field) {
     return scene_index;
 }
 
-gpu::Material GltfMaterials::convert(int index) {
-    const tinygltf::Material& g = model_.materials[std::size_t(index)];
-    const std::string name = "materials[" + std::to_string(index) + "]";
-    const std::string& file = notes_.file();
-    const auto in_range = [&](double v, double hi, const std::string& field) {
+namespace {
+
+// Checks of a material's numbers against their glTF ranges, with errors
+// naming the file and the glTF path.
+class FactorReader {
+public:
+    explicit FactorReader(const std::string& file) : file_(file) {}
+
+    float in_range(double v, double hi, const std::string& field) const {
         if (!(v >= 0.0 && v <= hi))
-            throw InputError(file, field, "must be from 0 to " + std::string(hi == 1.0 ? "1" : "FLT_MAX") + ", got " +
-                                              std::to_string(v));
+            throw InputError(file_, field, "must be from 0 to " + std::string(hi == 1.0 ? "1" : "FLT_MAX") +
+                                               ", got " + std::to_string(v));
         return float(v);
-    };
-    const auto colour = [&](const std::vector<double>& v, std::size_t size, const std::string& field) {
-        if (v.size() != size)
-            throw InputError(file, field, "must have " + std::to_string(size) + " components");
+    }
+
+    // The first three of `size` numbers, each in [0, 1].
+    glm::vec3 colour(const std::vector<double>& v, std::size_t size, const std::string& field) const {
+        if (v.size() != size) throw InputError(file_, field, "must have " + std::to_string(size) + " components");
         glm::vec3 c;
-        for (int i = 0; i < 3; ++i)
-            c[i] = in_range(v[std::size_t(i)], 1.0, field + "[" + std::to_string(i) + "]");
+        for (int i = 0; i < 3; ++i) c[i] = in_range(v[std::size_t(i)], 1.0, field + "[" + std::to_string(i) + "]");
         return c;
-    };
-    // A number in an extension object: `fallback` when absent.
-    const auto ext_number = [&](const tinygltf::Value& ext, const char* key, double fallback, double hi,
-                                const std::string& field) {
+    }
+
+    // A number of an extension object in [0, hi]; `fallback` when absent.
+    float number(const tinygltf::Value& ext, const char* key, double fallback, double hi,
+                 const std::string& field) const {
         if (!ext.IsObject() || !ext.Has(key)) return float(fallback);
         const tinygltf::Value& v = ext.Get(key);
-        if (!v.IsNumber()) throw InputError(file, field + "." + key, "must be a number");
+        if (!v.IsNumber()) throw InputError(file_, field + "." + key, "must be a number");
         return in_range(v.GetNumberAsDouble(), hi, field + "." + key);
-    };
-    const auto ext_colour = [&](const tinygltf::Value& ext, const char* key, const std::string& field) {
-        glm::vec3 c(0.0f);
-        if (!ext.IsObject() || !ext.Has(key)) return c;
+    }
+
+    // A colour of an extension object; black when absent.
+    glm::vec3 colour(const tinygltf::Value& ext, const char* key, const std::string& field) const {
+        if (!ext.IsObject() || !ext.Has(key)) return glm::vec3(0.0f);
         const tinygltf::Value& v = ext.Get(key);
-        if (!v.IsArray() || v.ArrayLen() != 3) throw InputError(file, field + "." + key, "must have 3 components");
+        if (!v.IsArray() || v.ArrayLen() != 3) throw InputError(file_, field + "." + key, "must have 3 components");
         std::vector<double> values;
         for (int i = 0; i < 3; ++i) {
-            if (!v.Get(i).IsNumber()) throw InputError(file, field + "." + key, "must hold numbers");
+            if (!v.Get(i).IsNumber()) throw InputError(file_, field + "." + key, "must hold numbers");
             values.push_back(v.Get(i).GetNumberAsDouble());
         }
         return colour(values, 3, field + "." + key);
-    };
-    const auto ext_has_texture = [](const tinygltf::Value& ext, std::initializer_list<const char*> keys) {
-        for (const char* key : keys)
-            if (ext.IsObject() && ext.Has(key)) return true;
-        return false;
-    };
-    const tinygltf::Value none;
-    const auto extension = [&](const char* key) -> const tinygltf::Value& {
-        const auto it = g.extensions.find(key);
-        return it == g.extensions.end() ? none : it->second;
-    };
+    }
 
+private:
+    const std::string& file_;
+};
+
+const tinygltf::Value& extension(const tinygltf::Material& g, const char* key) {
+    static const tinygltf::Value none;
+    const auto it = g.extensions.find(key);
+    return it == g.extensions.end() ? none : it->second;
+}
+
+bool has_any(const tinygltf::Value& ext, std::initializer_list<const char*> keys) {
+    for (const char* key : keys)
+        if (ext.IsObject() && ext.Has(key)) return true;
+    return false;
+}
+
+bool transformed(const tinygltf::ExtensionMap& ext) { return ext.find("KHR_texture_transform") != ext.end(); }
+
+// Disney's sheen colour is mix(white, tint, sheen_tint), the tint being the
+// base colour's hue. With both colours scaled to a largest component of 1,
+// sheen_tint is the least-squares t that brings mix(white, tint, t) nearest
+// the glTF sheen colour: 0 for a grey sheen, 1 for one of the base's hue.
+float sheen_tint(glm::vec3 sheen_colour, float sheen, glm::vec3 base) {
+    const float base_max = std::max({base.r, base.g, base.b});
+    const glm::vec3 tint = base_max > 0.0f ? base / base_max : glm::vec3(1.0f);
+    const glm::vec3 towards = tint - 1.0f;
+    const float length2 = glm::dot(towards, towards);
+    if (!(length2 > 1e-12f)) return 0.0f;
+    return std::clamp(glm::dot(sheen_colour / sheen - 1.0f, towards) / length2, 0.0f, 1.0f);
+}
+
+}  // namespace
+
+DisneyParams GltfMaterials::params(const tinygltf::Material& g, const std::string& name) {
+    const FactorReader read(notes_.file());
     const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
     const std::string pbr_name = name + ".pbrMetallicRoughness";
     DisneyParams p;
-    p.base_color = colour(pbr.baseColorFactor, 4, pbr_name + ".baseColorFactor");
-    p.metallic = in_range(pbr.metallicFactor, 1.0, pbr_name + ".metallicFactor");
-    p.roughness = in_range(pbr.roughnessFactor, 1.0, pbr_name + ".roughnessFactor");
+    p.base_color = read.colour(pbr.baseColorFactor, 4, pbr_name + ".baseColorFactor");
+    p.metallic = read.in_range(pbr.metallicFactor, 1.0, pbr_name + ".metallicFactor");
+    p.roughness = read.in_range(pbr.roughnessFactor, 1.0, pbr_name + ".roughnessFactor");
     p.specular = 0.5f;  // glTF's dielectric F0 of 0.04 is Disney's specular 0.5
     p.sheen_tint = 0.0f;
 
     const std::string clearcoat_name = name + ".extensions.KHR_materials_clearcoat";
-    const tinygltf::Value& clearcoat = extension("KHR_materials_clearcoat");
-    p.clearcoat = ext_number(clearcoat, "clearcoatFactor", 0.0, 1.0, clearcoat_name);
-    p.clearcoat_gloss = 1.0f - ext_number(clearcoat, "clearcoatRoughnessFactor", 0.0, 1.0, clearcoat_name);
-    if (ext_has_texture(clearcoat, {"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"}))
+    const tinygltf::Value& clearcoat = extension(g, "KHR_materials_clearcoat");
+    p.clearcoat = read.number(clearcoat, "clearcoatFactor", 0.0, 1.0, clearcoat_name);
+    p.clearcoat_gloss = 1.0f - read.number(clearcoat, "clearcoatRoughnessFactor", 0.0, 1.0, clearcoat_name);
+    if (has_any(clearcoat, {"clearcoatTexture", "clearcoatRoughnessTexture", "clearcoatNormalTexture"}))
         notes_.add(clearcoat_name, "clearcoat textures are not read; the factors apply everywhere");
 
     const std::string sheen_name = name + ".extensions.KHR_materials_sheen";
-    const tinygltf::Value& sheen = extension("KHR_materials_sheen");
-    const glm::vec3 sheen_colour = ext_colour(sheen, "sheenColorFactor", sheen_name);
-    ext_number(sheen, "sheenRoughnessFactor", 0.0, 1.0, sheen_name);  // checked; Disney's sheen has no roughness
+    const tinygltf::Value& sheen = extension(g, "KHR_materials_sheen");
+    const glm::vec3 sheen_colour = read.colour(sheen, "sheenColorFactor", sheen_name);
     p.sheen = std::max({sheen_colour.r, sheen_colour.g, sheen_colour.b});
-    if (p.sheen > 0.0f) {
-        // Disney's sheen colour is mix(white, tint, sheen_tint), the tint
-        // being the base colour's hue. Both colours scaled to a largest
-        // component of 1; sheen_tint is the least-squares t that brings
-        // mix(white, tint, t) nearest the glTF sheen colour.
-        const float base_max = std::max({p.base_color.r, p.base_color.g, p.base_color.b});
-        const glm::vec3 tint = base_max > 0.0f ? p.base_color / base_max : glm::vec3(1.0f);
-        const glm::vec3 towards = tint - 1.0f;
-        const float length2 = glm::dot(towards, towards);
-        p.sheen_tint = length2 > 1e-12f ? std::clamp(glm::dot(sheen_colour / p.sheen - 1.0f, towards) / length2, 0.0f, 1.0f)
-                                       : 0.0f;
-    }
-    if (ext_has_texture(sheen, {"sheenColorTexture", "sheenRoughnessTexture"}))
-        notes_.add(sheen_name, "sheen textures are not read; the factors apply everywhere");
-    if (sheen.IsObject() && ext_number(sheen, "sheenRoughnessFactor", 0.0, 1.0, sheen_name) > 0.0f)
+    if (p.sheen > 0.0f) p.sheen_tint = sheen_tint(sheen_colour, p.sheen, p.base_color);
+    if (read.number(sheen, "sheenRoughnessFactor", 0.0, 1.0, sheen_name) > 0.0f)
         notes_.add(sheen_name + ".sheenRoughnessFactor", "not used (Disney's sheen has no roughness)");
+    if (has_any(sheen, {"sheenColorTexture", "sheenRoughnessTexture"}))
+        notes_.add(sheen_name, "sheen textures are not read; the factors apply everywhere");
+    return p;
+}
 
-    gpu::Material m = make_disney_material(p);
-
-    const auto transformed = [](const tinygltf::ExtensionMap& ext) {
-        return ext.find("KHR_texture_transform") != ext.end();
+void GltfMaterials::add_textures(gpu::Material& m, const tinygltf::Material& g, const std::string& name) {
+    const tinygltf::PbrMetallicRoughness& pbr = g.pbrMetallicRoughness;
+    const std::string pbr_name = name + ".pbrMetallicRoughness";
+    const auto slot = [&](std::uint32_t gpu::Material::*field, const auto& info, const std::string& path) {
+        if (info.index < 0) return;
+        const std::uint32_t t = texture(info.index, info.texCoord, transformed(info.extensions), path);
+        if (t != gpu::kInvalidIndex) set_texture(m, field, t);
     };
-    if (pbr.baseColorTexture.index >= 0)
-        set_texture(m, &gpu::Material::base_color_texture,
-                    texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
-                            transformed(pbr.baseColorTexture.extensions), pbr_name + ".baseColorTexture"));
-    if (pbr.metallicRoughnessTexture.index >= 0)
-        set_texture(m, &gpu::Material::metallic_roughness_texture,
-                    texture(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
-                            transformed(pbr.metallicRoughnessTexture.extensions),
-                            pbr_name + ".metallicRoughnessTexture"));
+    slot(&gpu::Material::base_color_texture, pbr.baseColorTexture, pbr_name + ".baseColorTexture");
+    slot(&gpu::Material::metallic_roughness_texture, pbr.metallicRoughnessTexture,
+         pbr_name + ".metallicRoughnessTexture");
+    slot(&gpu::Material::normal_texture, g.normalTexture, name + ".normalTexture");
     if (g.normalTexture.index >= 0) {
-        set_texture(m, &gpu::Material::normal_texture,
-                    texture(g.normalTexture.index, g.normalTexture.texCoord, transformed(g.normalTexture.extensions),
-                            name + ".normalTexture"));
         if (!std::isfinite(g.normalTexture.scale) || std::abs(g.normalTexture.scale) > 1e6)
-            throw InputError(file, name + ".normalTexture.scale", "must be a finite number");
+            throw InputError(notes_.file(), name + ".normalTexture.scale", "must be a finite number");
         m.normal_scale = float(g.normalTexture.scale);
     }
+    // A texture only scales the factor: with black emission it cannot emit.
+    if ((m.flags & gpu::kMaterialEmissive) != 0u)
+        slot(&gpu::Material::emissive_texture, g.emissiveTexture, name + ".emissiveTexture");
+}
+
+gpu::Material GltfMaterials::convert(int index) {
+    const tinygltf::Material& g = model_.materials[std::size_t(index)];
+    const std::string name = "materials[" + std::to_string(index) + "]";
+    gpu::Material m = make_disney_material(params(g, name));
 
     // Emission: emissiveFactor x KHR_materials_emissive_strength (W/(sr m^2)).
-    const glm::vec3 emissive = colour(g.emissiveFactor.empty() ? std::vector<double>{0, 0, 0} : g.emissiveFactor, 3,
-                                      name + ".emissiveFactor");
-    const float strength = ext_number(extension("KHR_materials_emissive_strength"), "emissiveStrength", 1.0,
-                                      double(std::numeric_limits<float>::max()),
-                                      name + ".extensions.KHR_materials_emissive_strength");
+    const FactorReader read(notes_.file());
+    const glm::vec3 emissive = read.colour(g.emissiveFactor.empty() ? std::vector<double>{0, 0, 0} : g.emissiveFactor,
+                                           3, name + ".emissiveFactor");
+    const std::string strength_name = name + ".extensions.KHR_materials_emissive_strength";
+    const float strength = read.number(extension(g, "KHR_materials_emissive_strength"), "emissiveStrength", 1.0,
+                                       double(std::numeric_limits<float>::max()), strength_name);
     const glm::dvec3 radiance = glm::dvec3(emissive) * double(strength);
     for (int i = 0; i < 3; ++i)
         if (radiance[i] > double(std::numeric_limits<float>::max()))
-            throw InputError(file, name + ".extensions.KHR_materials_emissive_strength",
-                             "emissiveFactor x emissiveStrength overflows a float");
+            throw InputError(notes_.file(), strength_name, "emissiveFactor x emissiveStrength overflows a float");
     set_emission(m, glm::vec3(radiance), g.doubleSided);
-    // A texture only scales the factor: with black emission it cannot emit.
-    if (g.emissiveTexture.index >= 0 && (m.flags & gpu::kMaterialEmissive) != 0u)
-        set_texture(m, &gpu::Material::emissive_texture,
-                    texture(g.emissiveTexture.index, g.emissiveTexture.texCoord,
-                            transformed(g.emissiveTexture.extensions), name + ".emissiveTexture"));
-    // set_texture marks the material textured even for a left-out texture.
-    if (m.base_color_texture == gpu::kInvalidIndex && m.metallic_roughness_texture == gpu::kInvalidIndex &&
-        m.normal_texture == gpu::kInvalidIndex && m.emissive_texture == gpu::kInvalidIndex)
-        m.flags &= ~gpu::kMaterialTextured;
+    add_textures(m, g, name);
 
     if (g.alphaMode != "OPAQUE") notes_.add(name + ".alphaMode", g.alphaMode + " is drawn as OPAQUE");
     if (g.occlusionTexture.index >= 0)

@@ -10,8 +10,11 @@
 
 #include "lightcuts/scene.h"
 
+#include "materials.h"
+
 namespace tinygltf {
 class Model;
+struct Material;
 }
 
 namespace lc::loader {
@@ -48,6 +51,8 @@ private:
     std::map<int, std::uint32_t> images_;     // glTF image -> scene texture, so a shared image is added once
 
     gpu::Material convert(int index);
+    DisneyParams params(const tinygltf::Material& g, const std::string& name);
+    void add_textures(gpu::Material& m, const tinygltf::Material& g, const std::string& name);
     // The scene texture for a material's texture reference, or
     // kInvalidIndex where it is left out (with a note).
     std::uint32_t texture(int texture, int tex_coord, bool transformed, const std::string& field);
