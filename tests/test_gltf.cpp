@@ -91,6 +91,7 @@ TEST(Gltf, OneTriangleGetsItsFaceNormalTheDefaultMaterialAndADefaultFraming) {
     expect_near(s.camera.look_at, {0.5f, 0.5f, 0.0f}, 1e-6f, "look_at");
     EXPECT_EQ(s.camera.fov_y_degrees, 40.0f);
     EXPECT_TRUE(has_note(s, "no perspective camera"));
+    EXPECT_EQ(s.render.method, "lightcuts");
 }
 
 TEST(Gltf, BinaryGlbLoadsTheSameSceneAsItsGltf) {
@@ -274,6 +275,11 @@ TEST(Gltf, SceneJsonListsGltfMeshesWithTransformsBesideObjAndItsOwnLights) {
     expect_near(position(s.lights[1]), {0.2f, 0.2f, 1.0f}, 1e-7f, "triangle.glb light");
     expect_near(position(s.lights[2]), {0, 1, 1}, 0.0f, "JSON light");
     EXPECT_EQ(s.camera.width, 16u);  // the JSON's camera
+}
+
+TEST(Gltf, SceneJsonGltfEntryTakesNoMaterialOverride) {
+    const std::string e = error_of("bad_json_gltf_material.json");
+    EXPECT_NE(e.find("bad_json_gltf_material.json: meshes[0].material: unknown key"), std::string::npos) << e;
 }
 
 TEST(Gltf, CameraOptionIsRefusedForAJsonScene) {

@@ -43,7 +43,7 @@ GltfContents load_gltf(const std::filesystem::path& file, const MeshTransform& t
 
 // A whole scene from one glTF file: its lights, the perspective camera named
 // `camera` (empty: the first in node order; none: a default framing of the
-// bounds) and the default render settings.
+// bounds) and the default render settings, but method lightcuts.
 Scene load_gltf_scene(const std::filesystem::path& file, const std::string& camera);
 
 // Image size of a glTF camera: 256 rows, aspectRatio x 256 columns.

@@ -30,6 +30,10 @@ Scene load_gltf_scene(const std::filesystem::path& file, const std::string& came
     const std::string name = display(file);
     Scene scene;
     scene.file = file;
+    // A glTF file has no render settings. Lightcuts, not the JSON default
+    // brute force, which sums every light, the 65536 area-light samples of
+    // any emissive surface included, at every pixel.
+    scene.render.method = "lightcuts";
     MeshTarget target{scene, {}, {}};
     const GltfContents contents = load_gltf(file, MeshTransform{}, target);
 

@@ -351,6 +351,10 @@ def main():
                        {"gltf": "hierarchy.gltf", "transform": {"translate": [0, 0, -1]}},
                        {"gltf": "triangle.glb"}],
             "lights": [{"type": "point", "position": [0, 1, 1], "intensity": [1, 1, 1]}]}, indent=1) + "\n")
+    with open(os.path.join(HERE, "bad_json_gltf_material.json"), "w", encoding="ascii") as f:
+        f.write(json.dumps({
+            "camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+            "meshes": [{"gltf": "triangle.gltf", "material": {"kd": [1, 0, 0]}}]}, indent=1) + "\n")
     return 0
 
 
