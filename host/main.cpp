@@ -3,6 +3,7 @@
 //   lightcuts render SCENE -o OUT.exr [options]   render to EXR (+ PNG preview)
 //   lightcuts compare IMAGE REFERENCE [--heatmap]  error metrics between two EXRs
 //   lightcuts info SCENE                           what a scene holds
+// SCENE is a scene JSON or a glTF 2.0 file (.gltf, .glb).
 #include <charconv>
 #include <chrono>
 #include <cstdio>
@@ -24,6 +25,7 @@ namespace {
 
 struct RenderArgs {
     std::string scene, method, light_pick;
+    lc::SceneOptions scene_options;
     lc::RenderOutputs outputs;
     lc::DeviceChoice device;
     std::optional<std::uint32_t> spp, width, height, max_cut, seed, area_samples, light_samples, max_bounces;
@@ -76,13 +78,19 @@ lc::RenderOptions render_options(const RenderArgs& a, const lc::Scene& scene) {
     return o;
 }
 
+// What the loader dropped or left out, on stderr before anything else.
+void print_load_notes(const std::string& file, const lc::Scene& scene) {
+    if (scene.degenerate_triangles_dropped)
+        std::fprintf(stderr, "warning: %s: dropped %zu degenerate triangles\n", file.c_str(),
+                     scene.degenerate_triangles_dropped);
+    for (const std::string& line : scene.load_notes) std::fprintf(stderr, "note: %s\n", line.c_str());
+}
+
 int run_render(RenderArgs a) {
     const auto start = std::chrono::steady_clock::now();
-    lc::Scene scene = lc::load_scene(a.scene);
+    lc::Scene scene = lc::load_scene(a.scene, a.scene_options);
     const double load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (scene.degenerate_triangles_dropped)
-        std::fprintf(stderr, "warning: %s: dropped %zu degenerate triangles\n", a.scene.c_str(),
-                     scene.degenerate_triangles_dropped);
+    print_load_notes(a.scene, scene);
     const lc::RenderOptions options = render_options(a, scene);
     if (a.area_samples) scene.render.area_light_samples = *a.area_samples;
     if (a.vpls) scene.render.indirect.vpls = *a.vpls;
@@ -134,12 +142,14 @@ int run_compare(const std::string& image, const std::string& reference, const st
     return 0;
 }
 
-int run_info(const std::string& file) {
-    lc::Scene scene = lc::load_scene(file);
+int run_info(const std::string& file, const lc::SceneOptions& options) {
+    lc::Scene scene = lc::load_scene(file, options);
+    print_load_notes(file, scene);
     std::printf("%s\n", file.c_str());
     std::printf("  triangles          %zu (%zu degenerate dropped)\n", scene.triangles.size(),
                 scene.degenerate_triangles_dropped);
     std::printf("  materials          %zu\n", scene.materials.size());
+    std::printf("  textures           %zu (%zu texels)\n", scene.textures.size(), scene.texels.size());
     std::printf("  point lights       %zu\n", scene.count_lights(lc::gpu::kLightPoint));
     std::printf("  directional lights %zu\n", scene.count_lights(lc::gpu::kLightDirectional));
     std::printf("  spot lights        %zu\n", scene.count_lights(lc::gpu::kLightSpot));
@@ -159,7 +169,10 @@ int run_info(const std::string& file) {
 
 CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
     auto* render = app.add_subcommand("render", "Render a scene to a linear OpenEXR image and a PNG preview");
-    render->add_option("scene", r.scene, "Scene file (JSON)")->required();
+    render->add_option("scene", r.scene, "Scene file (JSON, or glTF 2.0: .gltf or .glb)")->required();
+    render->add_option("--camera", r.scene_options.camera,
+                       "glTF scenes: the perspective camera of this name (default: the first in node order; "
+                       "none in the file: a default framing of the scene)");
     render->add_option("-o,--output", r.outputs.image, "Output .exr (a tone-mapped .png is written beside it)")
         ->required();
     render->add_option("--method", r.method,
@@ -232,14 +245,16 @@ int main(int argc, char** argv) {
     compare->add_flag("--json", cmp_json, "Print the metrics as JSON");
 
     std::string info_scene;
+    lc::SceneOptions info_options;
     auto* info = app.add_subcommand("info", "Print what a scene holds and the memory it needs");
-    info->add_option("scene", info_scene, "Scene file (JSON)")->required();
+    info->add_option("scene", info_scene, "Scene file (JSON, or glTF 2.0: .gltf or .glb)")->required();
+    info->add_option("--camera", info_options.camera, "glTF scenes: the perspective camera of this name");
 
     CLI11_PARSE(app, argc, argv);
     try {
         if (*render) return run_render(r);
         if (*compare) return run_compare(cmp_image, cmp_ref, cmp_heatmap, cmp_json);
-        if (*info) return run_info(info_scene);
+        if (*info) return run_info(info_scene, info_options);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "error: %s\n", e.what());
         return 1;

@@ -54,6 +54,28 @@ expect_error "must end in .exr" render "$root/scenes/room/room.json" -o "$tmp/c.
 expect_error "nope.exr" compare "$tmp/a.exr" "$tmp/nope.exr"
 [ -e "$tmp/c.exr" ] && fail "a failed render left c.exr behind"
 
+# glTF: rendered directly (its camera, or the one --camera names), read by
+# info, its notes on stderr, and bad files refused naming the glTF path.
+gltf="$root/tests/data/gltf"
+"$exe" render "$root/scenes/gltf/textured.gltf" -o "$tmp/g.exr" --width 16 --height 12 --device cpu \
+  --method lightcuts --area-samples 256 --no-png >"$tmp/g.txt" 2>&1 || fail "glTF render: $(cat "$tmp/g.txt")"
+[ -s "$tmp/g.exr" ] || fail "glTF render wrote no image"
+"$exe" render "$gltf/triangle.glb" -o "$tmp/glb.exr" --width 4 --height 4 --device cpu --no-png \
+  >/dev/null 2>"$tmp/glb.txt" || fail "glb render: $(cat "$tmp/glb.txt")"
+grep -q "^note: .*triangle.glb: no perspective camera" "$tmp/glb.txt" || fail "glb render said: $(cat "$tmp/glb.txt")"
+"$exe" info "$root/scenes/gltf/textured.gltf" --camera top | grep -q "image              256x256" ||
+  fail "info --camera top"
+"$exe" info "$root/scenes/gltf/textured.gltf" | grep -q "image              341x256" || fail "info: first camera"
+"$exe" info "$gltf/modes.gltf" 2>&1 | grep -q "^note: .*primitives\[2\].mode: POINTS is not drawn" ||
+  fail "info: no note about the skipped points"
+expect_error "textured.gltf: --camera: no perspective camera named 'side'" \
+  render "$root/scenes/gltf/textured.gltf" -o "$tmp/c.exr" --camera side
+expect_error "--camera picks a camera of a glTF scene" render "$root/tests/data/scenes/minimal.json" -o "$tmp/c.exr" --camera top
+expect_error "bad_index_range.gltf: meshes[0].primitives[0].indices: index 7" render "$gltf/bad_index_range.gltf" -o "$tmp/c.exr"
+expect_error "bad_required_draco.gltf: extensionsRequired[0]" render "$gltf/bad_required_draco.gltf" -o "$tmp/c.exr"
+expect_error "bad_no_light.gltf: the scene has no light" render "$gltf/bad_no_light.gltf" -o "$tmp/c.exr"
+[ -e "$tmp/c.exr" ] && fail "a refused glTF render left c.exr behind"
+
 # Range edges: the command line takes the ranges of lightcuts/settings.h and
 # says what is wrong in the words the scene loader uses.
 mini="$root/tests/data/scenes/minimal.json"

@@ -18,6 +18,7 @@
 
 #include "csv_lights.h"
 #include "float_limits.h"
+#include "gltf_loader.h"
 #include "input_file.h"
 #include "json_reader.h"
 #include "light_records.h"
@@ -47,6 +48,10 @@ public:
         parse_camera(in_.require(root, "", "camera"));
         // Meshes before lights: the lights' extent is checked against the geometry.
         parse_meshes(in_.require(root, "", "meshes"));
+        // glTF meshes bring UVs; OBJ meshes after them have none.
+        if (!scene_.uvs.empty()) scene_.uvs.resize(scene_.triangles.size());
+        limits_ = LightLimits(meshes_.geometry);
+        add_gltf_lights();
         if (const json* l = JsonReader::find(root, "lights")) parse_lights(*l);
         if (const json* r = JsonReader::find(root, "render")) parse_render(*r);
         require_some_light();
@@ -61,6 +66,9 @@ private:
     Scene scene_;
     MeshTarget meshes_{scene_, {}, {}};
     LightLimits limits_;
+    // The lights of the glTF meshes, with the file each came from; they
+    // join the scene's lights before the "lights" list.
+    std::vector<std::pair<std::string, GltfLight>> gltf_lights_;
 
     fs::path resolve(const std::string& relative) const { return dir_ / relative; }
 
@@ -204,6 +212,10 @@ private:
 
     void parse_mesh(const json& j, const std::string& path) {
         in_.expect_object(j, path);
+        if (JsonReader::find(j, "gltf")) {
+            parse_gltf_mesh(j, path);
+            return;
+        }
         in_.check_keys(j, path, {"obj", "transform", "material"});
         const std::string obj_field = path + ".obj";
         const fs::path obj_path = resolve(in_.string(in_.require(j, path, "obj"), obj_field));
@@ -219,11 +231,30 @@ private:
         load_obj(obj_path, transform, override_material, meshes_);
     }
 
+    // {"gltf": "file.glb", "transform": {...}}: the glTF's meshes, materials
+    // and lights (its cameras are not used; the scene has its own).
+    void parse_gltf_mesh(const json& j, const std::string& path) {
+        in_.check_keys(j, path, {"gltf", "transform"});
+        const fs::path file = existing_file(j, path, "gltf");
+        MeshTransform transform;
+        if (const json* t = JsonReader::find(j, "transform")) transform = parse_transform(*t, path + ".transform");
+        GltfContents contents = load_gltf(file, transform, meshes_);
+        for (GltfLight& l : contents.lights) gltf_lights_.emplace_back(display(file), std::move(l));
+    }
+
+    void add_gltf_lights() {
+        for (const auto& [file, l] : gltf_lights_) {
+            const LightLimits::Problem p = limits_.add(l.light);
+            if (p.fault == LightLimits::Fault::total) in_.fail("lights", p.text);
+            if (p.fault == LightLimits::Fault::position) throw InputError(file, l.field, p.text);
+            scene_.lights.push_back(l.light);
+        }
+    }
+
     // -- lights -------------------------------------------------------------
 
     void parse_lights(const json& j) {
         in_.expect_array(j, "lights");
-        limits_ = LightLimits(meshes_.geometry);
         for (std::size_t i = 0; i < j.size(); ++i) parse_light(j[i], join_index("lights", i));
     }
 
@@ -355,6 +386,11 @@ private:
 }  // namespace
 }  // namespace loader
 
-Scene load_scene(const std::filesystem::path& file) { return loader::SceneParser(file).parse(); }
+Scene load_scene(const std::filesystem::path& file, const SceneOptions& options) {
+    if (loader::is_gltf_path(file)) return loader::load_gltf_scene(file, options.camera);
+    if (!options.camera.empty())
+        throw InputError(loader::display(file), "", "--camera picks a camera of a glTF scene; a JSON scene has its own");
+    return loader::SceneParser(file).parse();
+}
 
 }  // namespace lc

@@ -70,6 +70,9 @@ struct Scene {
     RenderSettings render;
     std::filesystem::path file;                  // the scene file it came from
     std::size_t degenerate_triangles_dropped = 0;
+    // What the loader read but left out or approximated (glTF features it
+    // does not support), one "FILE: FIELD: TEXT" line each; the CLI prints them.
+    std::vector<std::string> load_notes;
 
     // Bounds of the triangles only, not of the lights (a zero box at the
     // origin if there are none). They scale the inverse-square clamp, so a
@@ -80,12 +83,19 @@ struct Scene {
     std::size_t count_lights(std::uint32_t type) const;
 };
 
-// Loads a scene from JSON (docs/scene-format.md). Throws InputError naming
-// the file and the field on any problem; never returns a half-loaded scene.
-// Also refuses what would overflow the renderer's float sums: a per-type,
-// per-channel light intensity total above FLT_MAX, or a box around the
-// geometry and the point lights whose extent along an axis exceeds FLT_MAX.
-Scene load_scene(const std::filesystem::path& file);
+struct SceneOptions {
+    // glTF scenes: the perspective camera of this name (empty: the first in
+    // node order). A JSON scene has its own camera and refuses this.
+    std::string camera;
+};
+
+// Loads a scene from JSON, or from a glTF 2.0 file (.gltf or .glb) on its
+// own (docs/scene-format.md). Throws InputError naming the file and the
+// field on any problem; never returns a half-loaded scene. Also refuses what
+// would overflow the renderer's float sums: a per-type, per-channel light
+// intensity total above FLT_MAX, or a box around the geometry and the point
+// lights whose extent along an axis exceeds FLT_MAX.
+Scene load_scene(const std::filesystem::path& file, const SceneOptions& options = {});
 
 // Parses "x,y,z,r,g,b" lines into point lights (optional header line, '#'
 // comments). Throws InputError naming the file and line number, also for the

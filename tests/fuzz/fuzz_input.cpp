@@ -31,6 +31,14 @@ std::filesystem::path write_scene_files(std::string_view data, const std::filesy
     return dir / kSceneFile;
 }
 
+std::filesystem::path write_gltf_file(std::string_view data, const std::filesystem::path& dir) {
+    std::filesystem::create_directories(dir);
+    const std::filesystem::path file = dir / (data.substr(0, 4) == "glTF" ? "scene.glb" : "scene.gltf");
+    std::ofstream out(file, std::ios::binary | std::ios::trunc);
+    out.write(data.data(), std::streamsize(data.size()));
+    return file;
+}
+
 std::string check_scene_contract(const Scene& s) {
     const Camera& c = s.camera;
     if (!finite(c.position) || !finite(c.look_at) || !finite(c.up)) return "camera not finite";
@@ -67,6 +75,17 @@ std::string check_scene_contract(const Scene& s) {
         if (!unit({n.n0_x, n.n0_y, n.n0_z}) || !unit({n.n1_x, n.n1_y, n.n1_z}) || !unit({n.n2_x, n.n2_y, n.n2_z}))
             return "normal not unit length";
     }
+    if (!s.uvs.empty() && s.uvs.size() != s.triangles.size()) return "uvs not parallel to triangles";
+    for (const auto& t : s.uvs)
+        for (const float v : {t.u0, t.v0, t.u1, t.v1, t.u2, t.v2})
+            if (!std::isfinite(v)) return "uv not finite";
+    for (const auto& m : s.materials)
+        for (const std::uint32_t t : {m.base_color_texture, m.metallic_roughness_texture, m.emissive_texture,
+                                      m.normal_texture})
+            if (t != gpu::kInvalidIndex && t >= s.textures.size()) return "material texture out of range";
+    for (const auto& t : s.textures)
+        if (t.width < 1 || t.height < 1 || std::uint64_t(t.offset) + std::uint64_t(t.width) * t.height > s.texels.size())
+            return "texture texels out of range";
     for (const auto& l : s.lights) {
         if (l.type != gpu::kLightPoint && l.type != gpu::kLightDirectional && l.type != gpu::kLightSpot)
             return "unknown light type";

@@ -21,6 +21,10 @@ inline constexpr const char* kMtlFile = "mesh.mtl";
 // Returns the scene file's path.
 std::filesystem::path write_scene_files(std::string_view data, const std::filesystem::path& dir);
 
+// A glTF fuzz input is one file: written as scene.glb when it starts with
+// the binary magic "glTF", else as scene.gltf. Returns its path.
+std::filesystem::path write_gltf_file(std::string_view data, const std::filesystem::path& dir);
+
 // The loader's promises about a scene it returns (scene.h, scene-format.md):
 // every number finite, normals unit length, indices in range, colours and
 // roughness in range, a usable camera. Returns the first broken promise,

@@ -1,12 +1,20 @@
-# Configures tests/fuzz as its own project with clang, builds the fuzz
+# Configures tests/fuzz as its own project with clang, builds one fuzz
 # target, and runs it for SECONDS seconds. Fails on any finding; the input
-# that caused it is left in BUILD_DIR/artifacts/.
-#   cmake -DSOURCE_DIR=tests/fuzz -DBUILD_DIR=<dir> -DCXX=clang++ -DSECONDS=60 -P run_fuzz.cmake
+# that caused it is left in BUILD_DIR/runs/TARGET/artifacts/.
+#   cmake -DSOURCE_DIR=tests/fuzz -DBUILD_DIR=<dir> -DCXX=clang++ -DSECONDS=60 \
+#         [-DTARGET=lc_fuzz_scene_loader -DDICT=scene.dict -DCORPUS=corpus -DREGRESSIONS=regressions] \
+#         -P run_fuzz.cmake
 foreach(var SOURCE_DIR BUILD_DIR CXX SECONDS)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "run_fuzz.cmake: -D${var}=... is required")
   endif()
 endforeach()
+if(NOT DEFINED TARGET)
+  set(TARGET lc_fuzz_scene_loader)
+  set(DICT scene.dict)
+  set(CORPUS corpus)
+  set(REGRESSIONS regressions)
+endif()
 
 execute_process(
   COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${BUILD_DIR}
@@ -15,24 +23,25 @@ execute_process(
 if(rc)
   message(FATAL_ERROR "configuring the fuzz build failed")
 endif()
-execute_process(COMMAND ${CMAKE_COMMAND} --build ${BUILD_DIR} --target lc_fuzz_scene_loader -j 2
+execute_process(COMMAND ${CMAKE_COMMAND} --build ${BUILD_DIR} --target ${TARGET} -j 2
                 RESULT_VARIABLE rc)
 if(rc)
-  message(FATAL_ERROR "building lc_fuzz_scene_loader failed")
+  message(FATAL_ERROR "building ${TARGET} failed")
 endif()
 
 # New inputs go to the build tree's corpus (the first folder); the seeds
 # and regressions in the source tree are only read. A fixed seed makes a CI
 # run repeat the same mutations (up to how many fit in the time); fuzz
 # longer with another seed by hand (docs/testing.md).
-file(MAKE_DIRECTORY ${BUILD_DIR}/corpus ${BUILD_DIR}/artifacts)
+set(work ${BUILD_DIR}/runs/${TARGET})
+file(MAKE_DIRECTORY ${work}/corpus ${work}/artifacts)
 execute_process(
-  COMMAND ${BUILD_DIR}/lc_fuzz_scene_loader
+  COMMAND ${BUILD_DIR}/${TARGET}
           -seed=1 -max_total_time=${SECONDS} -rss_limit_mb=2048 -timeout=10 -print_final_stats=1
-          -dict=${SOURCE_DIR}/scene.dict -artifact_prefix=${BUILD_DIR}/artifacts/
-          ${BUILD_DIR}/corpus ${SOURCE_DIR}/corpus ${SOURCE_DIR}/regressions
+          -dict=${SOURCE_DIR}/${DICT} -artifact_prefix=${work}/artifacts/
+          ${work}/corpus ${SOURCE_DIR}/${CORPUS} ${SOURCE_DIR}/${REGRESSIONS}
   RESULT_VARIABLE rc)
 if(rc)
-  message(FATAL_ERROR "the fuzzer found a problem (exit ${rc}); the input is in ${BUILD_DIR}/artifacts/. "
-                      "Keep it under tests/fuzz/regressions/ with the fix (docs/testing.md).")
+  message(FATAL_ERROR "the fuzzer found a problem (exit ${rc}); the input is in ${work}/artifacts/. "
+                      "Keep it under tests/fuzz/${REGRESSIONS}/ with the fix (docs/testing.md).")
 endif()

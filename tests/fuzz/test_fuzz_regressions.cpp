@@ -1,5 +1,5 @@
-// Replays the fuzzer's seed corpus and every kept crash input through
-// load_scene: each must load into a scene that keeps the loader's promises
+// Replays the fuzzers' seed corpora and every kept crash input (scene
+// inputs and glTF files) through load_scene: each must load into a scene that keeps the loader's promises
 // or be rejected with lc::InputError. Anything else (a crash, a sanitizer
 // report in an LC_SANITIZE build, another exception) fails.
 #include <algorithm>
@@ -21,9 +21,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<fs::path> inputs() {
+std::vector<fs::path> inputs(std::initializer_list<const char*> dirs) {
     std::vector<fs::path> files;
-    for (const char* dir : {LC_FUZZ_CORPUS_DIR, LC_FUZZ_REGRESSIONS_DIR}) {
+    for (const char* dir : dirs) {
         if (!fs::is_directory(dir)) continue;
         for (const auto& entry : fs::directory_iterator(dir))
             if (entry.is_regular_file() && entry.path().filename().string()[0] != '.') files.push_back(entry.path());
@@ -32,17 +32,16 @@ std::vector<fs::path> inputs() {
     return files;
 }
 
-class FuzzInput : public ::testing::TestWithParam<fs::path> {};
-
-TEST_P(FuzzInput, LoadsOrIsRejectedWithInputError) {
-    std::ifstream in(GetParam(), std::ios::binary);
-    ASSERT_TRUE(in) << GetParam();
+// Loads one input as the fuzz target named by the test suite would.
+void replay(const fs::path& input, bool gltf) {
+    std::ifstream in(input, std::ios::binary);
+    ASSERT_TRUE(in) << input;
     const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    std::string name = info->name();  // "LoadsOrIsRejectedWithInputError/<input>"
+    std::string name = std::string(info->test_suite_name()) + "_" + info->name();
     std::replace(name.begin(), name.end(), '/', '_');
     const fs::path dir = fs::temp_directory_path() / ("lc_fuzz_replay_" + name);
-    const fs::path scene_file = fuzz::write_scene_files(data, dir);
+    const fs::path scene_file = gltf ? fuzz::write_gltf_file(data, dir) : fuzz::write_scene_files(data, dir);
     try {
         const Scene scene = load_scene(scene_file);
         std::printf("loaded: %zu triangles, %zu lights\n", scene.triangles.size(), scene.lights.size());
@@ -63,7 +62,16 @@ std::string name_of(const ::testing::TestParamInfo<fs::path>& info) {
     return name;
 }
 
-INSTANTIATE_TEST_SUITE_P(Fuzz, FuzzInput, ::testing::ValuesIn(inputs()), name_of);
+class FuzzInput : public ::testing::TestWithParam<fs::path> {};
+TEST_P(FuzzInput, LoadsOrIsRejectedWithInputError) { replay(GetParam(), false); }
+INSTANTIATE_TEST_SUITE_P(Fuzz, FuzzInput, ::testing::ValuesIn(inputs({LC_FUZZ_CORPUS_DIR, LC_FUZZ_REGRESSIONS_DIR})),
+                         name_of);
+
+class FuzzGltfInput : public ::testing::TestWithParam<fs::path> {};
+TEST_P(FuzzGltfInput, LoadsOrIsRejectedWithInputError) { replay(GetParam(), true); }
+INSTANTIATE_TEST_SUITE_P(Fuzz, FuzzGltfInput,
+                         ::testing::ValuesIn(inputs({LC_FUZZ_GLTF_CORPUS_DIR, LC_FUZZ_GLTF_REGRESSIONS_DIR})),
+                         name_of);
 
 // regressions/deeply_nested_*: memory grew with the square of the nesting
 // depth (over 2 GB for 400 KB of '['). Replaying them proves no crash; this
@@ -78,6 +86,22 @@ TEST(FuzzRegression, DeepNestingIsRejectedByDepth) {
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("nested more than 64 levels deep"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("camera[0][0]"), std::string::npos) << e.what();
+    }
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+}
+
+// tinygltf turns `extras` into its own values recursively: a file of nested
+// brackets must be refused before it runs the stack out.
+TEST(FuzzRegression, DeeplyNestedGltfIsRejectedByDepth) {
+    const fs::path dir = fs::temp_directory_path() / "lc_fuzz_replay_deep_gltf";
+    const fs::path file = fuzz::write_gltf_file(
+        "{\"asset\": {\"version\": \"2.0\"}, \"extras\": " + std::string(100000, '[') + "}", dir);
+    try {
+        load_scene(file);
+        ADD_FAILURE() << "a 100000-level glTF loaded";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("JSON nested more than 64 levels deep"), std::string::npos) << e.what();
     }
     std::error_code ec;
     fs::remove_all(dir, ec);

@@ -1,0 +1,105 @@
+// read_gltf_file (gltf_file.h).
+#include "gltf_file.h"
+
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <string_view>
+
+#include "input_file.h"
+#include "lightcuts/error.h"
+
+namespace lc::loader {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Extensions whose meaning this loader honours: a file may require them.
+constexpr std::array kSupportedExtensions{"KHR_lights_punctual", "KHR_materials_emissive_strength",
+                                          "KHR_materials_clearcoat", "KHR_materials_sheen"};
+
+bool supported(const std::string& extension) {
+    return std::find(kSupportedExtensions.begin(), kSupportedExtensions.end(), extension) !=
+           kSupportedExtensions.end();
+}
+
+// Deeper JSON than any glTF needs; tinygltf converts `extras` recursively,
+// so a file of nested brackets would otherwise run the stack out.
+constexpr int kMaxJsonDepth = 64;
+
+bool too_deep(std::string_view json) {
+    int depth = 0;
+    bool in_string = false;
+    for (std::size_t i = 0; i < json.size(); ++i) {
+        const char c = json[i];
+        if (in_string) {
+            if (c == '\\') ++i;
+            else if (c == '"') in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonDepth) return true;
+        } else if (c == ']' || c == '}') {
+            --depth;
+        }
+    }
+    return false;
+}
+
+std::string trimmed(std::string text) {
+    while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+    return text;
+}
+
+}  // namespace
+
+tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
+    const std::string& name = notes.file();
+    const std::string bytes = read_input_file(file);  // names the file when missing
+    if (bytes.size() > std::numeric_limits<unsigned int>::max()) throw InputError(name, "", "file too large");
+    const bool binary = bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0;
+    std::string_view json(bytes);
+    if (binary && bytes.size() >= 20) {
+        std::uint32_t length = 0;
+        std::copy_n(bytes.data() + 12, 4, reinterpret_cast<char*>(&length));
+        json = json.substr(20, length);
+    }
+    if (too_deep(json)) throw InputError(name, "", "JSON nested more than " + std::to_string(kMaxJsonDepth) + " levels deep");
+
+    tinygltf::TinyGLTF gltf;
+    tinygltf::Model model;
+    std::string err, warn;
+    const std::string base = file.parent_path().empty() ? std::string(".") : file.parent_path().string();
+    bool ok = false;
+    try {
+        const auto size = static_cast<unsigned int>(bytes.size());
+        ok = binary ? gltf.LoadBinaryFromMemory(&model, &err, &warn,
+                                                reinterpret_cast<const unsigned char*>(bytes.data()), size, base)
+                    : gltf.LoadASCIIFromString(&model, &err, &warn, bytes.data(), size, base);
+    } catch (const std::exception& e) {
+        err = e.what();
+        ok = false;
+    }
+    if (!ok) throw InputError(name, "", "tinygltf: " + (err.empty() ? std::string("cannot parse the file") : trimmed(err)));
+    warn = trimmed(warn);
+    for (std::size_t from = 0; from < warn.size();) {
+        const std::size_t end = std::min(warn.find('\n', from), warn.size());
+        if (end > from) notes.add("", "tinygltf: " + warn.substr(from, end - from));
+        from = end + 1;
+    }
+    for (std::size_t i = 0; i < model.extensionsRequired.size(); ++i) {
+        const std::string& ext = model.extensionsRequired[i];
+        if (!supported(ext))
+            throw InputError(name, "extensionsRequired[" + std::to_string(i) + "]",
+                             ext + " is required by the file but not supported (supported: KHR_lights_punctual, "
+                                   "KHR_materials_emissive_strength, KHR_materials_clearcoat, KHR_materials_sheen)");
+    }
+    for (const std::string& ext : model.extensionsUsed)
+        if (!supported(ext)) notes.add("extensionsUsed", ext + " is not supported; what it adds is ignored");
+    if (!model.animations.empty())
+        notes.add("animations", std::to_string(model.animations.size()) +
+                                    " animation(s) ignored; the scene is drawn as stored");
+    return model;
+}
+
+}  // namespace lc::loader

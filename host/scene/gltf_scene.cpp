@@ -1,0 +1,71 @@
+// load_gltf_scene: a glTF file as a whole scene (gltf_loader.h).
+#include <cmath>
+
+#include "float_limits.h"
+#include "gltf_loader.h"
+#include "input_file.h"
+#include "lightcuts/error.h"
+
+namespace lc::loader {
+namespace {
+
+// With no camera in the file: look along -Z at the bounding sphere of the
+// triangles, which fills the default 40-degree view.
+Camera default_framing(const Scene& scene) {
+    const glm::vec3 centre = 0.5f * (scene.bounds_min + scene.bounds_max);
+    float radius = 0.5f * glm::length(scene.bounds_max - scene.bounds_min);
+    if (!(radius > 0.0f)) radius = 1.0f;
+    Camera c;
+    c.fov_y_degrees = kDefaultFramingFovDegrees;
+    const float distance = radius / std::sin(glm::radians(0.5f * c.fov_y_degrees));
+    c.position = centre + glm::vec3(0.0f, 0.0f, distance);
+    c.look_at = centre;
+    c.up = glm::vec3(0.0f, 1.0f, 0.0f);
+    return c;
+}
+
+}  // namespace
+
+Scene load_gltf_scene(const std::filesystem::path& file, const std::string& camera) {
+    const std::string name = display(file);
+    Scene scene;
+    scene.file = file;
+    // A glTF file has no render settings. Lightcuts, not the JSON default
+    // brute force, which sums every light, the 65536 area-light samples of
+    // any emissive surface included, at every pixel.
+    scene.render.method = "lightcuts";
+    MeshTarget target{scene, {}, {}};
+    const GltfContents contents = load_gltf(file, MeshTransform{}, target);
+
+    LightLimits limits(target.geometry);
+    for (const GltfLight& l : contents.lights) {
+        const LightLimits::Problem p = limits.add(l.light);
+        if (p.fault == LightLimits::Fault::total) throw InputError(name, "extensions.KHR_lights_punctual", p.text);
+        if (p.fault == LightLimits::Fault::position) throw InputError(name, l.field, p.text);
+        scene.lights.push_back(l.light);
+    }
+    bool emissive = false;
+    for (const gpu::Material& m : scene.materials) emissive = emissive || (m.flags & gpu::kMaterialEmissive) != 0u;
+    if (scene.lights.empty() && !emissive)
+        throw InputError(name, "", "the scene has no light: no KHR_lights_punctual light and no emissive material");
+    update_bounds(scene);
+
+    if (!camera.empty()) {
+        std::string names;
+        for (const GltfCamera& c : contents.cameras) {
+            if (c.name == camera) {
+                scene.camera = c.camera;
+                return scene;
+            }
+            names += (names.empty() ? "" : ", ") + ("'" + c.name + "'");
+        }
+        throw InputError(name, "--camera", "no perspective camera named '" + camera + "' (the file has " +
+                                               (names.empty() ? std::string("none") : names) + ")");
+    }
+    scene.camera = contents.cameras.empty() ? default_framing(scene) : contents.cameras.front().camera;
+    if (contents.cameras.empty())
+        scene.load_notes.push_back(name + ": no perspective camera; looking along -Z at the bounding sphere (40 degrees)");
+    return scene;
+}
+
+}  // namespace lc::loader
