@@ -1,5 +1,6 @@
 // load_gltf_scene: a glTF file as a whole scene (gltf_loader.h).
 #include <cmath>
+#include <limits>
 
 #include "float_limits.h"
 #include "gltf_loader.h"
@@ -10,16 +11,24 @@ namespace lc::loader {
 namespace {
 
 // With no camera in the file: look along -Z at the bounding sphere of the
-// triangles, which fills the default 40-degree view.
-Camera default_framing(const Scene& scene) {
-    const glm::vec3 centre = 0.5f * (scene.bounds_min + scene.bounds_max);
-    float radius = 0.5f * glm::length(scene.bounds_max - scene.bounds_min);
-    if (!(radius > 0.0f)) radius = 1.0f;
+// triangles, which fills the default 40-degree view. In double: geometry
+// near the float range puts that camera beyond it, which is an error
+// naming the file.
+Camera default_framing(const Scene& scene, const std::string& name) {
+    const glm::dvec3 lo(scene.bounds_min), hi(scene.bounds_max);
+    const glm::dvec3 centre = 0.5 * (lo + hi);
+    double radius = 0.5 * glm::length(hi - lo);
+    if (!(radius > 0.0)) radius = 1.0;
     Camera c;
     c.fov_y_degrees = kDefaultFramingFovDegrees;
-    const float distance = radius / std::sin(glm::radians(0.5f * c.fov_y_degrees));
-    c.position = centre + glm::vec3(0.0f, 0.0f, distance);
-    c.look_at = centre;
+    const double distance = radius / std::sin(glm::radians(0.5 * double(c.fov_y_degrees)));
+    const glm::dvec3 position = centre + glm::dvec3(0.0, 0.0, distance);
+    if (!(std::abs(position.z) <= double(std::numeric_limits<float>::max())))
+        throw InputError(name, "cameras",
+                         "no perspective camera, and a default one framing geometry this large would stand "
+                         "beyond the float range: add a camera");
+    c.position = glm::vec3(position);
+    c.look_at = glm::vec3(centre);
     c.up = glm::vec3(0.0f, 1.0f, 0.0f);
     return c;
 }
@@ -62,7 +71,7 @@ Scene load_gltf_scene(const std::filesystem::path& file, const std::string& came
         throw InputError(name, "--camera", "no perspective camera named '" + camera + "' (the file has " +
                                                (names.empty() ? std::string("none") : names) + ")");
     }
-    scene.camera = contents.cameras.empty() ? default_framing(scene) : contents.cameras.front().camera;
+    scene.camera = contents.cameras.empty() ? default_framing(scene, name) : contents.cameras.front().camera;
     if (contents.cameras.empty())
         scene.load_notes.push_back(name + ": no perspective camera; looking along -Z at the bounding sphere (40 degrees)");
     return scene;
