@@ -17,6 +17,9 @@
 namespace lc {
 namespace {
 
+using test::normal;
+using test::vertex;
+
 namespace fs = std::filesystem;
 
 const fs::path kData = fs::path(LC_TEST_DATA_DIR) / "gltf";
@@ -44,18 +47,6 @@ std::string error_of(const std::string& name, const std::string& camera = "") {
 bool has_note(const Scene& s, const std::string& part) {
     return std::any_of(s.load_notes.begin(), s.load_notes.end(),
                        [&](const std::string& line) { return line.find(part) != std::string::npos; });
-}
-
-glm::vec3 vertex(const gpu::Triangle& t, int k) {
-    if (k == 0) return {t.v0_x, t.v0_y, t.v0_z};
-    if (k == 1) return {t.v1_x, t.v1_y, t.v1_z};
-    return {t.v2_x, t.v2_y, t.v2_z};
-}
-
-glm::vec3 normal(const gpu::TriangleNormals& n, int k) {
-    if (k == 0) return {n.n0_x, n.n0_y, n.n0_z};
-    if (k == 1) return {n.n1_x, n.n1_y, n.n1_z};
-    return {n.n2_x, n.n2_y, n.n2_z};
 }
 
 void expect_near(glm::vec3 a, glm::vec3 b, float tolerance, const std::string& what) {

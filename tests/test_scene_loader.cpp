@@ -24,6 +24,9 @@
 namespace lc {
 namespace {
 
+using test::normal;
+using test::vertex;
+
 namespace fs = std::filesystem;
 using test::TempDir;
 
@@ -44,18 +47,6 @@ std::string input_error_of(Fn&& load) {
     }
     ADD_FAILURE() << "expected lc::InputError, nothing was thrown";
     return {};
-}
-
-glm::vec3 vertex(const gpu::Triangle& t, int i) {
-    if (i == 0) return {t.v0_x, t.v0_y, t.v0_z};
-    if (i == 1) return {t.v1_x, t.v1_y, t.v1_z};
-    return {t.v2_x, t.v2_y, t.v2_z};
-}
-
-glm::vec3 normal(const gpu::TriangleNormals& n, int i) {
-    if (i == 0) return {n.n0_x, n.n0_y, n.n0_z};
-    if (i == 1) return {n.n1_x, n.n1_y, n.n1_z};
-    return {n.n2_x, n.n2_y, n.n2_z};
 }
 
 void expect_near(glm::vec3 actual, glm::vec3 expected, float tolerance = 1e-5f) {

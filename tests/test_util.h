@@ -47,6 +47,19 @@ private:
 
 // Materials as the loader makes them (host/scene/materials.cpp), without
 // its clamp of alpha: roughness = sqrt(alpha), no textures.
+// Corner k (0, 1, 2) of a triangle, and its shading normal there.
+inline glm::vec3 vertex(const gpu::Triangle& t, int k) {
+    if (k == 0) return {t.v0_x, t.v0_y, t.v0_z};
+    if (k == 1) return {t.v1_x, t.v1_y, t.v1_z};
+    return {t.v2_x, t.v2_y, t.v2_z};
+}
+
+inline glm::vec3 normal(const gpu::TriangleNormals& n, int k) {
+    if (k == 0) return {n.n0_x, n.n0_y, n.n0_z};
+    if (k == 1) return {n.n1_x, n.n1_y, n.n1_z};
+    return {n.n2_x, n.n2_y, n.n2_z};
+}
+
 inline gpu::Material lambert(glm::vec3 kd) {
     gpu::Material m{};
     m.kd_r = kd.x; m.kd_g = kd.y; m.kd_b = kd.z;

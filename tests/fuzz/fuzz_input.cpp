@@ -1,8 +1,13 @@
 #include "fuzz_input.h"
+#include "lightcuts/error.h"
 #include "lightcuts/settings.h"
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
 #include <fstream>
+#include <unistd.h>
 
 #include <glm/glm.hpp>
 
@@ -110,6 +115,37 @@ std::string check_scene_contract(const Scene& s) {
     if (!(r.indirect.clamp >= 0.0f) || !std::isfinite(r.indirect.clamp)) return "clamp invalid";
     if (!(r.time_limit >= 0.0) || !std::isfinite(r.time_limit)) return "time_limit invalid";
     return {};
+}
+
+namespace {
+
+struct WorkDir {
+    std::filesystem::path path =
+        std::filesystem::temp_directory_path() / ("lc_fuzz_" + std::to_string(::getpid()));
+    ~WorkDir() {
+        std::error_code ec;
+        std::filesystem::remove_all(path, ec);
+    }
+};
+
+}  // namespace
+
+void load_or_abort(std::string_view data, InputWriter write) {
+    static const WorkDir dir;
+    const std::filesystem::path file = write(data, dir.path);
+    try {
+        const Scene scene = load_scene(file);
+        const std::string broken = check_scene_contract(scene);
+        if (!broken.empty()) {
+            std::fprintf(stderr, "loaded scene breaks the loader's contract: %s\n", broken.c_str());
+            std::abort();
+        }
+    } catch (const InputError&) {
+        // Rejected with a message naming the file and field: correct.
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "load_scene threw something other than lc::InputError: %s\n", e.what());
+        std::abort();
+    }
 }
 
 }  // namespace lc::fuzz

@@ -31,4 +31,12 @@ std::filesystem::path write_gltf_file(std::string_view data, const std::filesyst
 // or an empty string.
 std::string check_scene_contract(const Scene& scene);
 
+// One fuzz run: writes the input with `write` into this process's own
+// temporary folder (removed when the process exits normally; per process,
+// so parallel jobs, -jobs=N, share no files), loads the scene and aborts on
+// anything but success with a scene that keeps check_scene_contract or an
+// lc::InputError.
+using InputWriter = std::filesystem::path (*)(std::string_view data, const std::filesystem::path& dir);
+void load_or_abort(std::string_view data, InputWriter write);
+
 }  // namespace lc::fuzz

@@ -4,50 +4,11 @@
 // report, any other exception, or a returned scene that breaks the loader's
 // promises is a bug.
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
-#include <exception>
-#include <string>
-#include <unistd.h>
+#include <string_view>
 
 #include "fuzz_input.h"
-#include "lightcuts/error.h"
-
-namespace {
-
-// Per process, so parallel fuzzing jobs (-jobs=N) do not share files;
-// removed when the process exits normally.
-struct WorkDir {
-    std::filesystem::path path =
-        std::filesystem::temp_directory_path() / ("lc_fuzz_" + std::to_string(::getpid()));
-    ~WorkDir() {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
-};
-
-const std::filesystem::path& work_dir() {
-    static const WorkDir dir;
-    return dir.path;
-}
-
-}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    const std::string_view input(reinterpret_cast<const char*>(data), size);
-    const std::filesystem::path scene_file = lc::fuzz::write_scene_files(input, work_dir());
-    try {
-        const lc::Scene scene = lc::load_scene(scene_file);
-        const std::string broken = lc::fuzz::check_scene_contract(scene);
-        if (!broken.empty()) {
-            std::fprintf(stderr, "loaded scene breaks the loader's contract: %s\n", broken.c_str());
-            std::abort();
-        }
-    } catch (const lc::InputError&) {
-        // Rejected with a message naming the file and field: correct.
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "load_scene threw something other than lc::InputError: %s\n", e.what());
-        std::abort();
-    }
+    lc::fuzz::load_or_abort(std::string_view(reinterpret_cast<const char*>(data), size), lc::fuzz::write_scene_files);
     return 0;
 }
