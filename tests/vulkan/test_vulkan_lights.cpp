@@ -4,9 +4,10 @@
 // against lightcuts at error 0 over the sampled lights on both devices; and
 // the stochastic methods (sampled, stochastic) on both devices; and all of
 // that again with indirect light as virtual point lights, with and without
-// their falloff clamp.
+// their falloff clamp, and on the Disney materials scene (scenes/materials).
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -62,10 +63,12 @@ Scene light_model_scene(std::uint32_t seed, bool spots, bool emitters, bool envi
 struct Case {
     const char* name;
     bool spots, emitters, environment;
-    float vpl_clamp = -1.0f;  // >= 0: with 1500 VPLs and this clamp
+    float vpl_clamp = -1.0f;      // >= 0: with 1500 VPLs and this clamp
+    const char* file = nullptr;   // a shipped scene (relative to the source tree) instead
 };
 
 Scene light_model_scene(std::uint32_t seed, const Case& c) {
+    if (c.file != nullptr) return load_scene(std::filesystem::path(LC_SOURCE_DIR) / c.file);
     return light_model_scene(seed, c.spots, c.emitters, c.environment, c.vpl_clamp);
 }
 
@@ -202,7 +205,9 @@ INSTANTIATE_TEST_SUITE_P(Kinds, VulkanLights,
                          ::testing::Values(Case{"spots", true, false, false}, Case{"area", false, true, false},
                                            Case{"environment", false, false, true}, Case{"all", true, true, true},
                                            Case{"indirect", false, true, false, 0.0f},
-                                           Case{"indirect_clamped", true, true, true, 0.5f}),
+                                           Case{"indirect_clamped", true, true, true, 0.5f},
+                                           // Disney spheres: every lobe, 2000 point lights.
+                                           Case{"disney", false, false, false, -1.0f, "scenes/materials/materials.json"}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 }  // namespace
