@@ -107,7 +107,7 @@ void expect_brute_matches(const PreparedScene& p, const RenderOptions& o, const 
 // A pixel whose cut differs by a cluster differs by up to the error
 // threshold; the others only by rounding.
 void expect_lightcuts_matches(const PreparedScene& p, const RenderOptions& o,
-                              const RenderResult& g) {
+                              const RenderResult& g, double relative) {
     const RenderResult c = render_cpu(p, o);
     ASSERT_EQ(g.image.width, c.image.width);
     ASSERT_EQ(g.image.height, c.image.height);
@@ -121,8 +121,7 @@ void expect_lightcuts_matches(const PreparedScene& p, const RenderOptions& o,
                 (p.vpls ? kVplCutsDifferFraction : kCutsDifferFraction) * double(cut_differs.size()));
     const double cuts_differ = p.vpls ? kVplCutsDifferFraction : kCutsDifferFraction;
     EXPECT_LE(double(differing), cuts_differ * double(cut_differs.size()));
-    EXPECT_LE(max_relative_difference(g.image, c.image, "lightcuts", kLightcutsRelative, cut_differs),
-              kLightcutsRelative);
+    EXPECT_LE(max_relative_difference(g.image, c.image, "lightcuts", relative, cut_differs), relative);
     expect_shadow_rays_match(g.stats, c.stats, "lightcuts", p.vpls ? kVplShadowRaysRelative : kShadowRaysRelative);
     // Whether refinement stopped at max_cut can only differ where the cut does.
     EXPECT_NEAR(double(g.stats.max_cut_pixels), double(c.stats.max_cut_pixels),
