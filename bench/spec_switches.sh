@@ -3,20 +3,26 @@
 # needs neither shadow rays, nor the GGX lobe, nor the spot/oriented light
 # code (scenes/plane) with the switches as the scene allows them, and with
 # each one forced on (LC_VK_FORCE_FEATURES), and prints the median GPU
-# shading time of 5 runs after a warm-up.
+# shading time of 5 runs after a warm-up. FEATURES lists the forcings to
+# run (LC_VK_FORCE_FEATURES values; "none" forces nothing), e.g.
+# "none disney sheen,clearcoat" for the Disney lobes (docs/results/disney.md).
 #
-#   bench/spec_switches.sh [SCENE] [SIZE]
+# METHODS: the methods to time (default "lightcuts brute").
+#
+#   bench/spec_switches.sh [SCENE] [SIZE] [FEATURES] [METHODS]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 scene="${1:-$root/scenes/plane/plane.json}"
 size="${2:-128}"
+features="${3:-none ggx shadows oriented all}"
+methods="${4:-lightcuts brute}"
 exe="$root/build/host/lightcuts"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 
 printf '%-10s %-14s %s\n' method forced "median shading [s] (5 runs)"
-for method in lightcuts brute; do
-  for force in none ggx shadows oriented all; do
+for method in $methods; do
+  for force in $features; do
     times=()
     for run in 0 1 2 3 4 5; do
       LC_VK_FORCE_FEATURES="$force" "$exe" render "$scene" -o "$tmp/x.exr" --device vulkan --method "$method" \

@@ -87,6 +87,14 @@ struct BasicShadeKernel {
     static constexpr bool kEnableShadows = true;
     static constexpr bool kEnableOriented = true;
     static constexpr bool kEnableTextures = true;
+    static constexpr bool kEnableDisney = true;
+    static constexpr bool kEnableSheen = true;
+    static constexpr bool kEnableClearcoat = true;
+    // Benchmarks only: replace the Disney BRDF's non-diffuse lobe bounds by
+    // the seed report's constant 1 (lc_disney_bound), to measure the cut
+    // size the lobe bounds save. Not conservative; the renderer reads it
+    // once per render from LC_CPU_SEED_LOBE_BOUND (cpu_renderer.cpp).
+    static inline bool seed_lobe_bound = false;
 
 #define LC_BVH_NODE(i) bvh_nodes[i]
 #define LC_TRIANGLE(i) triangles[i]
@@ -103,6 +111,7 @@ struct BasicShadeKernel {
 #define LC_HEAP_STORE(i, e) (heap_high_water = max(heap_high_water, (i) + 1u), heap[i] = (e))
 #define LC_ON_SHADOW_RAY(o, d, t) \
     if constexpr (kRecordRays) ray_log->push_back({o, d, t})
+#define LC_SEED_LOBE_BOUND seed_lobe_bound
 #include "shared/trace.h"
 #include "shared/textures.h"
 #include "shared/shading.h"
@@ -123,6 +132,7 @@ struct BasicShadeKernel {
 #undef LC_HEAP_LOAD
 #undef LC_HEAP_STORE
 #undef LC_ON_SHADOW_RAY
+#undef LC_SEED_LOBE_BOUND
 };
 
 using ShadeKernel = BasicShadeKernel<false>;

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
 #include <exception>
+#include <string>
 #include <thread>
 
 #include "cpu_kernel.h"
@@ -85,6 +87,10 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     const Method method = method_of(options.method);
     const bool lightcuts = method_selects_cuts(options.method);
     const gpu::FrameParams frame = make_frame_params(prepared, options);
+    // Benchmarks only (docs/results/disney.md): the seed report's constant
+    // bound for the Disney BRDF's non-diffuse lobes.
+    const char* seed_bound = std::getenv("LC_CPU_SEED_LOBE_BOUND");
+    cpu::ShadeKernel::seed_lobe_bound = seed_bound != nullptr && std::string(seed_bound) == "1";
     auto start = std::chrono::steady_clock::now();
 
     RenderResult result;

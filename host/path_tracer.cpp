@@ -79,7 +79,35 @@ private:
 
 // ---- BRDF sampling ----
 
+namespace {
+
+// Disney: the diffuse and sheen lobes through the cosine lobe, the specular
+// lobe through GGX whose Fresnel reaches 1 at grazing angles (hence the
+// floor), the clearcoat through GTR1; nothing where wo is below n, where the
+// BRDF is zero.
+LobeWeights disney_lobe_weights(Kernel& k, const gpu::Material& m, glm::vec3 n, glm::vec3 wo) {
+    if (!(glm::dot(n, wo) > 0.0f)) return {};
+    const float diffuse = gpu::lc_luminance(k.lc_kd(m)) * (1.0f - m.metallic) +
+                          ((m.flags & gpu::kMaterialHasSheen) != 0u ? gpu::lc_luminance(k.lc_disney_sheen_color(m)) : 0.0f);
+    const float specular = std::max(gpu::lc_luminance(k.lc_disney_spec0(m)), 0.1f);
+    const float clearcoat = (m.flags & gpu::kMaterialHasClearcoat) != 0u ? 0.25f * m.clearcoat : 0.0f;
+    const float total = std::max(diffuse, 0.0f) + specular + clearcoat;
+    return {std::max(diffuse, 0.0f) / total, specular / total, clearcoat / total};
+}
+
+// A half vector around n at cos(theta_h) = cos_h and azimuth phi.
+glm::vec3 half_vector(glm::vec3 n, glm::vec3 t, glm::vec3 b, float cos_h, float phi) {
+    const float sin_h = std::sqrt(std::max(0.0f, 1.0f - cos_h * cos_h));
+    return sin_h * std::cos(phi) * t + sin_h * std::sin(phi) * b + cos_h * n;
+}
+
+}  // namespace
+
 LobeWeights lobe_weights(const gpu::Material& m, glm::vec3 n, glm::vec3 wo) {
+    if ((m.flags & gpu::kMaterialDisney) != 0u) {
+        Kernel k;  // only its BRDF formulas, which read no scene data
+        return disney_lobe_weights(k, m, n, wo);
+    }
     const float diffuse = gpu::lc_luminance(glm::vec3(m.kd_r, m.kd_g, m.kd_b));
     const bool ggx = (m.flags & gpu::kMaterialHasSpecular) != 0u && glm::dot(n, wo) > 0.0f;
     const float specular = ggx ? gpu::lc_luminance(glm::vec3(m.ks_r, m.ks_g, m.ks_b)) : 0.0f;
@@ -101,12 +129,19 @@ float bsdf_pdf(Kernel& k, const gpu::Material& m, const LobeWeights& lobes, glm:
         const float wo_h = glm::dot(wo, h);
         if (cos_h > 0.0f && wo_h > 0.0f) pdf += lobes.specular * k.lc_ggx_d(cos_h, m.alpha) * cos_h / (4.0f * wo_h);
     }
+    if (lobes.clearcoat > 0.0f) {
+        const glm::vec3 h = glm::normalize(wi + wo);
+        const float cos_h = glm::dot(n, h);
+        const float wo_h = glm::dot(wo, h);
+        if (cos_h > 0.0f && wo_h > 0.0f)
+            pdf += lobes.clearcoat * k.lc_gtr1_d(cos_h, k.lc_clearcoat_alpha(m)) * cos_h / (4.0f * wo_h);
+    }
     return pdf;
 }
 
 BsdfSample sample_bsdf(Kernel& k, const gpu::Material& m, const LobeWeights& lobes, glm::vec3 n,
                        glm::vec3 wo, float u_lobe, float u1, float u2) {
-    if (!(lobes.diffuse + lobes.specular > 0.0f)) return {};
+    if (!(lobes.diffuse + lobes.specular + lobes.clearcoat > 0.0f)) return {};
     glm::vec3 t, b;
     k.lc_basis(n, t, b);
     const float phi = 2.0f * kPi * u2;
@@ -116,11 +151,17 @@ BsdfSample sample_bsdf(Kernel& k, const gpu::Material& m, const LobeWeights& lob
         const float r = std::sqrt(u1);
         wi = r * std::cos(phi) * t + r * std::sin(phi) * b + std::sqrt(std::max(0.0f, 1.0f - u1)) * n;
     } else {
-        // Inverting the CDF of D cos(theta_h): tan^2 = alpha^2 u / (1 - u).
-        const float tan2 = m.alpha * m.alpha * u1 / (1.0f - u1);
-        const float cos_h = 1.0f / std::sqrt(1.0f + tan2);
-        const float sin_h = std::sqrt(std::max(0.0f, 1.0f - cos_h * cos_h));
-        const glm::vec3 h = sin_h * std::cos(phi) * t + sin_h * std::sin(phi) * b + cos_h * n;
+        float cos_h;
+        if (lobes.clearcoat <= 0.0f || u_lobe < lobes.diffuse + lobes.specular) {
+            // Inverting the CDF of D cos(theta_h): tan^2 = alpha^2 u / (1 - u).
+            const float tan2 = m.alpha * m.alpha * u1 / (1.0f - u1);
+            cos_h = 1.0f / std::sqrt(1.0f + tan2);
+        } else {
+            // GTR1's (Burley 2012, appendix B): cos^2 = (1 - a^(2(1 - u))) / (1 - a^2).
+            const float a2 = k.lc_clearcoat_alpha(m) * k.lc_clearcoat_alpha(m);
+            cos_h = std::sqrt(std::max(0.0f, (1.0f - std::pow(a2, 1.0f - u1)) / (1.0f - a2)));
+        }
+        const glm::vec3 h = half_vector(n, t, b, cos_h, phi);
         const float wo_h = glm::dot(wo, h);
         if (!(wo_h > 0.0f)) return {};  // wo sees h from behind: no reflection
         wi = 2.0f * wo_h * h - wo;

@@ -22,13 +22,18 @@ namespace lc::path {
 using Kernel = cpu::ShadeKernel;
 using SurfacePoint = Kernel::SurfacePoint;
 
-// Probabilities of drawing a direction from the Lambert lobe and from the
-// GGX lobe, in proportion to the luminance of kd and ks; the GGX lobe only
-// where the material has one and wo is above the shading normal (elsewhere
-// lc_brdf_cos has no GGX term). Both 0 for a black material.
+// Probabilities of drawing a direction from the cosine (Lambert) lobe, the
+// GGX lobe and the GTR1 (clearcoat) lobe. Lambert + GGX: in proportion to
+// the luminance of kd and ks; the GGX lobe only where the material has one
+// and wo is above the shading normal (elsewhere lc_brdf_cos has no GGX
+// term); all 0 for a black material. Disney: the cosine lobe for diffuse
+// and sheen, GGX for the specular lobe, GTR1 for the clearcoat, in
+// proportion to rough estimates of their reflectance; all 0 where wo is
+// below the shading normal (the BRDF is zero there).
 struct LobeWeights {
     float diffuse = 0.0f;
     float specular = 0.0f;
+    float clearcoat = 0.0f;
 };
 LobeWeights lobe_weights(const gpu::Material& m, glm::vec3 n, glm::vec3 wo);
 
@@ -41,7 +46,7 @@ struct BsdfSample {
 
 // Lambert: cosine-weighted. GGX: a half vector h from D(h) cos(theta_h),
 // wi = wo reflected about h, with density D cos(theta_h) / (4 wo.h) (Walter
-// et al. 2007). `u_lobe` picks the lobe, (u1, u2) the direction; all in [0, 1).
+// et al. 2007); GTR1 likewise with its D. `u_lobe` picks the lobe, (u1, u2) the direction; all in [0, 1).
 // `k` only provides the shared BRDF formulas (no scene data is read).
 BsdfSample sample_bsdf(Kernel& k, const gpu::Material& m, const LobeWeights& lobes, glm::vec3 n,
                        glm::vec3 wo, float u_lobe, float u1, float u2);

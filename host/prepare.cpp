@@ -79,6 +79,10 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
     for (const auto& m : scene.materials) {
         prepared.has_specular |= (m.flags & gpu::kMaterialHasSpecular) != 0u;
         prepared.has_textures |= (m.flags & gpu::kMaterialTextured) != 0u;
+        const bool disney = (m.flags & gpu::kMaterialDisney) != 0u;
+        prepared.has_disney |= disney;
+        prepared.has_sheen |= disney && (m.flags & gpu::kMaterialHasSheen) != 0u;
+        prepared.has_clearcoat |= disney && (m.flags & gpu::kMaterialHasClearcoat) != 0u;
     }
     // The geometry's size alone (Scene::bounds), in double: a far-away
     // light or the size of the light set must not change it.

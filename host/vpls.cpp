@@ -154,7 +154,10 @@ void trace_path(const cpu::ShadeKernel& k, const Emitters& emitters, std::uint32
         if (tri == gpu::kInvalidIndex) return;
         const auto sp = kernel.lc_surface_point(tri, b1, b2, dir);
         const gpu::Material& m = sp.mat;
-        const glm::vec3 kd(m.kd_r, m.kd_g, m.kd_b);
+        // Only the diffuse part re-emits: a Disney material's is its base
+        // colour times (1 - metallic) (docs/lightcuts.md, "Indirect light").
+        const glm::vec3 kd = glm::vec3(m.kd_r, m.kd_g, m.kd_b) *
+                             ((m.flags & gpu::kMaterialDisney) != 0u ? 1.0f - m.metallic : 1.0f);
         const float survive = std::min(1.0f, std::max({kd.x, kd.y, kd.z}));
         if (!(survive > 0.0f)) return;
         const glm::vec3 vpl = flux * kd * (1.0f / kPi);

@@ -46,6 +46,9 @@ LC_CONST uint kSpecSpillStride = 5u;      // invocations the spill buffer is lai
 LC_CONST uint kSpecEnableOriented = 6u;   // any spot or oriented light (emission cones)
 LC_CONST uint kSpecStochastic = 7u;       // lightcuts.comp: Stochastic Lightcuts' fresh representatives
 LC_CONST uint kSpecEnableTextures = 8u;   // any material has a texture
+LC_CONST uint kSpecEnableDisney = 9u;     // any Disney material
+LC_CONST uint kSpecEnableSheen = 10u;     // any Disney material with sheen > 0
+LC_CONST uint kSpecEnableClearcoat = 11u; // any Disney material with clearcoat > 0
 
 // PixelStats.flags
 LC_CONST uint kPixelHeapOverflow = 1u;  // a heap outgrew its capacity (a bug: the capacity

@@ -9,11 +9,15 @@
 layout(local_size_x_id = kSpecWorkgroupSize) in;
 
 // Switched off for scenes that do not need them, so the compiler drops the
-// GGX lobe and the shadow-ray traversal (shared/shading.h reads these).
+// GGX lobe, the shadow-ray traversal, the Disney BRDF or its sheen and
+// clearcoat lobes (shared/shading.h reads these).
 layout(constant_id = kSpecEnableGgx) const bool kEnableGgx = true;
 layout(constant_id = kSpecEnableShadows) const bool kEnableShadows = true;
 layout(constant_id = kSpecEnableOriented) const bool kEnableOriented = true;
 layout(constant_id = kSpecEnableTextures) const bool kEnableTextures = true;
+layout(constant_id = kSpecEnableDisney) const bool kEnableDisney = true;
+layout(constant_id = kSpecEnableSheen) const bool kEnableSheen = true;
+layout(constant_id = kSpecEnableClearcoat) const bool kEnableClearcoat = true;
 
 // PushConstants of bindings.glsl: this dispatch's tile, sample and split.
 layout(push_constant) uniform Push { PushConstants push; };

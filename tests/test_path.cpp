@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "path_tracer.h"
+#include "scene/materials.h"
 #include "test_util.h"
 
 namespace lc {
@@ -197,9 +198,26 @@ TEST(PathEmitters, EnvironmentSamplingFollowsLuminanceTimesSolidAngle) {
 // densities integrate to at most 1 (GGX loses the reflections that go
 // below the surface), exactly 1 for Lambert alone.
 TEST(PathBsdf, SampledEstimateMatchesQuadrature) {
+    // Disney: a rough dielectric with sheen (cosine and GGX lobes), a metal
+    // (GGX), and a clearcoat whose GTR1 lobe (alpha_c = 0.07) the midpoint
+    // rule still resolves.
+    loader::DisneyParams sheen, metal, coat;
+    sheen.base_color = {0.6f, 0.4f, 0.3f};
+    sheen.roughness = 0.6f;
+    sheen.sheen = 0.8f;
+    metal.base_color = {0.9f, 0.7f, 0.5f};
+    metal.metallic = 1.0f;
+    metal.roughness = 0.3f;
+    coat.base_color = glm::vec3(0.3f);
+    coat.roughness = 0.5f;
+    coat.clearcoat = 1.0f;
+    coat.clearcoat_gloss = 0.3f;
     const gpu::Material materials[] = {test::lambert(glm::vec3(0.5f)),
                                        test::glossy({0.2f, 0.3f, 0.1f}, {0.5f, 0.4f, 0.4f}, 0.3f),
-                                       test::glossy(glm::vec3(0.0f), glm::vec3(0.9f), 0.05f)};
+                                       test::glossy(glm::vec3(0.0f), glm::vec3(0.9f), 0.05f),
+                                       loader::make_disney_material(sheen),
+                                       loader::make_disney_material(metal),
+                                       loader::make_disney_material(coat)};
     const glm::vec3 n(0.0f, 0.0f, 1.0f);
     Kernel k{};
     for (const gpu::Material& m : materials)

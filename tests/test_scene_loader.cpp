@@ -220,6 +220,142 @@ TEST(SceneLoader, MaterialOverrideReplacesMtlForWholeMesh) {
     EXPECT_EQ(matte.flags & gpu::kMaterialHasSpecular, 0u);
 }
 
+// ---------------------------------------------------------------------------
+// Disney materials (docs/scene-format.md): JSON keys and MTL's PBR keys.
+// ---------------------------------------------------------------------------
+
+// tri.obj with the given mesh material (JSON object text), in a fresh directory.
+fs::path scene_with_material(const TempDir& dir, const std::string& material) {
+    fs::copy_file(kFixtures / "tri.obj", dir.path() / "tri.obj", fs::copy_options::overwrite_existing);
+    return dir.write("material.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "tri.obj", "material": )" + material + R"(}],
+ "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]}
+)");
+}
+
+TEST(SceneLoader, DisneyKeysMakeADisneyMaterial) {
+    TempDir dir;
+    const Scene scene = load_scene(scene_with_material(dir, R"({"base_color": [0.9, 0.5, 0.1], "metallic": 0.25,
+        "roughness": 0.4, "specular": 0.3, "specular_tint": 0.2, "sheen": 0.7, "sheen_tint": 0.6,
+        "clearcoat": 0.8, "clearcoat_gloss": 0.1, "emission": [1, 2, 3]})"));
+    ASSERT_EQ(scene.materials.size(), 1u);
+    const gpu::Material& m = scene.materials[0];
+    EXPECT_NE(m.flags & gpu::kMaterialDisney, 0u);
+    EXPECT_NE(m.flags & gpu::kMaterialHasSheen, 0u);
+    EXPECT_NE(m.flags & gpu::kMaterialHasClearcoat, 0u);
+    EXPECT_NE(m.flags & gpu::kMaterialEmissive, 0u);
+    EXPECT_EQ(m.flags & gpu::kMaterialHasSpecular, 0u);
+    expect_near({m.kd_r, m.kd_g, m.kd_b}, {0.9f, 0.5f, 0.1f});
+    EXPECT_FLOAT_EQ(m.metallic, 0.25f);
+    EXPECT_FLOAT_EQ(m.roughness, 0.4f);
+    EXPECT_NEAR(m.alpha, 0.16f, 1e-6f);
+    EXPECT_FLOAT_EQ(m.specular, 0.3f);
+    EXPECT_FLOAT_EQ(m.specular_tint, 0.2f);
+    EXPECT_FLOAT_EQ(m.sheen, 0.7f);
+    EXPECT_FLOAT_EQ(m.sheen_tint, 0.6f);
+    EXPECT_FLOAT_EQ(m.clearcoat, 0.8f);
+    EXPECT_FLOAT_EQ(m.clearcoat_gloss, 0.1f);
+
+    // One Disney key is enough; the rest take Burley's defaults, and no
+    // sheen or clearcoat means no such lobe.
+    const Scene plain = load_scene(scene_with_material(dir, R"({"metallic": 1})"));
+    const gpu::Material& p = plain.materials[0];
+    EXPECT_NE(p.flags & gpu::kMaterialDisney, 0u);
+    EXPECT_EQ(p.flags & (gpu::kMaterialHasSheen | gpu::kMaterialHasClearcoat), 0u);
+    expect_near({p.kd_r, p.kd_g, p.kd_b}, glm::vec3(0.8f));
+    EXPECT_FLOAT_EQ(p.roughness, 0.5f);
+    EXPECT_FLOAT_EQ(p.specular, 0.5f);
+    EXPECT_FLOAT_EQ(p.clearcoat_gloss, 1.0f);
+
+    // Roughness alone is shared by both kinds: still Lambert + GGX.
+    const Scene lambert = load_scene(scene_with_material(dir, R"({"kd": [0.5, 0.5, 0.5], "roughness": 0.3})"));
+    EXPECT_EQ(lambert.materials[0].flags & gpu::kMaterialDisney, 0u);
+}
+
+TEST(SceneLoader, BadDisneyMaterialsNameTheField) {
+    struct Bad {
+        const char* material;
+        const char* field;
+    };
+    for (const Bad& b : {Bad{R"({"base_color": [0.5, 0.5, 0.5], "kd": [0.5, 0.5, 0.5]})", "kd"},
+                         Bad{R"({"ks": [0.5, 0.5, 0.5], "sheen": 0.5})", "ks"},
+                         Bad{R"({"metallic": 1.5})", "metallic"}, Bad{R"({"metallic": -0.1})", "metallic"},
+                         Bad{R"({"specular": 2})", "specular"}, Bad{R"({"specular_tint": "a"})", "specular_tint"},
+                         Bad{R"({"sheen": -1})", "sheen"}, Bad{R"({"sheen_tint": 1.01})", "sheen_tint"},
+                         Bad{R"({"clearcoat": 1e9})", "clearcoat"}, Bad{R"({"clearcoat_gloss": -0.5})", "clearcoat_gloss"},
+                         Bad{R"({"base_color": [0.5, 1.5, 0.5]})", "base_color[1]"},
+                         Bad{R"({"metallic": 0.5, "roughness": 0})", "roughness"}}) {
+        TempDir dir;
+        const fs::path file = scene_with_material(dir, b.material);
+        const std::string message = input_error_of([&] { load_scene(file); });
+        const std::string start = file.lexically_normal().string() + ": meshes[0].material." + b.field + ": ";
+        EXPECT_EQ(message.rfind(start, 0), 0u) << b.material << " -> " << message;
+    }
+}
+
+TEST(SceneLoader, MtlPbrKeysMakeADisneyMaterial) {
+    TempDir dir;
+    dir.write("pbr.mtl", R"(newmtl coated
+Kd 0.6 0.5 0.4
+Ks 0.9 0.9 0.9
+Pr 0.3
+Pc 0.7
+Pcr 0.2
+
+newmtl metal
+Kd 0.9 0.8 0.5
+Pm 1
+Ps 0.4
+
+newmtl plain
+Kd 0.2 0.3 0.4
+Pr 0.5
+)");
+    dir.write("pbr.obj", R"(mtllib pbr.mtl
+v 0 0 0
+v 1 0 0
+v 0 1 0
+usemtl coated
+f 1 2 3
+usemtl metal
+f 1 2 3
+usemtl plain
+f 1 2 3
+)");
+    const Scene scene = load_scene(dir.write("pbr.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "pbr.obj"}],
+ "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]}
+)"));
+    ASSERT_EQ(scene.materials.size(), 3u);
+    const gpu::Material& coated = scene.materials[0];
+    EXPECT_NE(coated.flags & gpu::kMaterialDisney, 0u);
+    EXPECT_NE(coated.flags & gpu::kMaterialHasClearcoat, 0u);
+    EXPECT_EQ(coated.flags & gpu::kMaterialHasSheen, 0u);
+    expect_near({coated.kd_r, coated.kd_g, coated.kd_b}, {0.6f, 0.5f, 0.4f});
+    EXPECT_FLOAT_EQ(coated.roughness, 0.3f);
+    EXPECT_FLOAT_EQ(coated.clearcoat, 0.7f);
+    EXPECT_FLOAT_EQ(coated.clearcoat_gloss, 0.8f);
+    EXPECT_FLOAT_EQ(coated.metallic, 0.0f);
+
+    const gpu::Material& metal = scene.materials[1];
+    EXPECT_NE(metal.flags & gpu::kMaterialDisney, 0u);
+    EXPECT_NE(metal.flags & gpu::kMaterialHasSheen, 0u);
+    EXPECT_FLOAT_EQ(metal.metallic, 1.0f);
+    EXPECT_FLOAT_EQ(metal.sheen, 0.4f);
+    EXPECT_FLOAT_EQ(metal.roughness, 0.5f);  // no Pr: the default
+
+    const gpu::Material& plain = scene.materials[2];
+    EXPECT_EQ(plain.flags & gpu::kMaterialDisney, 0u);  // Pr alone: Lambert + GGX as before
+    EXPECT_NEAR(plain.alpha, 0.25f, 1e-6f);
+
+    // Out of range: the error names the key.
+    dir.write("pbr.mtl", "newmtl coated\nKd 0.6 0.5 0.4\nPm 1.5\n");
+    dir.write("pbr.obj", "mtllib pbr.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl coated\nf 1 2 3\n");
+    const fs::path bad = dir.path() / "pbr.json";
+    const std::string message = input_error_of([&] { load_scene(bad); });
+    EXPECT_NE(message.find("material 'coated'.Pm: "), std::string::npos) << message;
+}
+
 TEST(SceneLoader, TransformAppliesScaleThenRotateXyzThenTranslate) {
     const Scene scene = load_scene(kFixtures / "transform.json");
     ASSERT_EQ(scene.triangles.size(), 5u);

@@ -88,6 +88,30 @@ gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj
         }
         ke[i] = static_cast<float>(mtl.emission[i]);
     }
+    const auto unit = [&](tinyobj::real_t v, const char* key) {
+        if (!std::isfinite(v) || v < 0.0 || v > 1.0) {
+            throw InputError(obj_name, field + "." + key, "must be in [0, 1], got " + std::to_string(v));
+        }
+        return static_cast<float>(v);
+    };
+    // The PBR extension (Pm, Ps, Pc, Pcr) makes a Disney material. tinyobj
+    // reports an absent key as 0, so only a non-zero value counts as given.
+    const float metallic = unit(mtl.metallic, "Pm");
+    const float sheen = unit(mtl.sheen, "Ps");
+    const float clearcoat = unit(mtl.clearcoat_thickness, "Pc");
+    const float clearcoat_roughness = unit(mtl.clearcoat_roughness, "Pcr");
+    if (metallic > 0.0f || sheen > 0.0f || clearcoat > 0.0f || clearcoat_roughness > 0.0f) {
+        DisneyParams p;
+        p.base_color = kd;
+        p.roughness = mtl.roughness > 0.0 ? unit(mtl.roughness, "Pr") : kDefaultRoughness;
+        p.metallic = metallic;
+        p.sheen = sheen;
+        p.clearcoat = clearcoat;
+        p.clearcoat_gloss = 1.0f - clearcoat_roughness;
+        gpu::Material m = make_disney_material(p);
+        set_emission(m, ke, false);
+        return m;
+    }
     const glm::vec3 ks = rgb(mtl.specular, "Ks");
     // tinyobj leaves roughness at 0 when the MTL has no "Pr", so Pr = 0 means
     // "not given" and the Blinn-Phong exponent decides (Walter et al. 2007).

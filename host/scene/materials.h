@@ -52,8 +52,10 @@ void set_texture(gpu::Material& m, std::uint32_t gpu::Material::*slot, std::uint
 // The material faces get when they name none.
 gpu::Material default_material();
 
-// One MTL entry (Ke is its emission, one-sided). Throws InputError naming
-// obj_name and "material 'NAME'.KEY".
+// One MTL entry (Ke is its emission, one-sided): Lambert + GGX from Kd, Ks,
+// Pr or Ns; a Disney material where any of Pm, Ps, Pc, Pcr is non-zero
+// (docs/scene-format.md). Throws InputError naming obj_name and
+// "material 'NAME'.KEY".
 gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj_name);
 
 }  // namespace lc::loader

@@ -184,17 +184,40 @@ private:
         return t;
     }
 
+    // A material naming any Disney key is a Disney material (roughness is
+    // shared by both kinds); kd and ks belong to Lambert + GGX only.
     gpu::Material parse_material_override(const json& j, const std::string& path) const {
         in_.expect_object(j, path);
-        in_.check_keys(j, path, {"kd", "ks", "roughness", "emission", "emission_two_sided"});
-        glm::vec3 kd{kDefaultAlbedo}, ks{0.0f};
+        in_.check_keys(j, path, {"kd", "ks", "roughness", "emission", "emission_two_sided", "base_color", "metallic",
+                                 "specular", "specular_tint", "sheen", "sheen_tint", "clearcoat",
+                                 "clearcoat_gloss"});
+        const char* disney_key = nullptr;
+        for (const char* key : {"base_color", "metallic", "specular", "specular_tint", "sheen", "sheen_tint",
+                                "clearcoat", "clearcoat_gloss"}) {
+            if (JsonReader::find(j, key) != nullptr) {
+                disney_key = key;
+                break;
+            }
+        }
         float roughness = kDefaultRoughness;
-        if (const json* v = JsonReader::find(j, "kd")) kd = in_.colour(*v, path + ".kd", 1.0f);
-        if (const json* v = JsonReader::find(j, "ks")) ks = in_.colour(*v, path + ".ks", 1.0f);
         if (const json* v = JsonReader::find(j, "roughness")) {
             roughness = in_.number_in(*v, path + ".roughness", 0.0f, 1.0f, true, false);
         }
-        gpu::Material m = make_material(kd, ks, roughness * roughness);
+        gpu::Material m;
+        if (disney_key != nullptr) {
+            for (const char* key : {"kd", "ks"}) {
+                if (JsonReader::find(j, key) != nullptr) {
+                    in_.fail(path + "." + key, std::string("belongs to Lambert + GGX materials; this one is a Disney "
+                                                           "material (it has \"") + disney_key + "\"): use base_color");
+                }
+            }
+            m = make_disney_material(parse_disney(j, path, roughness));
+        } else {
+            glm::vec3 kd{kDefaultAlbedo}, ks{0.0f};
+            if (const json* v = JsonReader::find(j, "kd")) kd = in_.colour(*v, path + ".kd", 1.0f);
+            if (const json* v = JsonReader::find(j, "ks")) ks = in_.colour(*v, path + ".ks", 1.0f);
+            m = make_material(kd, ks, roughness * roughness);
+        }
         glm::vec3 emission{0.0f};
         if (const json* v = JsonReader::find(j, "emission"))
             emission = in_.colour(*v, path + ".emission", std::numeric_limits<float>::max());
@@ -202,6 +225,23 @@ private:
         if (const json* v = JsonReader::find(j, "emission_two_sided")) two_sided = in_.boolean(*v, path + ".emission_two_sided");
         set_emission(m, emission, two_sided);
         return m;
+    }
+
+    DisneyParams parse_disney(const json& j, const std::string& path, float roughness) const {
+        DisneyParams p;
+        p.roughness = roughness;
+        if (const json* v = JsonReader::find(j, "base_color")) p.base_color = in_.colour(*v, path + ".base_color", 1.0f);
+        const auto unit = [&](const char* key, float& out) {
+            if (const json* v = JsonReader::find(j, key)) out = in_.number_in(*v, path + "." + key, 0.0f, 1.0f, false, false);
+        };
+        unit("metallic", p.metallic);
+        unit("specular", p.specular);
+        unit("specular_tint", p.specular_tint);
+        unit("sheen", p.sheen);
+        unit("sheen_tint", p.sheen_tint);
+        unit("clearcoat", p.clearcoat);
+        unit("clearcoat_gloss", p.clearcoat_gloss);
+        return p;
     }
 
     void parse_meshes(const json& j) {

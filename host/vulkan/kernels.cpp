@@ -24,6 +24,9 @@ struct SpecData {
     VkBool32 enable_oriented;
     VkBool32 stochastic;
     VkBool32 enable_textures;
+    VkBool32 enable_disney;
+    VkBool32 enable_sheen;
+    VkBool32 enable_clearcoat;
 };
 
 Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const KernelCode& code,
@@ -48,6 +51,9 @@ Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const Ker
         {gpu::kSpecEnableOriented, offsetof(SpecData, enable_oriented), sizeof(VkBool32)},
         {gpu::kSpecStochastic, offsetof(SpecData, stochastic), sizeof(VkBool32)},
         {gpu::kSpecEnableTextures, offsetof(SpecData, enable_textures), sizeof(VkBool32)},
+        {gpu::kSpecEnableDisney, offsetof(SpecData, enable_disney), sizeof(VkBool32)},
+        {gpu::kSpecEnableSheen, offsetof(SpecData, enable_sheen), sizeof(VkBool32)},
+        {gpu::kSpecEnableClearcoat, offsetof(SpecData, enable_clearcoat), sizeof(VkBool32)},
     };
     VkSpecializationInfo spec_info{};
     spec_info.mapEntryCount = std::uint32_t(std::size(entries));
@@ -83,6 +89,9 @@ Kernels::Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMetho
     spec.enable_oriented = switches.oriented;
     spec.stochastic = method.stochastic();
     spec.enable_textures = switches.textures;
+    spec.enable_disney = switches.disney;
+    spec.enable_sheen = switches.sheen;
+    spec.enable_clearcoat = switches.clearcoat;
     primary_ = compute_pipeline(
         ctx, layout, {lc_spirv_primary, sizeof lc_spirv_primary, "primary.comp (camera rays)"}, spec);
     shading_ = compute_pipeline(ctx, layout, method.kernel(), spec);

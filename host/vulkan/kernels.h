@@ -16,6 +16,9 @@ struct KernelSwitches {
     bool shadows = true;             // compile shadow rays in
     bool oriented = true;            // compile spot and oriented lights (emission cones) in
     bool textures = true;            // compile texture lookups in
+    bool disney = true;              // compile the Disney BRDF in
+    bool sheen = true;               // ... and its sheen lobe
+    bool clearcoat = true;           // ... and its clearcoat lobe
     std::uint32_t spill_stride = 1;  // invocations the heap spill buffer is laid out for
 };
 

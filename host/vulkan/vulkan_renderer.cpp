@@ -85,7 +85,8 @@ RenderSetup::RenderSetup(const Context& context, const PreparedScene& prepared,
       kernels(context, resources.pipeline_layout(), *method,
               {tuning.force_ggx || prepared.has_specular, tuning.force_shadows || prepared.has_occluders,
                tuning.force_oriented || prepared.has_oriented, tuning.force_textures || prepared.has_textures,
-               resources.tiles().invocations}),
+               tuning.force_disney || prepared.has_disney, tuning.force_sheen || prepared.has_sheen,
+               tuning.force_clearcoat || prepared.has_clearcoat, resources.tiles().invocations}),
       pass(context, resources, kernels, *method, timestamps) {}
 
 RenderSetup::~RenderSetup() { ctx.fn().vkDeviceWaitIdle(ctx.device().get()); }
@@ -99,6 +100,9 @@ Tuning Tuning::from_environment() {
         tuning.force_shadows = all || features.find("shadows") != std::string::npos;
         tuning.force_oriented = all || features.find("oriented") != std::string::npos;
         tuning.force_textures = all || features.find("textures") != std::string::npos;
+        tuning.force_disney = all || features.find("disney") != std::string::npos;
+        tuning.force_sheen = all || features.find("sheen") != std::string::npos;
+        tuning.force_clearcoat = all || features.find("clearcoat") != std::string::npos;
     }
     if (const char* v = std::getenv("LC_VK_MAX_TILE_PIXELS"))
         tuning.max_tile_pixels = std::uint32_t(std::strtoul(v, nullptr, 10));

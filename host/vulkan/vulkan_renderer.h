@@ -15,6 +15,9 @@ struct Tuning {
     bool force_shadows = false;
     bool force_oriented = false;
     bool force_textures = false;
+    bool force_disney = false;
+    bool force_sheen = false;
+    bool force_clearcoat = false;
     // Largest tile, in pixels (0: limited only by the buffer limits).
     std::uint32_t max_tile_pixels = 0;
     // Tiles are resized so one dispatch takes about this long.
@@ -27,7 +30,7 @@ struct Tuning {
     std::uint32_t lights_per_dispatch = 0;
     std::uint32_t refinements_per_dispatch = 0;
 
-    // LC_VK_FORCE_FEATURES=ggx,shadows,oriented,textures (or all), LC_VK_MAX_TILE_PIXELS=N, LC_VK_TARGET_MS=X,
+    // LC_VK_FORCE_FEATURES=ggx,shadows,oriented,textures,disney,sheen,clearcoat (or all), LC_VK_MAX_TILE_PIXELS=N, LC_VK_TARGET_MS=X,
     // LC_VK_LIGHTS_PER_DISPATCH=N, LC_VK_REFINEMENTS_PER_DISPATCH=N.
     static Tuning from_environment();
 };

@@ -27,6 +27,9 @@ struct PreparedScene {
     bool has_occluders = true;   // false: no triangle can block a light
     bool has_oriented = false;   // any spot or oriented light (emission cones matter)
     bool has_textures = false;   // any material with a texture
+    bool has_disney = false;     // any Disney material
+    bool has_sheen = false;      // ... with a sheen lobe
+    bool has_clearcoat = false;  // ... with a clearcoat lobe
     // Lights made from emissive triangles and from the environment (they are
     // in the tree, after the scene's own lights), and the time that took.
     std::size_t area_lights = 0;

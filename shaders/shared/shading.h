@@ -9,10 +9,12 @@
 //   LC_LIGHT(i)      -> Light
 //   LC_ENVIRONMENT_TEXEL(i) -> vec3 (radiance of environment texel i)
 //   LC_VPL_MIN_DISTANCE2 -> float (FrameParams.vpl_min_distance2)
-// and the feature switches kEnableGgx, kEnableShadows, kEnableOriented and kEnableTextures
+// and the feature switches kEnableGgx, kEnableShadows, kEnableOriented,
+// kEnableTextures, kEnableDisney, kEnableSheen and kEnableClearcoat
 // (specialization constants on the GPU, so a scene without GGX materials,
-// without occluders or without spot and oriented lights gets a kernel
-// without that code; always true on the CPU).
+// without occluders, without spot and oriented lights or without Disney
+// materials (or their sheen or clearcoat lobes) gets a kernel without that
+// code; always true on the CPU).
 // No include guard: each kernel context (a GLSL shader, a C++ kernel
 // struct in host/cpu_kernel.h) includes it exactly once.
 
@@ -201,7 +203,88 @@ float lc_smith_g1(float cos_v, float alpha) {
 vec3 lc_kd(Material m) { return vec3(m.kd_r, m.kd_g, m.kd_b); }
 vec3 lc_ks(Material m) { return vec3(m.ks_r, m.ks_g, m.ks_b); }
 
+// --- The Disney BRDF (Burley 2012, "Physically-Based Shading at Disney",
+// and its BRDF Explorer's disney.brdf): isotropic, without subsurface and
+// transmission. With cos_d = wi.h = wo.h and w(c) = (1 - c)^5 (Schlick's
+// weight), f is the sum of
+//   diffuse:   base/pi (1 - metallic) F_L F_V, F_x = 1 + (F_D90 - 1) w(cos_x),
+//              F_D90 = 0.5 + 2 roughness cos_d^2 (retro-reflection);
+//   sheen:     sheen mix(1, tint, sheen_tint) w(cos_d) (1 - metallic);
+//   specular:  GGX(alpha) D G1(wi) G1(wo) / (4 cos_i cos_o) times Schlick's
+//              Fresnel from Cspec0 = mix(0.08 specular mix(1, tint,
+//              specular_tint), base, metallic);
+//   clearcoat: 0.25 clearcoat GTR1(alpha_c) G1(wi; 0.25) G1(wo; 0.25) /
+//              (4 cos_i cos_o) times Schlick's Fresnel from 0.04,
+//              alpha_c = mix(0.1, 0.001, clearcoat_gloss);
+// tint = base / luminance(base) (white for black). As in Burley's code the
+// whole BRDF is zero when wo is below the shading normal.
+float lc_schlick_weight(float cos_x) {
+    float m = clamp(1.0f - cos_x, 0.0f, 1.0f);
+    float m2 = m * m;
+    return m2 * m2 * m;
+}
+
+vec3 lc_disney_tint(Material m) {
+    vec3 base = lc_kd(m);
+    float lum = lc_luminance(base);
+    return lum > 0.0f ? base / lum : vec3(1.0f);
+}
+
+// Reflectance of the specular lobe at normal incidence.
+vec3 lc_disney_spec0(Material m) {
+    vec3 tinted = mix(vec3(1.0f), lc_disney_tint(m), m.specular_tint);
+    return mix(tinted * (0.08f * m.specular), lc_kd(m), m.metallic);
+}
+
+vec3 lc_disney_sheen_color(Material m) {
+    return m.sheen * mix(vec3(1.0f), lc_disney_tint(m), m.sheen_tint) * (1.0f - m.metallic);
+}
+
+float lc_clearcoat_alpha(Material m) { return mix(0.1f, 0.001f, m.clearcoat_gloss); }
+LC_KCONST float kClearcoatSmithAlpha = 0.25f;
+
+// Burley's GTR1 (Berry) distribution for alpha < 1; grows with cos_h like
+// GGX. The denominator written as in lc_ggx_d.
+float lc_gtr1_d(float cos_h, float alpha) {
+    float a2 = alpha * alpha;
+    float c2 = cos_h * cos_h;
+    return (a2 - 1.0f) / (kPi * log(a2) * ((1.0f - c2) + a2 * c2));
+}
+
+// The diffuse lobe times cos_i, for a given F_D90.
+vec3 lc_disney_diffuse(Material m, float fd90, float cos_i, float cos_o) {
+    float fl = 1.0f + (fd90 - 1.0f) * lc_schlick_weight(cos_i);
+    float fv = 1.0f + (fd90 - 1.0f) * lc_schlick_weight(cos_o);
+    return lc_kd(m) * ((1.0f - m.metallic) * fl * fv * cos_i / kPi);
+}
+
+// The specular and clearcoat lobes share D G1 G1 / (4 cos_o) (times cos_i
+// already); their Fresnel factors are applied by the caller.
+float lc_microfacet_cos(float d, float cos_i, float cos_o, float alpha_g) {
+    return d * lc_smith_g1(cos_i, alpha_g) * lc_smith_g1(cos_o, alpha_g) / (4.0f * cos_o);
+}
+
+vec3 lc_disney_brdf_cos(Material m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
+    float cos_o = dot(n, wo);
+    if (!(cos_o > 0.0f)) return vec3(0.0f);
+    vec3 h = normalize(wi + wo);  // wi and wo are both above n, so wi + wo != 0
+    float cos_h = max(dot(n, h), 0.0f);
+    float cos_d = clamp(dot(wi, h), 0.0f, 1.0f);
+    float w = lc_schlick_weight(cos_d);
+    vec3 value = lc_disney_diffuse(m, 0.5f + 2.0f * m.roughness * cos_d * cos_d, cos_i, cos_o);
+    value += mix(lc_disney_spec0(m), vec3(1.0f), w) *
+             lc_microfacet_cos(lc_ggx_d(cos_h, m.alpha), cos_i, cos_o, m.alpha);
+    if (kEnableSheen && (m.flags & kMaterialHasSheen) != 0u) value += lc_disney_sheen_color(m) * (w * cos_i);
+    if (kEnableClearcoat && (m.flags & kMaterialHasClearcoat) != 0u) {
+        float coat = lc_microfacet_cos(lc_gtr1_d(cos_h, lc_clearcoat_alpha(m)), cos_i, cos_o, kClearcoatSmithAlpha);
+        value += vec3(0.25f * m.clearcoat * mix(0.04f, 1.0f, w) * coat);
+    }
+    return value;
+}
+
+// f * cos(theta_i) of either kind of material; cos_i = n.wi > 0.
 vec3 lc_brdf_cos(Material m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
+    if (kEnableDisney && (m.flags & kMaterialDisney) != 0u) return lc_disney_brdf_cos(m, n, wi, wo, cos_i);
     vec3 value = lc_kd(m) * (cos_i / kPi);
     if (kEnableGgx && (m.flags & kMaterialHasSpecular) != 0u) {
         float cos_o = dot(n, wo);
@@ -360,20 +443,31 @@ float lc_box_distance2(vec3 box_min, vec3 box_max, vec3 x) {
 // half-angle theta_c, from the box's bounding sphere). For fixed wo the map
 // h -> wi = reflect(-wo, h) is 2-Lipschitz in angle and sends n to the mirror
 // direction wr, so angle(h, n) >= max(0, angle(wr, a) - theta_c) / 2.
-float lc_ggx_bound(Material m, vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec3 wo) {
-    float cos_o = dot(n, wo);
-    if (cos_o <= 0.0f) return 0.0f;
+// The cone of directions from x towards the box, from the box's bounding
+// sphere: unit axis a (xyz) and half-angle theta_c (w); w < 0 when x is
+// inside the sphere, where the directions can be any.
+vec4 lc_box_cone(vec3 box_min, vec3 box_max, vec3 x) {
     vec3 c = 0.5f * ((box_min - x) + (box_max - x));  // see lc_cosine_bound
     float radius = 0.5f * length(box_max - box_min);
     float dist = length(c);
-    float cos_h_max = 1.0f;
-    if (dist > radius) {
-        vec3 wr = 2.0f * cos_o * n - wo;
-        float angle_r = acos(clamp(dot(wr, c / dist), -1.0f, 1.0f));
-        float angle_c = asin(clamp(radius / dist, 0.0f, 1.0f));
-        float delta = max(angle_r - angle_c, 0.0f);
-        cos_h_max = min(cos(0.5f * delta) * kBoundSlack, 1.0f);
-    }
+    if (!(dist > radius)) return vec4(0.0f, 0.0f, 1.0f, -1.0f);
+    return vec4(c / dist, asin(clamp(radius / dist, 0.0f, 1.0f)));
+}
+
+// The largest cos(theta_h) of any wi in the cone, for the view wo
+// (cos_o = n.wo > 0); the argument is lc_ggx_bound's.
+float lc_cos_h_max(vec4 cone, vec3 n, vec3 wo, float cos_o) {
+    if (cone.w < 0.0f) return 1.0f;
+    vec3 wr = 2.0f * cos_o * n - wo;
+    float angle_r = acos(clamp(dot(wr, vec3(cone)), -1.0f, 1.0f));
+    float delta = max(angle_r - cone.w, 0.0f);
+    return min(cos(0.5f * delta) * kBoundSlack, 1.0f);
+}
+
+float lc_ggx_bound(Material m, vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec3 wo) {
+    float cos_o = dot(n, wo);
+    if (cos_o <= 0.0f) return 0.0f;
+    float cos_h_max = lc_cos_h_max(lc_box_cone(box_min, box_max, x), n, wo, cos_o);
     return lc_ggx_d(cos_h_max, m.alpha) * lc_smith_g1(cos_o, m.alpha) / (4.0f * cos_o) *
            kBoundSlack;
 }
@@ -422,6 +516,50 @@ float lc_emission_bound(LightNode node, vec3 x) {
     return s * s;
 }
 
+// The range (min, max) of cos_d = wi.h = cos(angle(wi, wo) / 2) over the
+// directions wi in the cone: by the triangle inequality on the sphere,
+// angle(wi, wo) lies within angle(wo, a) -+ theta_c, widened by kAngleSlack
+// for acos's rounding (docs/disney-bounds.md).
+vec2 lc_cos_d_range(vec4 cone, vec3 wo) {
+    if (cone.w < 0.0f) return vec2(0.0f, 1.0f);
+    float angle_o = lc_safe_acos(dot(wo, vec3(cone)));
+    float nearest = max(angle_o - cone.w - kAngleSlack, 0.0f);
+    float farthest = min(angle_o + cone.w + kAngleSlack, kPi);
+    return vec2(max(cos(0.5f * farthest) / kBoundSlack - kCosineAbsSlack, 0.0f),
+                min(cos(0.5f * nearest) * kBoundSlack, 1.0f));
+}
+
+// Bound of the Disney BRDF times cos(theta_i) over every wi towards the box
+// (relative to x), lobe by lobe (docs/disney-bounds.md): the diffuse lobe's
+// F_D90 at the largest cos_d, Schlick's weight (sheen, both Fresnel factors)
+// at the smallest cos_d, GGX and GTR1 at the largest cos_h. cos_bound bounds
+// cos(theta_i).
+vec3 lc_disney_bound(Material m, vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec3 wo, float cos_bound) {
+    float cos_o = dot(n, wo);
+    if (!(cos_o > 0.0f)) return vec3(0.0f);
+    vec4 cone = lc_box_cone(box_min, box_max, x);
+    vec2 cos_d = lc_cos_d_range(cone, wo);
+    // F_L lies between 1 and F_D90; F_V grows with F_D90.
+    float fd90 = 0.5f + 2.0f * m.roughness * cos_d.y * cos_d.y;
+    float retro = max(fd90, 1.0f) * (1.0f + (fd90 - 1.0f) * lc_schlick_weight(cos_o));
+    vec3 bound = lc_kd(m) * ((1.0f - m.metallic) * retro * cos_bound / kPi);
+#ifdef LC_SEED_LOBE_BOUND
+    // The seed report's bound of 1 for every other lobe (benchmarks only).
+    if (LC_SEED_LOBE_BOUND) return bound * kBoundSlack + vec3(1.0f);
+#endif
+    float w = lc_schlick_weight(cos_d.x);
+    float cos_h_max = lc_cos_h_max(cone, n, wo, cos_o);
+    float ggx = lc_ggx_d(cos_h_max, m.alpha) * lc_smith_g1(cos_o, m.alpha) / (4.0f * cos_o);
+    bound += mix(lc_disney_spec0(m), vec3(1.0f), w) * ggx;
+    if (kEnableSheen && (m.flags & kMaterialHasSheen) != 0u) bound += lc_disney_sheen_color(m) * (w * cos_bound);
+    if (kEnableClearcoat && (m.flags & kMaterialHasClearcoat) != 0u) {
+        float coat = lc_gtr1_d(cos_h_max, lc_clearcoat_alpha(m)) * lc_smith_g1(cos_o, kClearcoatSmithAlpha) /
+                     (4.0f * cos_o);
+        bound += vec3(0.25f * m.clearcoat * mix(0.04f, 1.0f, w) * coat);
+    }
+    return bound * kBoundSlack;
+}
+
 // Bound of material * geometry * emission (per unit intensity, RGB) over
 // every light of a cluster, read from its node. Positional lights: the box
 // holds positions, G <= 1/d_min^2 with the same clamp as the exact term.
@@ -441,6 +579,8 @@ vec3 lc_cluster_bound(SurfacePoint sp, Material m, LightNode node, float min_dis
         factor *= kBoundSlack / max(lc_box_distance2(box_min, box_max, sp.p),
                                     lc_falloff_clamp2(min_distance2, lc_node_type(node)));
     }
+    if (kEnableDisney && (m.flags & kMaterialDisney) != 0u)
+        return lc_disney_bound(m, box_min, box_max, x, sp.n, sp.wo, cos_bound) * factor;
     vec3 bound = lc_kd(m) * (cos_bound / kPi);
     if (kEnableGgx && (m.flags & kMaterialHasSpecular) != 0u)
         bound += lc_ks(m) * lc_ggx_bound(m, box_min, box_max, x, sp.n, sp.wo);

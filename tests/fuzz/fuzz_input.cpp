@@ -65,6 +65,9 @@ std::string check_scene_contract(const Scene& s) {
         if (!(m.alpha >= 1e-3f && m.alpha <= 1.0f)) return "GGX alpha out of [1e-3, 1]";
         const bool specular = m.ks_r > 0.0f || m.ks_g > 0.0f || m.ks_b > 0.0f;
         if (specular != ((m.flags & gpu::kMaterialHasSpecular) != 0u)) return "specular flag disagrees with ks";
+        for (float v : {m.roughness, m.metallic, m.specular, m.specular_tint, m.sheen, m.sheen_tint, m.clearcoat,
+                        m.clearcoat_gloss})
+            if (!(v >= 0.0f && v <= 1.0f)) return "Disney parameter out of [0, 1]";
         const glm::vec3 e(m.emission_r, m.emission_g, m.emission_b);
         if (!finite(e) || e.r < 0.0f || e.g < 0.0f || e.b < 0.0f) return "emission invalid";
         const bool emits = e.r > 0.0f || e.g > 0.0f || e.b > 0.0f;

@@ -208,8 +208,8 @@ TEST_F(Vulkan, TinyMaxCutMatchesCpu) {
     expect_lightcuts_matches(p, o, gpu(p, o));
 }
 
-// Specialization constants switch GGX, shadow rays and the spot/oriented
-// light code off for scenes that cannot use them; forcing them on must not
+// Specialization constants switch GGX, shadow rays, the spot/oriented
+// light code and the Disney lobes off for scenes that cannot use them; forcing them on must not
 // change the image.
 TEST_F(Vulkan, FeatureSwitchesDoNotChangeTheImage) {
     Scene s;
@@ -227,6 +227,9 @@ TEST_F(Vulkan, FeatureSwitchesDoNotChangeTheImage) {
     all.force_shadows = true;
     all.force_oriented = true;
     all.force_textures = true;
+    all.force_disney = true;
+    all.force_sheen = true;
+    all.force_clearcoat = true;
     for (const char* method : {"brute", "lightcuts"}) {
         RenderOptions o = options(method, 24, 24);
         RenderResult off = gpu(p, o), on = gpu(p, o, all);

@@ -4,9 +4,10 @@
 // against lightcuts at error 0 over the sampled lights on both devices; and
 // the stochastic methods (sampled, stochastic) on both devices; and all of
 // that again with indirect light as virtual point lights, with and without
-// their falloff clamp.
+// their falloff clamp, and on the Disney materials scene (scenes/materials).
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -59,24 +60,40 @@ Scene light_model_scene(std::uint32_t seed, bool spots, bool emitters, bool envi
     return s;
 }
 
-struct Case {
-    const char* name;
-    bool spots, emitters, environment;
-    float vpl_clamp = -1.0f;  // >= 0: with 1500 VPLs and this clamp
-};
-
-Scene light_model_scene(std::uint32_t seed, const Case& c) {
-    return light_model_scene(seed, c.spots, c.emitters, c.environment, c.vpl_clamp);
-}
-
-class VulkanLights : public Vulkan, public ::testing::WithParamInterface<Case> {};
-
 // Measured on lavapipe: at most 6.5e-6 for the area lights and the
 // environment, but 3.1e-5 at one pixel of the spot scene (brute force and
 // lightcuts alike: one spot's contribution, near its cone's edge or behind
 // an edge, rounds differently with the device's FMA), against 2e-5 for
 // point lights (kBruteRelative). About 3x that.
 constexpr double kLightModelRelative = 1e-4;
+
+// The Disney scene's sharp microfacet peaks amplify the devices' different
+// rounding of cos(theta_h): GGX by about 4 / alpha^2, GTR1 by 2 / alpha_c^2
+// per unit of cos(theta_h) error, and the car paint's clearcoat (gloss 0.9,
+// alpha_c = 0.011) turns a few ulps (~1.2e-7) into ~2e-3 in that term.
+// Measured on lavapipe: brute force 1.4e-4 (many lights average it out),
+// stochastic lightcuts 5.2e-4 (measured before that test skipped shipped
+// scenes), lightcuts 4.0e-3 at a pixel whose cut is one representative in
+// the highlight. About 2x that.
+constexpr double kDisneyRelative = 1e-3;
+constexpr double kDisneyLightcutsRelative = 8e-3;
+
+struct Case {
+    const char* name;
+    bool spots, emitters, environment;
+    float vpl_clamp = -1.0f;      // >= 0: with 1500 VPLs and this clamp
+    const char* file = nullptr;   // a shipped scene (relative to the source tree) instead
+    double relative = kLightModelRelative;             // brute force and other per-light sums
+    double lightcuts_relative = vulkan_test::kLightcutsRelative;
+};
+
+Scene light_model_scene(std::uint32_t seed, const Case& c) {
+    if (c.file != nullptr) return load_scene(std::filesystem::path(LC_SOURCE_DIR) / c.file);
+    return light_model_scene(seed, c.spots, c.emitters, c.environment, c.vpl_clamp);
+}
+
+class VulkanLights : public Vulkan, public ::testing::WithParamInterface<Case> {};
+
 
 TEST_P(VulkanLights, BruteAndLightcutsMatchCpu) {
     const Case& c = GetParam();
@@ -85,11 +102,11 @@ TEST_P(VulkanLights, BruteAndLightcutsMatchCpu) {
     EXPECT_EQ(p.has_oriented, c.spots || c.emitters || indirect);
     EXPECT_EQ(p.vpls > 0, indirect);
     const RenderOptions brute = options("brute", 40, 32);
-    expect_brute_matches(p, brute, gpu(p, brute), kLightModelRelative);
+    expect_brute_matches(p, brute, gpu(p, brute), c.relative);
     RenderOptions lc = options("lightcuts", 40, 32);
     lc.max_cut = 200;
     const RenderResult g = gpu(p, lc);
-    expect_lightcuts_matches(p, lc, g);
+    expect_lightcuts_matches(p, lc, g, c.lightcuts_relative);
     // The cut's VPL clusters are counted alike (pixels whose cut differs by
     // rounding may move the sum a little, as the cut sizes).
     const RenderResult cpu = render_cpu(p, lc);
@@ -115,8 +132,8 @@ TEST_P(VulkanLights, ZeroErrorLightcutsIsBruteForce) {
                                                    kOrderOfSums),
               kOrderOfSums);
     EXPECT_LE(vulkan_test::max_relative_difference(gpu(p, lc).image, reference.image, "vulkan error 0",
-                                                   kLightModelRelative),
-              kLightModelRelative);
+                                                   c.relative),
+              c.relative);
 }
 
 // The stochastic methods on both devices with the same seed: the same
@@ -126,6 +143,11 @@ TEST_P(VulkanLights, ZeroErrorLightcutsIsBruteForce) {
 // pixels may differ by a light's contribution; they are only counted.
 TEST_P(VulkanLights, SampledAndStochasticMatchCpu) {
     const Case& c = GetParam();
+    // A shipped scene tests its materials, which brute force and lightcuts
+    // above already shade with every light; the sampled methods differ from
+    // them only in which lights they pick, which the light-model cases test
+    // (and the Disney scene would add half a minute to the suite).
+    if (c.file != nullptr) GTEST_SKIP() << "materials covered by BruteAndLightcutsMatchCpu";
     PreparedScene p = prepare_scene(light_model_scene(33, c), 1);
     struct Method {
         const char* method;
@@ -145,7 +167,7 @@ TEST_P(VulkanLights, SampledAndStochasticMatchCpu) {
         // sampling kTreePdfRelative.
         const double tolerance = std::string(m.pick) == "tree" && std::string(m.method) == "sampled"
                                      ? vulkan_test::kTreePdfRelative
-                                     : kLightModelRelative;
+                                     : c.relative;
         std::vector<bool> differs(std::size_t(40) * 32, false);
         std::size_t differing = 0;
         for (std::size_t i = 0; i < differs.size(); ++i)
@@ -178,6 +200,7 @@ TEST_P(VulkanLights, SampledAndStochasticMatchCpu) {
 // images are those of one dispatch, up to the order of the sums.
 TEST_P(VulkanLights, SampledAndStochasticSplitOverDispatches) {
     const Case& c = GetParam();
+    if (c.file != nullptr) GTEST_SKIP() << "as SampledAndStochasticMatchCpu";
     PreparedScene p = prepare_scene(light_model_scene(34, c), 1);
     vk::Tuning split;
     split.lights_per_dispatch = 2;
@@ -202,7 +225,10 @@ INSTANTIATE_TEST_SUITE_P(Kinds, VulkanLights,
                          ::testing::Values(Case{"spots", true, false, false}, Case{"area", false, true, false},
                                            Case{"environment", false, false, true}, Case{"all", true, true, true},
                                            Case{"indirect", false, true, false, 0.0f},
-                                           Case{"indirect_clamped", true, true, true, 0.5f}),
+                                           Case{"indirect_clamped", true, true, true, 0.5f},
+                                           // Disney spheres: every lobe, 2000 point lights.
+                                           Case{"disney", false, false, false, -1.0f, "scenes/materials/materials.json",
+                                                kDisneyRelative, kDisneyLightcutsRelative}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 }  // namespace

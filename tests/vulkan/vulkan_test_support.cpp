@@ -108,7 +108,7 @@ void expect_brute_matches(const PreparedScene& p, const RenderOptions& o, const 
 // A pixel whose cut differs by a cluster differs by up to the error
 // threshold; the others only by rounding.
 void expect_lightcuts_matches(const PreparedScene& p, const RenderOptions& o,
-                              const RenderResult& g) {
+                              const RenderResult& g, double relative) {
     const RenderResult c = render_cpu(p, o);
     ASSERT_EQ(g.image.width, c.image.width);
     ASSERT_EQ(g.image.height, c.image.height);
@@ -122,8 +122,7 @@ void expect_lightcuts_matches(const PreparedScene& p, const RenderOptions& o,
                 (p.vpls ? kVplCutsDifferFraction : kCutsDifferFraction) * double(cut_differs.size()));
     const double cuts_differ = p.vpls ? kVplCutsDifferFraction : kCutsDifferFraction;
     EXPECT_LE(double(differing), cuts_differ * double(cut_differs.size()));
-    EXPECT_LE(max_relative_difference(g.image, c.image, "lightcuts", kLightcutsRelative, cut_differs),
-              kLightcutsRelative);
+    EXPECT_LE(max_relative_difference(g.image, c.image, "lightcuts", relative, cut_differs), relative);
     // A refinement casts at most one ray (one child inherits the parent's
     // representative), so a pixel whose cut differs by d clusters may cast
     // up to d rays more or fewer.

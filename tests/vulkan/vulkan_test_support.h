@@ -96,7 +96,7 @@ void expect_brute_matches(const PreparedScene& p, const RenderOptions& o, const 
 // Cut sizes and shadow rays with the tolerances above, or those for VPLs
 // where the scene has them.
 void expect_lightcuts_matches(const PreparedScene& p, const RenderOptions& o,
-                              const RenderResult& g);
+                              const RenderResult& g, double relative = kLightcutsRelative);
 
 std::size_t pixels_with_different_cut(const RenderStats& a, const RenderStats& b);
 // Samples whose Lightcuts heap needs more than `shared_slots` slots (CPU).
