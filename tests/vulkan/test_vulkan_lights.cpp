@@ -93,7 +93,11 @@ Scene light_model_scene(std::uint32_t seed, const Case& c) {
 }
 
 class VulkanLights : public Vulkan, public ::testing::WithParamInterface<Case> {};
-
+// The stochastic methods, on the light-model cases only: they differ from
+// brute force and lightcuts only in which lights they pick, which those
+// cases test; a shipped scene's materials are covered by VulkanLights (and
+// the Disney scene would add half a minute to the suite here).
+class VulkanSampled : public VulkanLights {};
 
 TEST_P(VulkanLights, BruteAndLightcutsMatchCpu) {
     const Case& c = GetParam();
@@ -141,13 +145,8 @@ TEST_P(VulkanLights, ZeroErrorLightcutsIsBruteForce) {
 // the same lights. A descent step whose random number falls within rounding
 // of its branch probability may go the other way on one device, so a few
 // pixels may differ by a light's contribution; they are only counted.
-TEST_P(VulkanLights, SampledAndStochasticMatchCpu) {
+TEST_P(VulkanSampled, SampledAndStochasticMatchCpu) {
     const Case& c = GetParam();
-    // A shipped scene tests its materials, which brute force and lightcuts
-    // above already shade with every light; the sampled methods differ from
-    // them only in which lights they pick, which the light-model cases test
-    // (and the Disney scene would add half a minute to the suite).
-    if (c.file != nullptr) GTEST_SKIP() << "materials covered by BruteAndLightcutsMatchCpu";
     PreparedScene p = prepare_scene(light_model_scene(33, c), 1);
     struct Method {
         const char* method;
@@ -198,9 +197,8 @@ TEST_P(VulkanLights, SampledAndStochasticMatchCpu) {
 // cuts long loops short: light samples in ranges of 2, stochastic cuts
 // paused every 5 steps (refinements and fresh draws, kept in CutState). The
 // images are those of one dispatch, up to the order of the sums.
-TEST_P(VulkanLights, SampledAndStochasticSplitOverDispatches) {
+TEST_P(VulkanSampled, SampledAndStochasticSplitOverDispatches) {
     const Case& c = GetParam();
-    if (c.file != nullptr) GTEST_SKIP() << "as SampledAndStochasticMatchCpu";
     PreparedScene p = prepare_scene(light_model_scene(34, c), 1);
     vk::Tuning split;
     split.lights_per_dispatch = 2;
@@ -221,15 +219,22 @@ TEST_P(VulkanLights, SampledAndStochasticSplitOverDispatches) {
     }
 }
 
+const Case kLightModelCases[] = {Case{"spots", true, false, false},          Case{"area", false, true, false},
+                                 Case{"environment", false, false, true},    Case{"all", true, true, true},
+                                 Case{"indirect", false, true, false, 0.0f},
+                                 Case{"indirect_clamped", true, true, true, 0.5f}};
+// Disney spheres: every lobe, 2000 point lights.
+const Case kDisneyCase{"disney", false, false, false, -1.0f, "scenes/materials/materials.json", kDisneyRelative,
+                       kDisneyLightcutsRelative};
+
+std::string case_name(const ::testing::TestParamInfo<Case>& info) { return info.param.name; }
+
 INSTANTIATE_TEST_SUITE_P(Kinds, VulkanLights,
-                         ::testing::Values(Case{"spots", true, false, false}, Case{"area", false, true, false},
-                                           Case{"environment", false, false, true}, Case{"all", true, true, true},
-                                           Case{"indirect", false, true, false, 0.0f},
-                                           Case{"indirect_clamped", true, true, true, 0.5f},
-                                           // Disney spheres: every lobe, 2000 point lights.
-                                           Case{"disney", false, false, false, -1.0f, "scenes/materials/materials.json",
-                                                kDisneyRelative, kDisneyLightcutsRelative}),
-                         [](const auto& info) { return std::string(info.param.name); });
+                         ::testing::Values(kLightModelCases[0], kLightModelCases[1], kLightModelCases[2],
+                                           kLightModelCases[3], kLightModelCases[4], kLightModelCases[5],
+                                           kDisneyCase),
+                         case_name);
+INSTANTIATE_TEST_SUITE_P(Kinds, VulkanSampled, ::testing::ValuesIn(kLightModelCases), case_name);
 
 }  // namespace
 }  // namespace lc
