@@ -185,18 +185,10 @@ double albedo(Kernel& k, const gpu::Material& m, float view_degrees, int channel
     const glm::vec3 n(0.0f, 0.0f, 1.0f);
     const double a = double(view_degrees) * kPi / 180.0;
     const glm::vec3 wo(float(std::sin(a)), 0.0f, float(std::cos(a)));
-    constexpr int kCells = 400;
     double sum = 0.0;
-    for (int i = 0; i < kCells; ++i) {
-        const double theta = (i + 0.5) * (0.5 * kPi / kCells);
-        const double cell = (0.5 * kPi / kCells) * (2.0 * kPi / kCells) * std::sin(theta);
-        for (int j = 0; j < kCells; ++j) {
-            const double phi = (j + 0.5) * (2.0 * kPi / kCells);
-            const glm::vec3 wi(float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
-                               float(std::cos(theta)));
-            sum += k.lc_brdf_cos(m, n, wi, wo, wi.z)[channel] * cell;
-        }
-    }
+    test::for_hemisphere_cells(400, [&](glm::vec3 wi, double cell) {
+        sum += k.lc_brdf_cos(m, n, wi, wo, wi.z)[channel] * cell;
+    });
     return sum;
 }
 

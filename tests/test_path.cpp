@@ -227,19 +227,11 @@ TEST(PathBsdf, SampledEstimateMatchesQuadrature) {
             const path::LobeWeights lobes = path::lobe_weights(m, n, wo);
             // Midpoint rule, 1000 x 1000 cells of 1.6e-3 rad: the narrowest
             // lobe below (alpha 0.05) is about 2 alpha = 0.1 rad wide.
-            constexpr int kCells = 1000;
             double integral = 0.0, pdf_integral = 0.0;
-            for (int i = 0; i < kCells; ++i) {
-                const double theta = (i + 0.5) * (0.5 * kPi / kCells);
-                const double cell = (0.5 * kPi / kCells) * (2.0 * kPi / kCells) * std::sin(theta);
-                for (int j = 0; j < kCells; ++j) {
-                    const double phi = (j + 0.5) * (2.0 * kPi / kCells);
-                    const glm::vec3 wi(float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
-                                       float(std::cos(theta)));
-                    integral += luminance(k.lc_brdf_cos(m, n, wi, wo, wi.z)) * cell;
-                    pdf_integral += path::bsdf_pdf(k, m, lobes, n, wo, wi) * cell;
-                }
-            }
+            test::for_hemisphere_cells(1000, [&](glm::vec3 wi, double cell) {
+                integral += luminance(k.lc_brdf_cos(m, n, wi, wo, wi.z)) * cell;
+                pdf_integral += path::bsdf_pdf(k, m, lobes, n, wo, wi) * cell;
+            });
             EXPECT_LE(pdf_integral, 1.0 + 1e-3);
             if (lobes.specular == 0.0f) {
                 EXPECT_NEAR(pdf_integral, 1.0, 1e-3);

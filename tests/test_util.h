@@ -47,6 +47,24 @@ private:
 
 // Materials as the loader makes them (host/scene/materials.cpp), without
 // its clamp of alpha: roughness = sqrt(alpha), no textures.
+// The midpoint rule over the upper hemisphere (z > 0): `cells` x `cells`
+// cells in (theta, phi), calling visit(wi, solid_angle_of_the_cell) once at
+// each cell's centre.
+template <typename Visit>
+void for_hemisphere_cells(int cells, Visit&& visit) {
+    constexpr double kPiD = 3.14159265358979323846;
+    for (int i = 0; i < cells; ++i) {
+        const double theta = (i + 0.5) * (0.5 * kPiD / cells);
+        const double cell = (0.5 * kPiD / cells) * (2.0 * kPiD / cells) * std::sin(theta);
+        for (int j = 0; j < cells; ++j) {
+            const double phi = (j + 0.5) * (2.0 * kPiD / cells);
+            visit(glm::vec3(float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)),
+                            float(std::cos(theta))),
+                  cell);
+        }
+    }
+}
+
 // Corner k (0, 1, 2) of a triangle, and its shading normal there.
 inline glm::vec3 vertex(const gpu::Triangle& t, int k) {
     if (k == 0) return {t.v0_x, t.v0_y, t.v0_z};
