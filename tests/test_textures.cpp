@@ -235,6 +235,26 @@ TEST(ObjTextures, MapKdLoadsAndVtTurnsToGrowDownwards) {
     EXPECT_EQ(m.normal_texture, gpu::kInvalidIndex);
 }
 
+// JPEG as well as PNG: a uniform 8 x 8 JPEG decodes to (nearly) its colour.
+TEST(ObjTextures, JpegTexturesLoad) {
+    TempDir dir;
+    const std::vector<std::uint8_t> bytes = rgba_bytes(std::vector<std::uint32_t>(64, rgba(200, 100, 50)));
+    std::vector<std::uint8_t> rgb;
+    for (std::size_t i = 0; i < bytes.size(); i += 4) rgb.insert(rgb.end(), {bytes[i], bytes[i + 1], bytes[i + 2]});
+    ASSERT_NE(stbi_write_jpg((dir.path() / "paint.jpg").string().c_str(), 8, 8, 3, rgb.data(), 95), 0);
+    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd paint.jpg\n");
+    dir.write("quad.obj", kTexturedObj);
+    const Scene s = load_scene(dir.write("scene.json", quad_scene_json()));
+    ASSERT_EQ(s.textures.size(), 1u);
+    EXPECT_EQ(s.textures[0].width, 8u);
+    ASSERT_EQ(s.texels.size(), 64u);
+    const glm::vec4 c = unpack(s.texels[27]) * 255.0f;
+    EXPECT_NEAR(c.x, 200.0f, 3.0f);
+    EXPECT_NEAR(c.y, 100.0f, 3.0f);
+    EXPECT_NEAR(c.z, 50.0f, 3.0f);
+    EXPECT_EQ(c.w, 255.0f);
+}
+
 TEST(ObjTextures, MissingOrBrokenTextureNamesTheFiles) {
     TempDir dir;
     dir.write("quad.obj", kTexturedObj);
