@@ -20,7 +20,7 @@ glm::vec3 emission(const gpu::Material& m) { return {m.emission_r, m.emission_g,
 
 bool emits(const gpu::Material& m) { return (m.flags & gpu::kMaterialEmissive) != 0u; }
 
-bool lc_has_emissive_texture(const gpu::Material& m) {
+bool has_emissive_texture(const gpu::Material& m) {
     return (m.flags & gpu::kMaterialTextured) != 0u && m.emissive_texture != gpu::kInvalidIndex;
 }
 
@@ -44,7 +44,7 @@ void sample_triangle(const TriangleEmission& source, std::size_t index, const gp
     const glm::vec3 cross = glm::cross(b - a, c - a);
     const float area = 0.5f * glm::length(cross);
     const glm::vec3 normal = glm::normalize(cross);
-    const bool textured = lc_has_emissive_texture(m);
+    const bool textured = has_emissive_texture(m);
     const glm::vec3 constant = emission(m) * (area / float(samples));
     // A random shift of the whole pattern (Cranley-Patterson rotation).
     const float shift_u = gpu::lc_unit_float(hash), shift_v = gpu::lc_unit_float(gpu::lc_hash(hash));
@@ -79,7 +79,7 @@ TriangleEmission::TriangleEmission(std::span<const gpu::Triangle> triangles, std
 glm::vec3 TriangleEmission::at(std::size_t i, float b1, float b2) const {
     const gpu::Material& m = materials_[triangles_[i].material];
     if (!emits(m)) return glm::vec3(0.0f);
-    if (!lc_has_emissive_texture(m) || uvs_.size() != triangles_.size()) return emission(m);
+    if (!has_emissive_texture(m) || uvs_.size() != triangles_.size()) return emission(m);
     cpu::TextureKernel k;
     k.materials = materials_.data();
     k.uvs = uvs_.data();
@@ -92,7 +92,7 @@ glm::vec3 TriangleEmission::at(std::size_t i, float b1, float b2) const {
 glm::vec3 TriangleEmission::mean(std::size_t i) const {
     const gpu::Material& m = materials_[triangles_[i].material];
     if (!emits(m)) return glm::vec3(0.0f);
-    if (!lc_has_emissive_texture(m) || uvs_.size() != triangles_.size()) return emission(m);
+    if (!has_emissive_texture(m) || uvs_.size() != triangles_.size()) return emission(m);
     glm::dvec3 sum(0.0);
     for (std::uint32_t k = 0; k < kMeanPoints; ++k) {
         const glm::vec2 b = triangle_sample_barycentrics(k, kMeanPoints, 0.0f, 0.5f / float(kMeanPoints));

@@ -9,14 +9,6 @@
 #include "lightcuts/error.h"
 
 namespace lc::loader {
-namespace {
-
-// GGX alpha floor (gpu::kMinGgxAlpha of shared/textures.h, which textures
-// respect too): below this the fp32 NDF peak (1 / (pi alpha^2)) gets large
-// enough that single point-light highlights turn into isolated fireflies.
-constexpr float kMinGgxAlpha = 1e-3f;
-
-}  // namespace
 
 gpu::Material make_material(glm::vec3 kd, glm::vec3 ks, float alpha) {
     gpu::Material m{};
@@ -26,7 +18,7 @@ gpu::Material make_material(glm::vec3 kd, glm::vec3 ks, float alpha) {
     m.ks_r = ks.r;
     m.ks_g = ks.g;
     m.ks_b = ks.b;
-    m.alpha = std::clamp(alpha, kMinGgxAlpha, 1.0f);
+    m.alpha = std::clamp(alpha, gpu::kMinGgxAlpha, 1.0f);
     m.roughness = std::sqrt(m.alpha);
     m.flags = (ks.r > 0.0f || ks.g > 0.0f || ks.b > 0.0f) ? gpu::kMaterialHasSpecular : 0u;
     m.specular = 0.5f;

@@ -20,7 +20,7 @@ inline constexpr float kDefaultAlbedo = 0.8f;
 inline constexpr float kDefaultRoughness = 0.5f;
 
 // kd: Lambert albedo; ks: GGX lobe reflectance (any component > 0 turns the
-// lobe on); alpha: GGX roughness, clamped to [kMinGgxAlpha, 1].
+// lobe on); alpha: GGX roughness, clamped to [gpu::kMinGgxAlpha, 1].
 gpu::Material make_material(glm::vec3 kd, glm::vec3 ks, float alpha);
 
 // Adds emitted radiance (W/(sr m^2)), one-sided along the geometric normal
@@ -41,7 +41,7 @@ struct DisneyParams {
     float clearcoat_gloss = 1.0f;
 };
 
-// A Disney material (kMaterialDisney): alpha = max(roughness^2, kMinGgxAlpha);
+// A Disney material (kMaterialDisney): alpha = max(roughness^2, gpu::kMinGgxAlpha);
 // sets kMaterialHasSheen and kMaterialHasClearcoat where those are > 0.
 gpu::Material make_disney_material(const DisneyParams& p);
 

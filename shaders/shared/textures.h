@@ -11,10 +11,6 @@
 // Texture coordinates follow glTF: (0, 0) is the top-left corner of the
 // image, v grows downwards, and the pattern repeats outside [0, 1).
 
-// The smallest GGX alpha a material gets (host/scene/materials.cpp says
-// why); a roughness texture cannot take it lower.
-LC_KCONST float kMinGgxAlpha = 1e-3f;
-
 // The sRGB transfer function undone (IEC 61966-2-1).
 float lc_srgb_to_linear(float c) {
     return c <= 0.04045f ? c * (1.0f / 12.92f) : pow((c + 0.055f) * (1.0f / 1.055f), 2.4f);

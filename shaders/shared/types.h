@@ -46,6 +46,11 @@ LC_CONST uint kNodeTwoSided = 4u;      // some light of the cluster emits on bot
 LC_CONST uint kNodeTypeShift = 8u;
 LC_CONST uint kNodeTypeMask = 0xFFu;
 
+// The smallest GGX alpha a material gets, from the loader or a roughness
+// texture: below it the fp32 NDF peak (1 / (pi alpha^2)) gets large enough
+// that single point-light highlights turn into isolated fireflies.
+LC_CONST float kMinGgxAlpha = 1e-3f;
+
 // Material.flags
 LC_CONST uint kMaterialHasSpecular = 1u;     // Lambert + GGX: the GGX lobe is on
 LC_CONST uint kMaterialEmissive = 2u;        // emission is not black
