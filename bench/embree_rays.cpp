@@ -114,14 +114,14 @@ int run(int argc, char** argv) {
         lo.width = lo.height = kLightcutsSize;
         const lc::gpu::FrameParams lf = lc::make_frame_params(p, lo);
         std::vector<lc::cpu::ShadowRayRecord> log;
-        std::vector<lc::gpu::CutEntry> heap(p.tree.cut_heap_capacity(lf.max_cut));
-        auto recorder = lc::cpu::make_shade_kernel<true>(p, heap.data());
+        std::vector<lc::gpu::CutEntry> heap(p.tree.cut_heap_slots(lo.max_cut, lo.cut_heap));
+        auto recorder = lc::cpu::make_shade_kernel<true>(p, heap.data(), std::uint32_t(heap.size()));
         recorder.ray_log = &log;
         for (std::uint32_t y = 0; y < kLightcutsSize; ++y)
             for (std::uint32_t x = 0; x < kLightcutsSize; ++x) {
                 decltype(recorder)::SurfacePoint sp;
                 if (!recorder.lc_camera_hit(lf, x, y, 0, sp)) continue;
-                decltype(recorder)::ShadeStats stats{0u, 0u, 0u, 0u};
+                decltype(recorder)::ShadeStats stats{};
                 recorder.lc_shade_lightcuts(sp, lf, stats);
             }
         for (const auto& r : log) lightcuts_rays.push_back({r.org, r.dir, r.t_max, 0u});

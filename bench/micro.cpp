@@ -63,8 +63,8 @@ struct Fixture {
         prepared = lc::prepare_scene(lc::test::room_scene(lights_in_room(n_lights), 64), 1);
         lc::RenderOptions o = lc::test::options("lightcuts", 64);
         frame = lc::make_frame_params(prepared, o);
-        heap.resize(frame.max_cut + 2);
-        k = lc::cpu::make_shade_kernel(prepared, heap.data());
+        heap.resize(prepared.tree.cut_heap_slots(o.max_cut, o.cut_heap));
+        k = lc::cpu::make_shade_kernel(prepared, heap.data(), std::uint32_t(heap.size()));
         for (std::uint32_t y = 0; y < 64; y += 4)
             for (std::uint32_t x = 0; x < 64; x += 4) {
                 ShadeKernel::SurfacePoint sp;
@@ -92,7 +92,7 @@ void BM_CutSelection(benchmark::State& state) {
     std::size_t i = 0;
     std::uint64_t rays = 0, cut = 0;
     for (auto _ : state) {
-        ShadeKernel::ShadeStats ss{0, 0, 0, 0};
+        ShadeKernel::ShadeStats ss{};
         benchmark::DoNotOptimize(f.k.lc_shade_lightcuts(f.points[i++ % f.points.size()], f.frame, ss));
         rays += ss.shadow_rays;
         cut += ss.cut_size;

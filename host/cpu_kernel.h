@@ -57,8 +57,8 @@ struct ShadowRayRecord {
     float t_max;
 };
 
-// Everything a pixel needs. `heap` must hold tree.cut_heap_capacity(max_cut)
-// entries; one kernel object per thread (make_shade_kernel binds one to a
+// Everything a pixel needs. `heap` holds `heap_slots` entries, the cut
+// heap's capacity (LightTree::cut_heap_slots); one kernel object per thread (make_shade_kernel binds one to a
 // scene). kRecordRays: every shadow ray is also appended to `*ray_log`
 // (bench/embree_rays traces lightcuts' rays again with other tracers); the
 // renderer's kernel, ShadeKernel, has no such code.
@@ -76,9 +76,7 @@ struct BasicShadeKernel {
     const float* environment = nullptr;  // RGB texels of the environment map
     float vpl_min_distance2 = 0.0f;      // FrameParams.vpl_min_distance2
     CutEntry* heap = nullptr;
-    // Highest heap slot written + 1 since the caller last reset it: tells how
-    // many slots a cut needed (the GPU keeps only the first K in shared memory).
-    uint heap_high_water = 0u;
+    uint heap_slots = 1u;
     std::vector<ShadowRayRecord>* ray_log = nullptr;  // kRecordRays only
 
     // The CPU reference always runs the full kernel; the GPU switches parts
@@ -108,7 +106,8 @@ struct BasicShadeKernel {
 #define LC_ENVIRONMENT_TEXEL(i) vec3(environment[3u * (i)], environment[3u * (i) + 1u], environment[3u * (i) + 2u])
 #define LC_VPL_MIN_DISTANCE2 vpl_min_distance2
 #define LC_HEAP_LOAD(i) heap[i]
-#define LC_HEAP_STORE(i, e) (heap_high_water = max(heap_high_water, (i) + 1u), heap[i] = (e))
+#define LC_HEAP_STORE(i, e) heap[i] = (e)
+#define LC_HEAP_CAPACITY heap_slots
 #define LC_ON_SHADOW_RAY(o, d, t) \
     if constexpr (kRecordRays) ray_log->push_back({o, d, t})
 #define LC_SEED_LOBE_BOUND seed_lobe_bound
@@ -131,15 +130,17 @@ struct BasicShadeKernel {
 #undef LC_VPL_MIN_DISTANCE2
 #undef LC_HEAP_LOAD
 #undef LC_HEAP_STORE
+#undef LC_HEAP_CAPACITY
 #undef LC_ON_SHADOW_RAY
 #undef LC_SEED_LOBE_BOUND
 };
 
 using ShadeKernel = BasicShadeKernel<false>;
 
-// A kernel reading the prepared scene's arrays, with `heap` as its cut heap.
+// A kernel reading the prepared scene's arrays, with `heap` (`heap_slots`
+// entries) as its cut heap.
 template <bool kRecordRays = false>
-BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, CutEntry* heap) {
+BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, CutEntry* heap = nullptr, uint heap_slots = 0u) {
     BasicShadeKernel<kRecordRays> k;
     k.bvh_nodes = p.bvh.nodes.data();
     k.triangles = p.scene.triangles.data();
@@ -153,6 +154,7 @@ BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, CutEntry
     k.environment = p.scene.environment.rgb.data();
     k.vpl_min_distance2 = p.vpl_min_distance2;
     k.heap = heap;
+    k.heap_slots = heap_slots;
     return k;
 }
 

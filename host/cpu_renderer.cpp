@@ -24,12 +24,14 @@ struct Worker {
     std::uint64_t shadow_rays = 0;
     std::uint64_t max_cut_hits = 0;
     std::uint64_t cut_indirect = 0;
+    std::uint64_t frozen_samples = 0;
 };
 
 // All samples of one pixel: the mean radiance and the mean cut size.
 struct PixelResult {
     glm::vec3 radiance{0.0f};
     float cut_size = 0.0f;
+    float heap_froze = 0.0f;  // fraction of samples whose cut froze clusters
 };
 
 enum class Method { kBrute, kLightcuts, kSampled, kStochastic };
@@ -62,20 +64,23 @@ PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Meth
                         std::uint32_t y, Worker& t) {
     glm::vec3 sum(0.0f);
     std::uint64_t cut_sum = 0;
+    std::uint32_t froze = 0;
     for (std::uint32_t s = 0; s < frame.spp; ++s) {
         cpu::ShadeKernel::SurfacePoint sp;
         glm::vec3 seen;
         const bool hit = k.lc_camera_sample(frame, x, y, s, sp, seen);
         sum += seen;
         if (!hit) continue;
-        cpu::ShadeKernel::ShadeStats ss{0u, 0u, 0u, 0u};
+        cpu::ShadeKernel::ShadeStats ss{};
         sum += shade_point(k, frame, method, sp, k.lc_sample_stream(frame.seed, x, y, s), ss);
         cut_sum += ss.cut_size;
         t.shadow_rays += ss.shadow_rays;
         t.max_cut_hits += ss.hit_max_cut;
         t.cut_indirect += ss.cut_indirect;
+        t.frozen_samples += ss.frozen > 0u ? 1u : 0u;
+        froze += ss.frozen > 0u ? 1u : 0u;
     }
-    return {sum / float(frame.spp), float(double(cut_sum) / frame.spp)};
+    return {sum / float(frame.spp), float(double(cut_sum) / frame.spp), float(double(froze) / frame.spp)};
 }
 
 
@@ -97,24 +102,31 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     result.image = Image(frame.width, frame.height);
     RenderStats& stats = result.stats;
     stats.device = "cpu";
-    if (lightcuts) stats.cut_size.assign(std::size_t(frame.width) * frame.height, 0.0f);
+    if (lightcuts) {
+        stats.cut_size.assign(std::size_t(frame.width) * frame.height, 0.0f);
+        stats.heap_froze.assign(std::size_t(frame.width) * frame.height, 0.0f);
+    }
 
     const std::uint32_t tiles_x = (frame.width + kTile - 1) / kTile;
     const std::uint32_t tile_count = tiles_x * ((frame.height + kTile - 1) / kTile);
     unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     std::vector<Worker> workers(std::max(1u, std::min(threads, tile_count)));
-    for (Worker& w : workers) w.heap.resize(lightcuts ? prepared.tree.cut_heap_capacity(frame.max_cut) : 0);
+    const std::uint32_t heap_slots = prepared.tree.cut_heap_slots(frame.max_cut, options.cut_heap);
+    for (Worker& w : workers) w.heap.resize(lightcuts ? heap_slots : 0);
     std::atomic<std::uint32_t> tiles_done{0};
     Progress progress(options.progress);
 
     for_each_tile(tile_count, workers, [&](std::uint32_t tile, Worker& t) {
-        cpu::ShadeKernel k = cpu::make_shade_kernel(prepared, t.heap.data());
+        cpu::ShadeKernel k = cpu::make_shade_kernel(prepared, t.heap.data(), heap_slots);
         const std::uint32_t x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
         for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); ++y)
             for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); ++x) {
                 const PixelResult px = shade_pixel(k, frame, method, x, y, t);
                 result.image.set(x, y, px.radiance);
-                if (lightcuts) stats.cut_size[std::size_t(y) * frame.width + x] = px.cut_size;
+                if (lightcuts) {
+                    stats.cut_size[std::size_t(y) * frame.width + x] = px.cut_size;
+                    stats.heap_froze[std::size_t(y) * frame.width + x] = px.heap_froze;
+                }
             }
         progress.update(double(tiles_done.fetch_add(1) + 1) / tile_count);
     });
@@ -124,7 +136,9 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
         stats.shadow_rays += t.shadow_rays;
         stats.max_cut_pixels += t.max_cut_hits;
         stats.cut_indirect_total += t.cut_indirect;
+        stats.heap_frozen_samples += t.frozen_samples;
     }
+    if (lightcuts) stats.heap_slots = heap_slots;
     stats.spp_done = frame.spp;
     stats.camera_rays = std::uint64_t(frame.width) * frame.height * frame.spp;
     stats.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

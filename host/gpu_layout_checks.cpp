@@ -57,8 +57,8 @@ static_assert(offsetof(GBufferTexel, wo_x) == 24);
 static_assert(offsetof(GBufferTexel, material) == 36);
 static_assert(offsetof(GBufferTexel, v) == 44);
 
-static_assert(sizeof(CutEntry) == 20);
-static_assert(offsetof(CutEntry, unit_r) == 8);
+static_assert(sizeof(CutEntry) == 8);
+static_assert(offsetof(CutEntry, error) == 4);
 
 static_assert(sizeof(FrameParams) == 128);
 static_assert(offsetof(FrameParams, light_samples) == 112);

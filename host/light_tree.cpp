@@ -349,6 +349,10 @@ std::uint32_t LightTree::cut_heap_capacity(std::uint32_t max_cut) const {
     return std::uint32_t(std::max<std::uint64_t>(1, std::min(interior, cut)));
 }
 
+std::uint32_t LightTree::cut_heap_slots(std::uint32_t max_cut, std::uint32_t cut_heap) const {
+    return std::max(1u, std::min(cut_heap, cut_heap_capacity(max_cut)));
+}
+
 LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t seed, TreeBuilder builder,
                            double cone_scale) {
     auto start = std::chrono::steady_clock::now();

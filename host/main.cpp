@@ -28,7 +28,7 @@ struct RenderArgs {
     lc::SceneOptions scene_options;
     lc::RenderOutputs outputs;
     lc::DeviceChoice device;
-    std::optional<std::uint32_t> spp, width, height, max_cut, seed, area_samples, light_samples, max_bounces;
+    std::optional<std::uint32_t> spp, width, height, max_cut, cut_heap, seed, area_samples, light_samples, max_bounces;
     std::optional<std::uint32_t> vpls, vpl_bounces;
     std::optional<float> relative_error, vpl_clamp;
     std::optional<double> time_limit;
@@ -66,6 +66,7 @@ lc::RenderOptions render_options(const RenderArgs& a, const lc::Scene& scene) {
     o.spp = a.spp.value_or(scene.render.spp);
     o.relative_error = a.relative_error.value_or(scene.render.relative_error);
     o.max_cut = a.max_cut.value_or(scene.render.max_cut);
+    o.cut_heap = a.cut_heap.value_or(scene.render.cut_heap);
     o.seed = a.seed.value_or(scene.render.seed);
     o.light_samples = a.light_samples.value_or(scene.render.light_samples);
     o.light_pick = a.light_pick.empty() ? scene.render.light_pick : a.light_pick;
@@ -187,6 +188,10 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
         ->check(setting(lc::kSettingRelativeError));
     render->add_option("--max-cut", r.max_cut, "lightcuts and stochastic: largest cut (default 1000)")
         ->check(setting(lc::kSettingMaxCut));
+    render->add_option("--cut-heap", r.cut_heap,
+                       "lightcuts and stochastic: cut-heap capacity per shaded point; a larger cut freezes "
+                       "its clusters of smallest bound (default " + std::to_string(lc::kDefaultCutHeap) + ")")
+        ->check(setting(lc::kSettingCutHeap));
     render->add_option("--area-samples", r.area_samples,
                        "Point lights the emissive surfaces become, in all (default 65536)")
         ->check(setting(lc::kSettingAreaLightSamples));

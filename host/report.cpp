@@ -57,8 +57,12 @@ LightcutsReport lightcuts_report(const RenderOptions& o, const PreparedScene& p,
     l.max_cut_samples = s.max_cut_pixels;
     const double samples = double(cuts.size()) * std::max(s.spp_done, 1u);
     l.cut_indirect_mean = samples > 0.0 ? double(s.cut_indirect_total) / samples : 0.0;
-    l.heap_capacity_shared = s.heap_capacity_shared;
-    l.heap_spill_samples = s.heap_spill_pixels;
+    l.cut_heap = o.cut_heap;
+    l.heap_slots = s.heap_slots;
+    l.heap_bytes = s.heap_shared_bytes;
+    l.workgroup_size = s.workgroup_size;
+    l.heap_frozen_samples = s.heap_frozen_samples;
+    l.heap_paused_samples = s.heap_paused_samples;
     return l;
 }
 
@@ -71,9 +75,17 @@ std::string lightcuts_text(const RenderReport& r, const LightcutsReport& l) {
     if (r.indirect)
         text += format("  of the cut: %.1f direct, %.1f indirect (VPL) clusters on average\n",
                        l.cut_size_mean - l.cut_indirect_mean, l.cut_indirect_mean);
+    const double samples = double(std::max<std::uint64_t>(r.camera_rays, 1));
+    text += format("  cut heap: %u slots per point (cut_heap %u); %llu samples (%.2f%%) froze clusters out of a full "
+                   "heap\n",
+                   l.heap_slots, l.cut_heap, static_cast<unsigned long long>(l.heap_frozen_samples),
+                   100.0 * double(l.heap_frozen_samples) / samples);
     if (r.device != "cpu")
-        text += format("  cut heap: %u slots per pixel in shared memory; %llu samples spilled to global memory\n",
-                       l.heap_capacity_shared, static_cast<unsigned long long>(l.heap_spill_samples));
+        text += format("  cut heap in shared memory: %s per workgroup of %u; %llu samples (%.2f%%) paused it in "
+                       "global memory between dispatches\n",
+                       human_bytes(l.heap_bytes).c_str(), l.workgroup_size,
+                       static_cast<unsigned long long>(l.heap_paused_samples),
+                       100.0 * double(l.heap_paused_samples) / samples);
     return text;
 }
 
@@ -88,8 +100,11 @@ json lightcuts_json(const LightcutsReport& l) {
             {"cut_size_p99", l.cut_size_p99},
             {"cut_size_max", l.cut_size_max},
             {"max_cut_samples", l.max_cut_samples},
-            {"heap_capacity_shared", l.heap_capacity_shared},
-            {"heap_spill_samples", l.heap_spill_samples}};
+            {"cut_heap", l.cut_heap},
+            {"heap_slots", l.heap_slots},
+            {"heap_bytes_per_workgroup", l.heap_bytes},
+            {"heap_frozen_samples", l.heap_frozen_samples},
+            {"heap_paused_samples", l.heap_paused_samples}};
 }
 
 }  // namespace

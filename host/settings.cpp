@@ -30,7 +30,7 @@ std::string shortest(float v) {
 std::string setting_problem(std::string_view key, double value) {
     constexpr double kMaxU32 = double(std::numeric_limits<std::uint32_t>::max());
     if (key == kSettingSpp) return integer_problem(value, 1, kMaxSpp);
-    if (key == kSettingMaxCut) return integer_problem(value, 1, kMaxU32);
+    if (key == kSettingMaxCut || key == kSettingCutHeap) return integer_problem(value, 1, kMaxU32);
     if (key == kSettingSeed) return integer_problem(value, 0, kMaxU32);
     if (key == kSettingWidth || key == kSettingHeight) return integer_problem(value, 1, kMaxImageSide);
     if (key == kSettingLightSamples) return integer_problem(value, 1, kMaxLightSamplesPerPoint);
@@ -73,6 +73,7 @@ void validate_render_options(const RenderOptions& o) {
         {kSettingSpp, o.spp},
         {kSettingRelativeError, o.relative_error},
         {kSettingMaxCut, o.max_cut},
+        {kSettingCutHeap, o.cut_heap},
         {kSettingSeed, o.seed},
         {kSettingLightSamples, o.light_samples},
         {kSettingMaxBounces, o.max_bounces},

@@ -31,7 +31,7 @@ LC_CONST uint kBindingFrame = 10u;        // one FrameParams
 LC_CONST uint kBindingGBuffer = 11u;      // GBufferTexel per tile pixel
 LC_CONST uint kBindingRadiance = 12u;     // 3 floats per tile pixel, summed over samples
 LC_CONST uint kBindingPixelStats = 13u;   // PixelStats per tile pixel, summed over samples
-LC_CONST uint kBindingHeapSpill = 14u;    // CutEntry slots of every invocation (see heap.glsl)
+LC_CONST uint kBindingHeapSave = 14u;     // cut heaps paused between dispatches (see heap.glsl)
 LC_CONST uint kBindingCutState = 15u;     // CutState per tile pixel, between Lightcuts dispatches
 LC_CONST uint kBindingCount = 16u;
 
@@ -39,10 +39,8 @@ LC_CONST uint kBindingCount = 16u;
 LC_CONST uint kSpecWorkgroupSize = 0u;    // local_size_x
 LC_CONST uint kSpecEnableGgx = 1u;        // any material has a GGX lobe
 LC_CONST uint kSpecEnableShadows = 2u;    // any triangle can block a light
-LC_CONST uint kSpecHeapShared = 3u;       // K: cut-heap slots per invocation in shared memory
-LC_CONST uint kSpecHeapCapacity = 4u;     // all cut-heap slots per invocation,
-                                          // LightTree::cut_heap_capacity(max_cut)
-LC_CONST uint kSpecSpillStride = 5u;      // invocations the spill buffer is laid out for
+LC_CONST uint kSpecHeapSlots = 3u;        // K: cut-heap slots per invocation, in shared memory
+LC_CONST uint kSpecSaveStride = 5u;       // invocations the heap-save buffer is laid out for
 LC_CONST uint kSpecEnableOriented = 6u;   // any spot or oriented light (emission cones)
 LC_CONST uint kSpecStochastic = 7u;       // lightcuts.comp: Stochastic Lightcuts' fresh representatives
 LC_CONST uint kSpecEnableTextures = 8u;   // any material has a texture
@@ -51,8 +49,6 @@ LC_CONST uint kSpecEnableSheen = 10u;     // any Disney material with sheen > 0
 LC_CONST uint kSpecEnableClearcoat = 11u; // any Disney material with clearcoat > 0
 
 // PixelStats.flags
-LC_CONST uint kPixelHeapOverflow = 1u;  // a heap outgrew its capacity (a bug: the capacity
-                                        // bounds every cut the tree and max_cut allow)
 LC_CONST uint kPixelLoopLimit = 2u;     // the driver cut the invocation's loops short
 LC_CONST uint kPixelCutUnfinished = 4u; // refinement went on past the pass's last dispatch (a bug)
 
@@ -65,9 +61,9 @@ struct PixelStats {
     uint cut_size_lo, cut_size_hi;        // lightcuts: clusters in the final cuts
     uint shadow_rays_lo, shadow_rays_hi;
     uint max_cut_samples;   // samples whose refinement stopped at max_cut
-    uint spill_samples;     // samples whose heap grew past kHeapShared slots
+    uint frozen_samples;    // samples whose cut froze clusters out of a full heap
     uint flags;             // kPixel* bits, or-ed over samples
-    uint pad0;
+    uint paused_samples;    // samples whose heap waited in global memory between dispatches
     uint cut_indirect_lo, cut_indirect_hi;  // ... of which virtual point lights
 };
 
@@ -84,18 +80,18 @@ void lc_count_add(inout uint lo, inout uint hi, uint v) {
 
 // A Lightcuts cut in the making, kept in global memory between the
 // dispatches of one sample when the refinement is spread over several
-// (52 bytes). The heap slots themselves stay in the spill buffer.
+// (52 bytes). The heap slots go to the heap-save buffer.
 LC_CONST uint kCutDone = 1u;       // result added to the pixel; later dispatches skip it
-LC_CONST uint kCutSpilled = 2u;    // the heap went past kHeapShared slots
+LC_CONST uint kCutFroze = 2u;      // the cut froze clusters out of a full heap
 LC_CONST uint kCutSelected = 4u;   // stochastic: the cut is final; its clusters are being shaded
 struct CutState {
     uint heap_size;
     uint cut_size;
     uint shadow_rays;
     uint flags;                    // kCut* bits
-    float leaf_r, leaf_g, leaf_b;
+    float fixed_r, fixed_g, fixed_b;  // single lights and frozen clusters
     // While the cut is refined: the running sum of the heap's estimates.
-    // Stochastic, once kCutSelected: leaf_sum plus the fresh estimates of
+    // Stochastic, once kCutSelected: fixed_sum plus the fresh estimates of
     // heap slots [0, shaded) and of draws [0, draw) of slot `shaded`.
     float heap_r, heap_g, heap_b;
     uint shaded;

@@ -1,61 +1,37 @@
-// The per-invocation cut heap of shared/lightcuts.h. Slots below K live in
-// workgroup shared memory; slots K and above spill to a global buffer laid
-// out for the whole tile. K, the capacity and the spill layout are
-// specialization constants chosen by the host from the device's shared
-// memory size, the workgroup size and the capacity, which is
-// LightTree::cut_heap_capacity(max_cut): the tree's interior nodes, never
-// more than the cut, so a huge max_cut over a small tree costs nothing.
+// The per-invocation cut heap of shared/lightcuts.h: K = kHeapSlots entries
+// in workgroup shared memory, nothing in global memory while a cut is
+// refined. K is the smaller of render.cut_heap and the tree's
+// LightTree::cut_heap_capacity(max_cut); a cut that would outgrow it freezes
+// its smallest clusters (lc_heap_push), on the CPU reference alike.
 //
-// The global buffer has room for all kHeapCapacity slots of every
-// invocation: slots below K are where the shared part is saved while a
-// refinement waits for its next dispatch.
+// Only where a cut is spread over several dispatches (the driver limits how
+// long an invocation may loop: lavapipe) is its heap saved to the heap-save
+// buffer at the end of a dispatch and restored at the start of the next.
 #ifndef LC_HEAP_GLSL
 #define LC_HEAP_GLSL
 
-layout(constant_id = kSpecHeapShared) const uint kHeapShared = 1u;
-layout(constant_id = kSpecHeapCapacity) const uint kHeapCapacity = 2u;
-layout(constant_id = kSpecSpillStride) const uint kSpillStride = 1u;
+layout(constant_id = kSpecHeapSlots) const uint kHeapSlots = 1u;
+layout(constant_id = kSpecSaveStride) const uint kSaveStride = 1u;
 
-layout(std430, binding = kBindingHeapSpill) buffer HeapSpill { CutEntry heap_spill[]; };
+layout(std430, binding = kBindingHeapSave) buffer HeapSave { CutEntry heap_save[]; };
 
 // Slot-major, so neighbouring invocations touch neighbouring entries.
-shared CutEntry s_heap[kHeapShared * gl_WorkGroupSize.x];
-
-bool g_heap_spilled = false;   // this sample's heap went past kHeapShared slots
-bool g_heap_overflow = false;  // ... or past its capacity (a bug: nothing stored)
+shared CutEntry s_heap[kHeapSlots * gl_WorkGroupSize.x];
 
 uint lc_shared_slot(uint slot) { return slot * gl_WorkGroupSize.x + gl_LocalInvocationIndex; }
-uint lc_global_slot(uint slot) { return slot * kSpillStride + gl_GlobalInvocationID.x; }
-
-CutEntry lc_heap_load(uint slot) {
-    if (slot < kHeapShared) return s_heap[lc_shared_slot(slot)];
-    if (slot < kHeapCapacity) return heap_spill[lc_global_slot(slot)];
-    return CutEntry(0u, 0.0f, 0.0f, 0.0f, 0.0f);
-}
-
-void lc_heap_store(uint slot, CutEntry e) {
-    if (slot < kHeapShared) {
-        s_heap[lc_shared_slot(slot)] = e;
-    } else if (slot < kHeapCapacity) {
-        g_heap_spilled = true;
-        heap_spill[lc_global_slot(slot)] = e;
-    } else {
-        g_heap_overflow = true;
-    }
-}
+uint lc_saved_slot(uint slot) { return slot * kSaveStride + gl_GlobalInvocationID.x; }
 
 // Shared slots to global memory and back, around a pause between dispatches.
 void lc_heap_save(uint heap_size) {
-    for (uint slot = 0u; slot < min(heap_size, kHeapShared); ++slot)
-        heap_spill[lc_global_slot(slot)] = s_heap[lc_shared_slot(slot)];
+    for (uint slot = 0u; slot < heap_size; ++slot) heap_save[lc_saved_slot(slot)] = s_heap[lc_shared_slot(slot)];
 }
 
 void lc_heap_restore(uint heap_size) {
-    for (uint slot = 0u; slot < min(heap_size, kHeapShared); ++slot)
-        s_heap[lc_shared_slot(slot)] = heap_spill[lc_global_slot(slot)];
+    for (uint slot = 0u; slot < heap_size; ++slot) s_heap[lc_shared_slot(slot)] = heap_save[lc_saved_slot(slot)];
 }
 
-#define LC_HEAP_LOAD(i) lc_heap_load(i)
-#define LC_HEAP_STORE(i, e) lc_heap_store(i, e)
+#define LC_HEAP_LOAD(i) s_heap[lc_shared_slot(i)]
+#define LC_HEAP_STORE(i, e) s_heap[lc_shared_slot(i)] = (e)
+#define LC_HEAP_CAPACITY kHeapSlots
 
 #endif

@@ -36,14 +36,16 @@ void main() {
     stats.shadow_rays = 0u;
     stats.hit_max_cut = 0u;
     stats.cut_indirect = 0u;
+    stats.frozen = 0u;
+    stats.frozen_error = 0.0f;
     uint heap_size = 0u;
-    vec3 leaf_sum = vec3(0.0f);
+    vec3 fixed_sum = vec3(0.0f);
     vec3 heap_sum = vec3(0.0f);
     bool selected = false;  // stochastic: the cut is final; heap_sum is the fresh sum
     uint shaded = 0u;       // stochastic: heap slots shaded afresh so far
     uint draw = 0u;         // ... and draws of slot `shaded` (frame.light_samples per slot)
     if ((push.cut_flags & kCutFirstDispatch) != 0u) {
-        lc_cut_start(sp, m, frame, heap_size, leaf_sum, heap_sum, stats);
+        lc_cut_start(sp, m, frame, heap_size, fixed_sum, heap_sum, stats);
     } else {
         CutState s = cut_states[i];
         if ((s.flags & kCutDone) != 0u) return;
@@ -51,11 +53,11 @@ void main() {
         stats.cut_size = s.cut_size;
         stats.cut_indirect = s.cut_indirect;
         stats.shadow_rays = s.shadow_rays;
-        g_heap_spilled = (s.flags & kCutSpilled) != 0u;
+        stats.frozen = (s.flags & kCutFroze) != 0u ? 1u : 0u;
         selected = (s.flags & kCutSelected) != 0u;
         shaded = s.shaded;
         draw = s.draw;
-        leaf_sum = vec3(s.leaf_r, s.leaf_g, s.leaf_b);
+        fixed_sum = vec3(s.fixed_r, s.fixed_g, s.fixed_b);
         heap_sum = vec3(s.heap_r, s.heap_g, s.heap_b);
         lc_heap_restore(heap_size);
     }
@@ -64,12 +66,12 @@ void main() {
     bool done = false;
     for (uint r = 0u; r < push.refine_budget && !done; ++r) {
         if (!selected) {
-            if (lc_cut_refine(sp, m, frame, heap_size, leaf_sum, heap_sum, stats)) continue;
+            if (lc_cut_refine(sp, m, frame, heap_size, fixed_sum, heap_sum, stats)) continue;
             selected = true;
-            heap_sum = leaf_sum;  // the fresh sum starts from the exact single lights
+            heap_sum = fixed_sum;  // the fresh sum starts from the single lights and frozen clusters
             done = !kStochastic;
         } else if (shaded < heap_size) {
-            heap_sum += lc_shade_cluster_stochastic(sp, LC_HEAP_LOAD(shaded).node, frame.min_distance2, stream,
+            heap_sum += lc_shade_cluster_stochastic(sp, lc_entry_node(LC_HEAP_LOAD(shaded)), frame.min_distance2, stream,
                                                     draw, stats) *
                         (1.0f / float(frame.light_samples));
             draw += 1u;
@@ -89,7 +91,8 @@ void main() {
         PixelStats ps = pixel_stats[i];
         if ((push.cut_flags & kCutLastDispatch) != 0u) ps.flags |= kPixelCutUnfinished;
         if (cut_short) ps.flags |= kPixelLoopLimit;
-        if (g_heap_overflow) ps.flags |= kPixelHeapOverflow;
+        // Counted once per sample, at its first pause.
+        if ((push.cut_flags & kCutFirstDispatch) != 0u) ps.paused_samples += 1u;
         pixel_stats[i] = ps;
         lc_heap_save(heap_size);
         CutState s;
@@ -97,8 +100,8 @@ void main() {
         s.cut_size = stats.cut_size;
         s.cut_indirect = stats.cut_indirect;
         s.shadow_rays = stats.shadow_rays;
-        s.flags = (g_heap_spilled ? kCutSpilled : 0u) | (selected ? kCutSelected : 0u);
-        s.leaf_r = leaf_sum.x; s.leaf_g = leaf_sum.y; s.leaf_b = leaf_sum.z;
+        s.flags = (stats.frozen > 0u ? kCutFroze : 0u) | (selected ? kCutSelected : 0u);
+        s.fixed_r = fixed_sum.x; s.fixed_g = fixed_sum.y; s.fixed_b = fixed_sum.z;
         s.heap_r = heap_sum.x; s.heap_g = heap_sum.y; s.heap_b = heap_sum.z;
         s.shaded = shaded;
         s.draw = draw;
@@ -106,14 +109,13 @@ void main() {
         return;
     }
 
-    lc_accumulate(i, kStochastic ? heap_sum : lc_cut_result(heap_size, leaf_sum));
+    lc_accumulate(i, kStochastic ? heap_sum : lc_cut_result(sp, frame.min_distance2, heap_size, fixed_sum));
     PixelStats ps = pixel_stats[i];
     lc_count_add(ps.cut_size_lo, ps.cut_size_hi, stats.cut_size);
     lc_count_add(ps.cut_indirect_lo, ps.cut_indirect_hi, stats.cut_indirect);
     lc_count_add(ps.shadow_rays_lo, ps.shadow_rays_hi, stats.shadow_rays);
     ps.max_cut_samples += stats.hit_max_cut;
-    ps.spill_samples += g_heap_spilled ? 1u : 0u;
-    if (g_heap_overflow) ps.flags |= kPixelHeapOverflow;
+    ps.frozen_samples += stats.frozen > 0u ? 1u : 0u;
     if (cut_short || lc_loops_were_cut_short()) ps.flags |= kPixelLoopLimit;
     pixel_stats[i] = ps;
     if ((push.cut_flags & kCutLastDispatch) == 0u) cut_states[i].flags = kCutDone;

@@ -114,18 +114,28 @@ TEST(LightcutsBounds, GgxBoundIsTighterThanThePeak) {
     EXPECT_GE(k.lc_ggx_bound(m, lo2, hi2, glm::vec3(0.0f), n, wo), peak);
 }
 
+// Pushes an entry of bound `error` for node `node` into k's heap, with the
+// visibility bit clear (a frozen entry's estimate is then zero).
+void push_entry(Kernel& k, std::uint32_t& size, std::uint32_t node, float error, Kernel::ShadeStats& ss) {
+    glm::vec3 fixed_sum(0.0f), heap_sum(0.0f);
+    k.lc_heap_push(Kernel::SurfacePoint{}, 0.0f, size, gpu::CutEntry{node, error}, glm::vec3(0.0f), fixed_sum,
+                   heap_sum, ss);
+}
+
 TEST(LightcutsHeap, PopsInDecreasingOrder) {
     std::vector<gpu::CutEntry> storage(1000);
     Kernel k;
     k.heap = storage.data();
+    k.heap_slots = 1000;
     std::mt19937 rng(4);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     std::uint32_t size = 0;
     std::vector<float> pushed;
+    Kernel::ShadeStats ss{};
     for (int i = 0; i < 1000; ++i) {
-        gpu::CutEntry e{std::uint32_t(i), u(rng), 0, 0, 0};
-        pushed.push_back(e.error);
-        k.lc_heap_push(size, e);
+        const float error = u(rng);
+        pushed.push_back(error);
+        push_entry(k, size, std::uint32_t(i), error, ss);
         if (i % 3 == 2) {  // interleave pops
             float top = storage[0].error;
             auto it = std::max_element(pushed.begin(), pushed.end());
@@ -141,6 +151,52 @@ TEST(LightcutsHeap, PopsInDecreasingOrder) {
         k.lc_heap_pop(size);
     }
     EXPECT_EQ(size, 0u);
+    EXPECT_EQ(ss.frozen, 0u);
+}
+
+// A full heap of K entries freezes the smallest bound of the K + 1 it would
+// hold: after any sequence of pushes and pops it holds the K largest of the
+// entries not popped, every other one is frozen, and the frozen bounds add
+// up in the stats.
+TEST(LightcutsHeap, BoundedHeapKeepsTheLargestAndFreezesTheRest) {
+    for (std::uint32_t capacity : {1u, 2u, 7u, 16u}) {
+        std::vector<gpu::CutEntry> storage(capacity);
+        std::vector<gpu::LightNode> nodes(600, gpu::LightNode{});
+        Kernel k;
+        k.heap = storage.data();
+        k.heap_slots = capacity;
+        k.light_nodes = nodes.data();
+        std::mt19937 rng(capacity);
+        std::uniform_real_distribution<float> u(0.0f, 1.0f);
+        std::uint32_t size = 0;
+        std::vector<float> live;  // entries pushed, not popped and not frozen (a multiset)
+        Kernel::ShadeStats ss{};
+        double frozen_error = 0.0;
+        std::uint32_t frozen = 0;
+        for (int i = 0; i < 600; ++i) {
+            const float error = float(int(u(rng) * 64.0f)) / 64.0f;  // ties happen
+            push_entry(k, size, std::uint32_t(i), error, ss);
+            live.push_back(error);
+            std::sort(live.rbegin(), live.rend());
+            if (live.size() > capacity) {  // the smallest goes
+                frozen_error += live.back();
+                frozen += 1;
+                live.pop_back();
+            }
+            ASSERT_EQ(size, live.size());
+            std::vector<float> held;
+            for (std::uint32_t j = 0; j < size; ++j) held.push_back(storage[j].error);
+            std::sort(held.rbegin(), held.rend());
+            ASSERT_EQ(held, live) << "capacity " << capacity << " after push " << i;
+            ASSERT_EQ(storage[0].error, live.front());
+            if (i % 5 == 4) {
+                k.lc_heap_pop(size);
+                live.erase(live.begin());
+            }
+        }
+        EXPECT_EQ(ss.frozen, frozen);
+        EXPECT_NEAR(double(ss.frozen_error), frozen_error, 1e-4 * frozen_error);
+    }
 }
 
 Scene mixed_room(std::size_t n_point, std::uint32_t size, std::uint32_t seed) {
@@ -158,6 +214,7 @@ TEST(Lightcuts, ZeroErrorReproducesBruteForce) {
     RenderOptions o = test::options("lightcuts", 32);
     o.relative_error = 0.0f;
     o.max_cut = 1u << 20;
+    o.cut_heap = o.max_cut;  // nothing frozen
     RenderResult lc = render_cpu(p, o);
     RenderResult brute = render_cpu(p, test::options("brute", 32));
     EXPECT_EQ(lc.stats.max_cut_pixels, 0u);
@@ -177,7 +234,7 @@ TEST(Lightcuts, MaxCutOneUsesTheRootRepresentative) {
     RenderResult r = render_cpu(p, o);
     gpu::FrameParams f = make_frame_params(p, o);
     std::vector<gpu::CutEntry> heap(2);
-    Kernel k = cpu::make_shade_kernel(p, heap.data());
+    Kernel k = cpu::make_shade_kernel(p, heap.data(), 2);
     const gpu::LightNode& root = p.tree.nodes[p.tree.roots[gpu::kLightPoint]];
     glm::vec3 root_intensity(root.intensity_r, root.intensity_g, root.intensity_b);
     int lit = 0;
@@ -185,8 +242,9 @@ TEST(Lightcuts, MaxCutOneUsesTheRootRepresentative) {
         for (std::uint32_t x = 0; x < 24; ++x) {
             Kernel::SurfacePoint sp;
             ASSERT_TRUE(k.lc_camera_hit(f, x, y, 0, sp));
-            Kernel::ShadeStats ss{0, 0, 0, 0};
-            glm::vec3 expected = k.lc_rep_unit(sp, root.rep_light, f.min_distance2, ss) * root_intensity;
+            Kernel::ShadeStats ss{};
+            bool visible = false;
+            glm::vec3 expected = k.lc_rep_unit(sp, root.rep_light, f.min_distance2, visible, ss) * root_intensity;
             glm::vec3 got = r.image.at(x, y);
             ASSERT_EQ(got, expected) << x << "," << y;
             ASSERT_EQ(r.stats.cut_size[y * 24 + x], 1.0f);
@@ -275,6 +333,10 @@ struct ShippedCase {
     double max_rmse;           // relative RMSE limit
     double max_above_2pct;     // limit on the fraction of pixels above 2% error
     double max_above_5pct;
+    // The default cut heap (kDefaultCutHeap slots, clusters frozen out of a
+    // full heap): relative RMSE limit against brute force. The limits above
+    // hold for a heap as large as the tree needs (nothing frozen).
+    double bounded_max_rmse;
 };
 
 // Lightcuts at the defaults (relative_error 0.02, max_cut 1000) against brute
@@ -284,6 +346,10 @@ struct ShippedCase {
 //   bunny: relative RMSE 0.0076, 3.8% of pixels above 2%, 0.20% above 5%.
 // The 2% threshold bounds each cluster's error, not the pixel's, so a pixel
 // can exceed 2%; the limits sit about 1.5x above the measurement.
+// With the default heap of 64 slots, measured relative RMSE: room 0.0082,
+// bunny 0.0077, panels 0.0013, gallery 0.114 (its loose spot cones make cuts
+// of 700 clusters, which a heap of 64 cannot refine: docs/results/heap.md),
+// sky 0.0121, materials 0.0113; the limit is the last field.
 class ShippedScenes : public ::testing::TestWithParam<ShippedCase> {};
 
 TEST_P(ShippedScenes, LightcutsMatchesBruteForceAtDefaults) {
@@ -300,7 +366,11 @@ TEST_P(ShippedScenes, LightcutsMatchesBruteForceAtDefaults) {
     scene.render.area_light_samples = std::min(scene.render.area_light_samples, 4096u);
     PreparedScene p = prepare_scene(std::move(scene), 1);
     RenderOptions o = test::options("lightcuts", 64);
+    o.cut_heap = o.max_cut;
     RenderResult lc = render_cpu(p, o);
+    ASSERT_EQ(lc.stats.heap_frozen_samples, 0u);
+    o.cut_heap = kDefaultCutHeap;
+    const RenderResult bounded = render_cpu(p, o);
     o.method = "brute";
     RenderResult brute = render_cpu(p, o);
     CompareResult cmp = compare_images(lc.image, brute.image);
@@ -314,20 +384,26 @@ TEST_P(ShippedScenes, LightcutsMatchesBruteForceAtDefaults) {
     EXPECT_LT(cmp.fraction_above_2pct, c.max_above_2pct);
     EXPECT_LT(cmp.fraction_above_5pct, c.max_above_5pct);
     EXPECT_LT(lc.stats.shadow_rays, brute.stats.shadow_rays / 4);
+    const CompareResult bounded_cmp = compare_images(bounded.image, brute.image);
+    std::printf("[ measured ] %s, cut_heap %u: relative RMSE %.4f, above 2%% %.4f, above 5%% %.4f; %.1f%% of the "
+                "samples froze clusters\n",
+                c.scene, kDefaultCutHeap, bounded_cmp.relative_rmse, bounded_cmp.fraction_above_2pct,
+                bounded_cmp.fraction_above_5pct, 100.0 * double(bounded.stats.heap_frozen_samples) / (64.0 * 64.0));
+    EXPECT_LT(bounded_cmp.relative_rmse, c.bounded_max_rmse);
 }
 
 INSTANTIATE_TEST_SUITE_P(Lightcuts, ShippedScenes,
-                         ::testing::Values(ShippedCase{"scenes/room/room.json", 0.012, 0.09, 0.01},
-                                           ShippedCase{"scenes/bunny/bunny.json", 0.012, 0.06, 0.01},
+                         ::testing::Values(ShippedCase{"scenes/room/room.json", 0.012, 0.09, 0.01, 0.012},
+                                           ShippedCase{"scenes/bunny/bunny.json", 0.012, 0.06, 0.01, 0.012},
                                            // Measured 0.0013, 5.7%, 0.12% (4096 samples).
-                                           ShippedCase{"scenes/panels/panels.json", 0.002, 0.086, 0.002},
+                                           ShippedCase{"scenes/panels/panels.json", 0.002, 0.086, 0.002, 0.002},
                                            // Measured 0.040, 53%, 17%: sharp spots whose
                                            // representative misses the point (docs/lightcuts.md).
-                                           ShippedCase{"scenes/gallery/gallery.json", 0.06, 0.8, 0.25},
+                                           ShippedCase{"scenes/gallery/gallery.json", 0.06, 0.8, 0.25, 0.16},
                                            // Measured 0.012, 9.1%, 0.24%.
-                                           ShippedCase{"scenes/sky/sky.json", 0.018, 0.14, 0.004},
+                                           ShippedCase{"scenes/sky/sky.json", 0.018, 0.14, 0.004, 0.018},
                                            // Disney spheres: measured 0.0106, 8.2%, 0.17%.
-                                           ShippedCase{"scenes/materials/materials.json", 0.016, 0.12, 0.003}),
+                                           ShippedCase{"scenes/materials/materials.json", 0.016, 0.12, 0.003, 0.016}),
                          [](const auto& info) {
                              std::string name = info.param.scene;
                              name = name.substr(name.rfind('/') + 1);

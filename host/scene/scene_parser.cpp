@@ -107,8 +107,8 @@ private:
     void parse_render(const json& j) {
         const std::string path = "render";
         in_.expect_object(j, path);
-        in_.check_keys(j, path, {kSettingMethod, kSettingSpp, kSettingRelativeError, kSettingMaxCut, kSettingSeed,
-                                 kSettingAreaLightSamples, kSettingLightSamples, kSettingLightPick,
+        in_.check_keys(j, path, {kSettingMethod, kSettingSpp, kSettingRelativeError, kSettingMaxCut, kSettingCutHeap,
+                                 kSettingSeed, kSettingAreaLightSamples, kSettingLightSamples, kSettingLightPick,
                                  kSettingMaxBounces, kSettingTimeLimit, kSettingIndirect});
         RenderSettings& r = scene_.render;
         if (const json* v = JsonReader::find(j, kSettingMethod)) {
@@ -125,6 +125,7 @@ private:
         if (const auto v = setting(kSettingSpp)) r.spp = static_cast<std::uint32_t>(*v);
         if (const auto v = setting(kSettingRelativeError)) r.relative_error = static_cast<float>(*v);
         if (const auto v = setting(kSettingMaxCut)) r.max_cut = static_cast<std::uint32_t>(*v);
+        if (const auto v = setting(kSettingCutHeap)) r.cut_heap = static_cast<std::uint32_t>(*v);
         if (const auto v = setting(kSettingSeed)) r.seed = static_cast<std::uint32_t>(*v);
         if (const auto v = setting(kSettingAreaLightSamples)) r.area_light_samples = static_cast<std::uint32_t>(*v);
         if (const auto v = setting(kSettingLightSamples)) r.light_samples = static_cast<std::uint32_t>(*v);

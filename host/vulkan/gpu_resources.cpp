@@ -46,7 +46,7 @@ constexpr bool scene_bindings_in_order() {
 static_assert(scene_bindings_in_order());
 static_assert(gpu::kBindingRadiance == gpu::kBindingGBuffer + 1 &&
               gpu::kBindingPixelStats == gpu::kBindingGBuffer + 2 &&
-              gpu::kBindingHeapSpill == gpu::kBindingGBuffer + 3 &&
+              gpu::kBindingHeapSave == gpu::kBindingGBuffer + 3 &&
               gpu::kBindingCutState == gpu::kBindingGBuffer + 4 &&
               gpu::kBindingCount == gpu::kBindingGBuffer + 5,
               "GpuResources::TileIndex follows the per-tile bindings");
@@ -153,7 +153,7 @@ std::vector<TileBuffer> GpuResources::tile_buffers(const ShadingMethod& method) 
     buffers[kGBuffer] = {"g-buffer", sizeof(gpu::GBufferTexel), ""};
     buffers[kRadiance] = {"radiance", 3 * sizeof(float), ""};
     buffers[kPixelStats] = {"pixel stats", sizeof(gpu::PixelStats), ""};
-    buffers[kHeapSpill] = method.heap_spill();
+    buffers[kHeapSave] = method.heap_save();
     buffers[kCutState] = method.cut_state();
     return buffers;
 }

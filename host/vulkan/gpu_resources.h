@@ -57,7 +57,7 @@ public:
 
 private:
     // Per-tile buffers, in binding order from kBindingGBuffer.
-    enum TileIndex { kGBuffer, kRadiance, kPixelStats, kHeapSpill, kCutState, kTileBufferCount };
+    enum TileIndex { kGBuffer, kRadiance, kPixelStats, kHeapSave, kCutState, kTileBufferCount };
 
     Buffer storage_buffer(const std::string& name, VkDeviceSize bytes, MemoryUse use,
                           VkBufferUsageFlags extra_usage = 0);

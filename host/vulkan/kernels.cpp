@@ -18,9 +18,8 @@ struct SpecData {
     std::uint32_t workgroup_size;
     VkBool32 enable_ggx;
     VkBool32 enable_shadows;
-    std::uint32_t heap_shared;
-    std::uint32_t heap_capacity;
-    std::uint32_t spill_stride;
+    std::uint32_t heap_slots;
+    std::uint32_t save_stride;
     VkBool32 enable_oriented;
     VkBool32 stochastic;
     VkBool32 enable_textures;
@@ -45,9 +44,8 @@ Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const Ker
         {gpu::kSpecWorkgroupSize, offsetof(SpecData, workgroup_size), sizeof(std::uint32_t)},
         {gpu::kSpecEnableGgx, offsetof(SpecData, enable_ggx), sizeof(VkBool32)},
         {gpu::kSpecEnableShadows, offsetof(SpecData, enable_shadows), sizeof(VkBool32)},
-        {gpu::kSpecHeapShared, offsetof(SpecData, heap_shared), sizeof(std::uint32_t)},
-        {gpu::kSpecHeapCapacity, offsetof(SpecData, heap_capacity), sizeof(std::uint32_t)},
-        {gpu::kSpecSpillStride, offsetof(SpecData, spill_stride), sizeof(std::uint32_t)},
+        {gpu::kSpecHeapSlots, offsetof(SpecData, heap_slots), sizeof(std::uint32_t)},
+        {gpu::kSpecSaveStride, offsetof(SpecData, save_stride), sizeof(std::uint32_t)},
         {gpu::kSpecEnableOriented, offsetof(SpecData, enable_oriented), sizeof(VkBool32)},
         {gpu::kSpecStochastic, offsetof(SpecData, stochastic), sizeof(VkBool32)},
         {gpu::kSpecEnableTextures, offsetof(SpecData, enable_textures), sizeof(VkBool32)},
@@ -77,15 +75,13 @@ Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const Ker
 
 Kernels::Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMethod& method,
                  const KernelSwitches& switches) {
-    const HeapLayout heap = method.heap();
     SpecData spec{};
     spec.workgroup_size = gpu::kWorkgroupSize;
     spec.enable_ggx = switches.ggx;
     spec.enable_shadows = switches.shadows;
     // Kernels without a heap do not declare its constants; any valid value does.
-    spec.heap_shared = std::max(heap.shared, 1u);
-    spec.heap_capacity = std::max(heap.capacity, 1u);
-    spec.spill_stride = switches.spill_stride;
+    spec.heap_slots = std::max(method.heap_slots(), 1u);
+    spec.save_stride = switches.save_stride;
     spec.enable_oriented = switches.oriented;
     spec.stochastic = method.stochastic();
     spec.enable_textures = switches.textures;

@@ -19,7 +19,7 @@ struct KernelSwitches {
     bool disney = true;              // compile the Disney BRDF in
     bool sheen = true;               // ... and its sheen lobe
     bool clearcoat = true;           // ... and its clearcoat lobe
-    std::uint32_t spill_stride = 1;  // invocations the heap spill buffer is laid out for
+    std::uint32_t save_stride = 1;   // invocations the heap-save buffer is laid out for
 };
 
 class Kernels {

@@ -54,25 +54,29 @@ private:
 constexpr std::uint32_t kFirstRefineBudget = 128;
 
 // Lightcuts: every cut from the roots to the end in one dispatch, or a
-// budget of steps per dispatch, the cut paused in CutState and the heap's
-// spill buffer in between. A step is one refinement, or (stochastic) one
+// budget of steps per dispatch, the cut paused in CutState and the heap in
+// the heap-save buffer in between. A step is one refinement, or (stochastic) one
 // fresh representative drawn for a cluster of the final cut.
 class Lightcuts final : public ShadingMethod {
 public:
     Lightcuts(const gpu::FrameParams& frame, const LightTree& tree, const Tuning& tuning,
-              std::uint32_t shared_memory_bytes, bool stochastic)
-        : max_cut_(frame.max_cut), stochastic_(stochastic) {
+              std::uint32_t cut_heap, std::uint32_t shared_memory_bytes, bool stochastic)
+        : stochastic_(stochastic) {
         // Walter 2005 §4 keeps a max-heap of the refinable clusters of the
-        // cut; the tree bounds its size, whatever max_cut says. The first K
-        // slots live in shared memory, as many as fit a whole workgroup.
-        heap_.capacity = tree.cut_heap_capacity(frame.max_cut);
-        const std::uint32_t k_max =
-            shared_memory_bytes / (gpu::kWorkgroupSize * std::uint32_t(sizeof(gpu::CutEntry)));
-        if (k_max == 0)
-            throw std::runtime_error("Vulkan device has too little shared memory (" +
-                                     std::to_string(shared_memory_bytes) +
-                                     " bytes) for the cut heap");
-        heap_.shared = std::min(k_max, heap_.capacity);
+        // cut, here bounded by K = render.cut_heap (shared/lightcuts.h,
+        // lc_heap_push); the tree bounds it too, whatever max_cut says. All
+        // K slots of every invocation live in shared memory.
+        heap_slots_ = tree.cut_heap_slots(frame.max_cut, cut_heap);
+        const std::uint64_t bytes =
+            std::uint64_t(heap_slots_) * gpu::kWorkgroupSize * sizeof(gpu::CutEntry);
+        if (bytes > shared_memory_bytes)
+            throw std::runtime_error(
+                "cut_heap " + std::to_string(cut_heap) + " needs " + std::to_string(bytes) +
+                " bytes of shared memory per workgroup (" + std::to_string(gpu::kWorkgroupSize) +
+                " invocations x " + std::to_string(heap_slots_) + " slots x " +
+                std::to_string(sizeof(gpu::CutEntry)) + " bytes); the Vulkan device offers " +
+                std::to_string(shared_memory_bytes) + ", so at most cut_heap " +
+                std::to_string(shared_memory_bytes / (gpu::kWorkgroupSize * sizeof(gpu::CutEntry))));
         // A refinement adds one cluster to the cut and takes one interior
         // node off the heap for good, so a cut never sees more refinements
         // than either allows.
@@ -80,7 +84,7 @@ public:
         const std::uint64_t refinements = std::min<std::uint64_t>(frame.max_cut, interior);
         // The refinements, the step that finds the cut final, and the fresh
         // draws of the heap's clusters.
-        max_steps_ = refinements + 1 + (stochastic ? std::uint64_t(heap_.capacity) * frame.light_samples : 0);
+        max_steps_ = refinements + 1 + (stochastic ? std::uint64_t(heap_slots_) * frame.light_samples : 0);
         if (tuning.refinements_per_dispatch > 0) budget_ = tuning.refinements_per_dispatch;
     }
 
@@ -89,11 +93,10 @@ public:
                 stochastic_ ? "lightcuts.comp (stochastic lightcuts)" : "lightcuts.comp (cut selection + shading)"};
     }
     bool stochastic() const override { return stochastic_; }
-    HeapLayout heap() const override { return heap_; }
-    TileBuffer heap_spill() const override {
-        return {"heap spill", std::uint64_t(heap_.capacity) * sizeof(gpu::CutEntry),
-                std::to_string(heap_.capacity) + " heap slots per pixel for max_cut " +
-                    std::to_string(max_cut_)};
+    std::uint32_t heap_slots() const override { return heap_slots_; }
+    TileBuffer heap_save() const override {
+        return {"heap save", std::uint64_t(heap_slots_) * sizeof(gpu::CutEntry),
+                std::to_string(heap_slots_) + " heap slots per pixel"};
     }
     TileBuffer cut_state() const override { return {"cut state", sizeof(gpu::CutState), ""}; }
     bool reports_cuts() const override { return true; }
@@ -117,9 +120,8 @@ public:
     }
 
 private:
-    std::uint32_t max_cut_;
     bool stochastic_;
-    HeapLayout heap_;
+    std::uint32_t heap_slots_ = 0;
     std::uint64_t max_steps_ = 0;
     std::uint32_t budget_ = gpu::kUnlimitedRefinements;  // refinements per dispatch
 };
@@ -131,7 +133,8 @@ std::unique_ptr<ShadingMethod> make_shading_method(const RenderOptions& options,
                                                    const LightTree& tree, const Tuning& tuning,
                                                    std::uint32_t shared_memory_bytes) {
     if (method_selects_cuts(options.method))
-        return std::make_unique<Lightcuts>(frame, tree, tuning, shared_memory_bytes, options.method == "stochastic");
+        return std::make_unique<Lightcuts>(frame, tree, tuning, options.cut_heap, shared_memory_bytes,
+                                           options.method == "stochastic");
     if (options.method == "sampled")
         return std::make_unique<RangedMethod>(
             KernelCode{lc_spirv_sampled, sizeof lc_spirv_sampled, "sampled.comp (light samples)"},

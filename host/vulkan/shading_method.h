@@ -24,14 +24,6 @@ struct KernelCode {
     const char* name = "";
 };
 
-// Cut-heap slots per invocation (shaders/heap.glsl): the first `shared` in
-// workgroup shared memory, up to `capacity` in the spill buffer. Zero for a
-// method without a heap.
-struct HeapLayout {
-    std::uint32_t shared = 0;
-    std::uint32_t capacity = 0;
-};
-
 // A per-tile buffer and its bytes per tile pixel; `why` explains the size
 // when the buffer cannot fit a single workgroup.
 struct TileBuffer {
@@ -45,10 +37,12 @@ public:
     virtual ~ShadingMethod() = default;
 
     virtual KernelCode kernel() const = 0;
-    virtual HeapLayout heap() const { return {}; }
-    // Bytes per tile pixel of the heap spill and cut state buffers (0: not
+    // Cut-heap slots per invocation, all in workgroup shared memory
+    // (shaders/heap.glsl); 0 for a method without a heap.
+    virtual std::uint32_t heap_slots() const { return 0; }
+    // Bytes per tile pixel of the heap-save and cut state buffers (0: not
     // used; the binding still gets a one-element buffer).
-    virtual TileBuffer heap_spill() const { return {"heap spill", 0, ""}; }
+    virtual TileBuffer heap_save() const { return {"heap save", 0, ""}; }
     virtual TileBuffer cut_state() const { return {"cut state", 0, ""}; }
     // True when the method's cut sizes go into RenderStats::cut_size.
     virtual bool reports_cuts() const { return false; }

@@ -94,12 +94,9 @@ std::uint32_t TileScheduler::loop_limited_pixels(const Tile& tile) const {
             cut_short += 1;
             continue;
         }
-        if (flags & (gpu::kPixelHeapOverflow | gpu::kPixelCutUnfinished))
+        if (flags & gpu::kPixelCutUnfinished)
             throw std::logic_error(
-                std::string("Lightcuts kernel: ") +
-                (flags & gpu::kPixelHeapOverflow ? "heap outgrew its capacity"
-                                                 : "cut unfinished after the last dispatch") +
-                " at pixel (" + std::to_string(tile.x0 + i % tile.width) + ", " +
+                "Lightcuts kernel: cut unfinished after the last dispatch at pixel (" + std::to_string(tile.x0 + i % tile.width) + ", " +
                 std::to_string(tile.y0 + i / tile.width) + ")");
     }
     return cut_short;
@@ -132,12 +129,15 @@ void TileScheduler::read_back(const Tile& tile, RenderResult& result) const {
         const gpu::PixelStats& ps = pixel_stats[i];
         out.shadow_rays += gpu::count64(ps.shadow_rays_lo, ps.shadow_rays_hi);
         out.max_cut_pixels += ps.max_cut_samples;
-        out.heap_spill_pixels += ps.spill_samples;
+        out.heap_frozen_samples += ps.frozen_samples;
+        out.heap_paused_samples += ps.paused_samples;
         out.cut_indirect_total += gpu::count64(ps.cut_indirect_lo, ps.cut_indirect_hi);
         // The CPU reference's rounding of the mean, so equal cuts compare equal.
-        if (method_.reports_cuts())
+        if (method_.reports_cuts()) {
             out.cut_size[std::size_t(y) * frame_.width + x] =
                 float(double(gpu::count64(ps.cut_size_lo, ps.cut_size_hi)) / spp);
+            out.heap_froze[std::size_t(y) * frame_.width + x] = float(double(ps.frozen_samples) / spp);
+        }
     }
 }
 

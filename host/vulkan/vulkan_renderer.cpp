@@ -40,15 +40,19 @@ RenderResult render(const Context& ctx, const PreparedScene& prepared,
     if (frame.width == 0 || frame.height == 0) return result;
 
     RenderSetup setup(ctx, prepared, options, frame, tuning);
-    if (setup.method->reports_cuts())
+    if (setup.method->reports_cuts()) {
         stats.cut_size.assign(std::size_t(frame.width) * frame.height, 0.0f);
+        stats.heap_froze.assign(std::size_t(frame.width) * frame.height, 0.0f);
+    }
     TileScheduler scheduler(ctx.device_name(), setup.submitter, setup.pass, *setup.method,
                             setup.resources, frame, tuning.target_dispatch_ms, options.progress);
     scheduler.render(result);
 
     stats.spp_done = frame.spp;
     stats.camera_rays = std::uint64_t(frame.width) * frame.height * frame.spp;
-    stats.heap_capacity_shared = setup.method->heap().shared;
+    stats.heap_slots = setup.method->heap_slots();
+    stats.heap_shared_bytes = std::uint64_t(stats.heap_slots) * gpu::kWorkgroupSize * sizeof(gpu::CutEntry);
+    stats.workgroup_size = gpu::kWorkgroupSize;
     stats.buffer_bytes = setup.resources.buffer_bytes();
     return result;
 }

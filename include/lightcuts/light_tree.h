@@ -32,6 +32,9 @@ struct LightTree {
     // nodes, and never more than the cut (max(max_cut, roots) clusters).
     // At least 1, whatever max_cut is.
     std::uint32_t cut_heap_capacity(std::uint32_t max_cut) const;
+    // The slots a cut heap of capacity `cut_heap` (render.cut_heap) gets:
+    // no more than cut_heap_capacity(max_cut) ever holds. At least 1.
+    std::uint32_t cut_heap_slots(std::uint32_t max_cut, std::uint32_t cut_heap) const;
 };
 
 enum class TreeBuilder {

@@ -65,6 +65,7 @@ struct RenderOptions {
     std::uint32_t spp = 1;
     float relative_error = 0.02f;
     std::uint32_t max_cut = 1000;
+    std::uint32_t cut_heap = kDefaultCutHeap;  // lightcuts: cut-heap capacity K per shaded point
     std::uint32_t seed = 1;
     std::uint32_t light_samples = 1;  // sampled: lights per camera sample; stochastic: draws per cluster
     std::string light_pick = "tree";  // sampled: "tree", "uniform" or "power"
@@ -84,11 +85,19 @@ struct RenderStats {
     std::uint64_t camera_rays = 0;
     std::uint64_t shadow_rays = 0;
     std::uint64_t max_cut_pixels = 0;       // samples where refinement hit max_cut
-    std::uint64_t heap_spill_pixels = 0;    // GPU: samples whose heap spilled to global memory
-    std::uint32_t heap_capacity_shared = 0; // GPU: heap slots per invocation in shared memory
+    std::uint32_t heap_slots = 0;           // lightcuts: cut-heap slots per shaded point (GPU: in
+                                            // shared memory), min(cut_heap, what the tree can fill)
+    std::uint64_t heap_frozen_samples = 0;  // lightcuts: samples whose cut froze clusters out of a
+                                            // full heap
+    std::uint64_t heap_paused_samples = 0;  // GPU: samples whose heap waited in global memory
+                                            // between dispatches (the driver's loop limit)
+    std::uint64_t heap_shared_bytes = 0;    // GPU: shared memory of one workgroup's heaps
+    std::uint32_t workgroup_size = 0;       // GPU: invocations per workgroup
     std::uint32_t loop_limit_retries = 0;   // GPU: tiles rendered again with the work split over
                                             // more dispatches (the driver cut loops short)
     std::vector<float> cut_size;      // per pixel, mean over samples (lightcuts only)
+    std::vector<float> heap_froze;    // per pixel, the fraction of samples whose cut froze
+                                      // clusters out of a full heap (lightcuts only)
     std::uint64_t cut_indirect_total = 0;  // lightcuts: VPL clusters, summed over every sample's cut
     std::vector<std::pair<std::string, std::uint64_t>> buffer_bytes;
 };

@@ -26,8 +26,14 @@ struct LightcutsReport {
     double cut_size_mean = 0.0, cut_size_p50 = 0.0, cut_size_p99 = 0.0, cut_size_max = 0.0;
     double cut_indirect_mean = 0.0;           // of cut_size_mean, VPL clusters (indirect light)
     std::uint64_t max_cut_samples = 0;        // samples whose refinement stopped at max_cut
-    std::uint32_t heap_capacity_shared = 0;   // GPU only
-    std::uint64_t heap_spill_samples = 0;     // GPU only
+    std::uint32_t cut_heap = 0;               // render.cut_heap, the heap's capacity K
+    std::uint32_t heap_slots = 0;             // slots a heap gets: K, or less where the tree
+                                              // cannot fill K (GPU: in shared memory)
+    std::uint64_t heap_bytes = 0;             // GPU: shared memory the heaps of a workgroup take
+    std::uint32_t workgroup_size = 0;         // GPU: invocations per workgroup
+    std::uint64_t heap_frozen_samples = 0;    // samples whose cut froze clusters out of a full heap
+    std::uint64_t heap_paused_samples = 0;    // GPU: samples whose heap waited in global memory
+                                              // between dispatches
 };
 
 struct SamplingReport {

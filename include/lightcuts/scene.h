@@ -10,6 +10,7 @@
 
 #include <glm/glm.hpp>
 
+#include "settings.h"
 #include "shared/types.h"
 
 namespace lc {
@@ -37,6 +38,7 @@ struct RenderSettings {
     std::uint32_t spp = 1;          // camera rays per pixel (stratified, jittered)
     float relative_error = 0.02f;   // lightcuts: refine while bound > this * estimate
     std::uint32_t max_cut = 1000;   // lightcuts: largest cut per shaded point
+    std::uint32_t cut_heap = kDefaultCutHeap;  // lightcuts: cut-heap capacity K per shaded point
     std::uint32_t seed = 1;         // pixel jitter, light-tree representatives, light samples
     std::uint32_t light_samples = 1;  // sampled: lights per camera sample; stochastic: draws per cluster
     std::string light_pick = "tree";  // sampled: "tree", "uniform" or "power"

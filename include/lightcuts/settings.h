@@ -18,7 +18,11 @@ inline constexpr std::uint32_t kMaxLightSamplesPerPoint = 65536;  // sampled, st
 inline constexpr std::uint32_t kMaxVpls = 1u << 24;    // render.indirect.vpls
 inline constexpr std::uint32_t kMaxBounces = 1024;     // max_bounces (path and indirect); 0 = unlimited
 // max_cut may be any positive 32-bit value: the cut heap is sized by the
-// light tree, never by max_cut (a cut cannot outgrow the tree).
+// light tree and cut_heap, never by max_cut (a cut cannot outgrow the tree).
+// The default capacity K of the cut heap per shaded point (cut_heap): a cut
+// that would need more freezes its clusters of smallest bound
+// (docs/lightcuts.md, "The bounded heap"; the choice: docs/results/heap.md).
+inline constexpr std::uint32_t kDefaultCutHeap = 64;
 
 // Names of the settings as the scene file's render block spells them (the
 // command line uses the same words, with "--" and '-' for '_').
@@ -26,6 +30,7 @@ inline constexpr std::string_view kSettingMethod = "method";
 inline constexpr std::string_view kSettingSpp = "spp";
 inline constexpr std::string_view kSettingRelativeError = "relative_error";
 inline constexpr std::string_view kSettingMaxCut = "max_cut";
+inline constexpr std::string_view kSettingCutHeap = "cut_heap";
 inline constexpr std::string_view kSettingSeed = "seed";
 inline constexpr std::string_view kSettingWidth = "width";
 inline constexpr std::string_view kSettingHeight = "height";

@@ -5,21 +5,48 @@
 //   LC_LIGHT_NODE(i)        -> LightNode
 //   LC_HEAP_LOAD(i)         -> CutEntry        (heap slot i of this point)
 //   LC_HEAP_STORE(i, e)     stores CutEntry e in slot i
-// On the GPU the first slots live in workgroup shared memory and the rest
-// spill to a global buffer; on the CPU they are a per-thread array.
+//   LC_HEAP_CAPACITY        K, the heap's capacity (see lc_heap_push)
+// On the GPU the K slots live in workgroup shared memory; on the CPU they
+// are a per-thread array.
 // No include guard: each kernel context (a GLSL shader, a C++ kernel
 // struct in host/cpu_kernel.h) includes it exactly once.
 
-// Unscaled contribution of a light (material * geometry * visibility):
-// the representative's estimate is this times the cluster's RGB intensity.
-vec3 lc_rep_unit(SurfacePoint sp, uint light_index, float min_distance2,
+// Unscaled contribution of a cluster's representative (material * geometry
+// * visibility): the cluster's estimate is this times its RGB intensity.
+// `visible` is what the shadow ray found (false when no ray was needed
+// because the light cannot reach the point).
+vec3 lc_rep_unit(SurfacePoint sp, uint light_index, float min_distance2, LC_OUT(bool) visible,
                  LC_INOUT(ShadeStats) stats) {
-    return lc_light_unit_shadowed(sp, LC_LIGHT(light_index), min_distance2, stats);
+    vec3 wi;
+    float t_max;
+    vec3 unit = lc_light_unit(sp, LC_LIGHT(light_index), min_distance2, wi, t_max);
+    visible = false;
+    if (!(unit.x + unit.y + unit.z > 0.0f)) return vec3(0.0f);
+    stats.shadow_rays += 1u;
+    visible = lc_visible(sp, wi, t_max);
+    return visible ? unit : vec3(0.0f);
 }
 
-void lc_heap_push(LC_INOUT(uint) size, CutEntry e) {
-    uint i = size;
-    size += 1u;
+// The same contribution again, from the visibility an earlier ray found:
+// the same function of the same inputs, without the ray.
+vec3 lc_rep_unit_known(SurfacePoint sp, uint light_index, float min_distance2, bool visible) {
+    if (!visible) return vec3(0.0f);
+    vec3 wi;
+    float t_max;
+    return lc_light_unit(sp, LC_LIGHT(light_index), min_distance2, wi, t_max);
+}
+
+uint lc_entry_node(CutEntry e) { return e.node & kCutEntryNodeMask; }
+bool lc_entry_visible(CutEntry e) { return (e.node & kCutEntryVisible) != 0u; }
+
+// An entry's estimate: its representative's contribution times the
+// cluster's intensity.
+vec3 lc_entry_estimate(SurfacePoint sp, CutEntry e, float min_distance2) {
+    LightNode node = LC_LIGHT_NODE(lc_entry_node(e));
+    return lc_rep_unit_known(sp, node.rep_light, min_distance2, lc_entry_visible(e)) * lc_node_intensity(node);
+}
+
+void lc_heap_sift_up(uint i, CutEntry e) {
     while (i > 0u) {
         uint parent = (i - 1u) / 2u;
         CutEntry p = LC_HEAP_LOAD(parent);
@@ -54,13 +81,50 @@ void lc_heap_pop(LC_INOUT(uint) size) {
     LC_HEAP_STORE(i, last);
 }
 
+// The bounded heap: at most LC_HEAP_CAPACITY entries. A push into a full
+// heap freezes the entry with the smallest bound, the new one included (the
+// new one on a tie): it stays in the cut with its current estimate, which
+// moves from heap_sum into the frozen part of the sum, `fixed_sum`, and is
+// never refined. The smallest entry of a max-heap is one of its leaves,
+// slots size/2 and up; the new entry takes its slot and rises.
+void lc_heap_push(SurfacePoint sp, float min_distance2, LC_INOUT(uint) size, CutEntry e, vec3 estimate,
+                  LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
+    if (size < uint(LC_HEAP_CAPACITY)) {
+        size += 1u;
+        lc_heap_sift_up(size - 1u, e);
+        heap_sum += estimate;
+        return;
+    }
+    stats.frozen += 1u;
+    uint smallest = kInvalidIndex;
+    float smallest_error = e.error;
+    for (uint i = size / 2u; i < size; ++i) {
+        float error = LC_HEAP_LOAD(i).error;
+        if (error < smallest_error) {
+            smallest_error = error;
+            smallest = i;
+        }
+    }
+    if (smallest == kInvalidIndex) {
+        stats.frozen_error += e.error;
+        fixed_sum += estimate;
+        return;
+    }
+    stats.frozen_error += smallest_error;
+    vec3 frozen = lc_entry_estimate(sp, LC_HEAP_LOAD(smallest), min_distance2);
+    fixed_sum += frozen;
+    heap_sum += estimate - frozen;
+    lc_heap_sift_up(smallest, e);
+}
+
 // Adds one cluster to the cut: its bound decides whether it needs a ray at
-// all; leaves are final (exact, zero error) and go to leaf_sum, refinable
+// all; leaves are final (exact, zero error) and go to fixed_sum, refinable
 // interior nodes go to the heap. `inherited` is true when the caller already
-// knows the representative's unit contribution (shared with the parent).
-void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, bool inherited,
-                    vec3 inherited_unit, float min_distance2, LC_INOUT(uint) heap_size, LC_INOUT(vec3) leaf_sum,
-                    LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
+// knows the representative's unit contribution (shared with the parent) and
+// the visibility behind it.
+void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, bool inherited, vec3 inherited_unit,
+                    bool inherited_visible, float min_distance2, LC_INOUT(uint) heap_size,
+                    LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
     LightNode node = LC_LIGHT_NODE(node_index);
     vec3 intensity = lc_node_intensity(node);
     bool leaf = (node.flags & kNodeLeaf) != 0u;
@@ -71,19 +135,16 @@ void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, bool inherited
         // A cluster whose bound is zero contributes exactly zero: no ray.
         if (!(error > 0.0f)) return;
     }
-    vec3 unit = inherited ? inherited_unit : lc_rep_unit(sp, node.rep_light, min_distance2, stats);
+    bool visible = inherited_visible;
+    vec3 unit = inherited ? inherited_unit : lc_rep_unit(sp, node.rep_light, min_distance2, visible, stats);
     if (leaf) {
-        leaf_sum += unit * intensity;
+        fixed_sum += unit * intensity;
         return;
     }
     CutEntry e;
-    e.node = node_index;
+    e.node = node_index | (visible ? kCutEntryVisible : 0u);
     e.error = error;
-    e.unit_r = unit.x;
-    e.unit_g = unit.y;
-    e.unit_b = unit.z;
-    lc_heap_push(heap_size, e);
-    heap_sum += unit * intensity;
+    lc_heap_push(sp, min_distance2, heap_size, e, unit * intensity, fixed_sum, heap_sum, stats);
 }
 
 // Walter 2005, section 4: start from the roots, repeatedly replace the
@@ -93,18 +154,19 @@ void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, bool inherited
 //
 // In three steps (start, one refinement, result) so that the GPU can spread
 // a long refinement over several dispatches; lc_shade_lightcuts runs them
-// back to back.
+// back to back. fixed_sum holds the estimates that are final (leaves and
+// frozen clusters), heap_sum the running sum of the heap's.
 void lc_cut_start(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_size,
-                  LC_OUT(vec3) leaf_sum, LC_OUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
+                  LC_OUT(vec3) fixed_sum, LC_OUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
     heap_size = 0u;
-    leaf_sum = vec3(0.0f);
+    fixed_sum = vec3(0.0f);
     heap_sum = vec3(0.0f);
     stats.cut_size = 0u;
     uint root_count = 0u;
     for (uint type = 0u; type < kLightTypeCount; ++type) {
         if (f.roots[type] == kInvalidIndex) continue;
-        lc_add_cluster(sp, m, f.roots[type], false, vec3(0.0f), f.min_distance2, heap_size,
-                       leaf_sum, heap_sum, stats);
+        lc_add_cluster(sp, m, f.roots[type], false, vec3(0.0f), false, f.min_distance2, heap_size, fixed_sum,
+                       heap_sum, stats);
         root_count += 1u;
     }
     stats.cut_size = root_count;
@@ -116,24 +178,25 @@ void lc_cut_start(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_
 // Refines the cluster with the largest bound; false (cut unchanged) once the
 // cut is final.
 bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) heap_size,
-                   LC_INOUT(vec3) leaf_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
+                   LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
     if (heap_size == 0u) return false;
     CutEntry top = LC_HEAP_LOAD(0u);
-    float estimate = lc_luminance(leaf_sum + heap_sum);
+    float estimate = lc_luminance(fixed_sum + heap_sum);
     if (!(top.error > f.relative_error * estimate)) return false;
     if (stats.cut_size >= f.max_cut) {
         stats.hit_max_cut = 1u;
         return false;
     }
     lc_heap_pop(heap_size);
-    LightNode node = LC_LIGHT_NODE(top.node);
-    vec3 unit = vec3(top.unit_r, top.unit_g, top.unit_b);
+    LightNode node = LC_LIGHT_NODE(lc_entry_node(top));
+    bool visible = lc_entry_visible(top);
+    vec3 unit = lc_rep_unit_known(sp, node.rep_light, f.min_distance2, visible);
     heap_sum -= unit * lc_node_intensity(node);
     bool right_shares = (node.flags & kNodeRepFromRight) != 0u;
-    lc_add_cluster(sp, m, node.left, !right_shares, unit, f.min_distance2, heap_size, leaf_sum,
+    lc_add_cluster(sp, m, node.left, !right_shares, unit, visible, f.min_distance2, heap_size, fixed_sum,
                    heap_sum, stats);
-    lc_add_cluster(sp, m, node.left + 1u, right_shares, unit, f.min_distance2, heap_size,
-                   leaf_sum, heap_sum, stats);
+    lc_add_cluster(sp, m, node.left + 1u, right_shares, unit, visible, f.min_distance2, heap_size, fixed_sum,
+                   heap_sum, stats);
     stats.cut_size += 1u;
     if (lc_node_type(node) == kLightVpl) stats.cut_indirect += 1u;
     return true;
@@ -141,30 +204,27 @@ bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) he
 
 // The running heap_sum drifts by the additions and subtractions of the
 // refinements; the result is summed afresh from the final cut.
-vec3 lc_cut_result(uint heap_size, vec3 leaf_sum) {
-    vec3 result = leaf_sum;
-    for (uint i = 0u; i < heap_size; ++i) {
-        CutEntry e = LC_HEAP_LOAD(i);
-        result += vec3(e.unit_r, e.unit_g, e.unit_b) * lc_node_intensity(LC_LIGHT_NODE(e.node));
-    }
+vec3 lc_cut_result(SurfacePoint sp, float min_distance2, uint heap_size, vec3 fixed_sum) {
+    vec3 result = fixed_sum;
+    for (uint i = 0u; i < heap_size; ++i) result += lc_entry_estimate(sp, LC_HEAP_LOAD(i), min_distance2);
     return result;
 }
 
 // Runs the cut selection from the roots to the final cut.
-void lc_select_cut(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_size, LC_OUT(vec3) leaf_sum,
+void lc_select_cut(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_size, LC_OUT(vec3) fixed_sum,
                    LC_INOUT(ShadeStats) stats) {
     vec3 heap_sum = vec3(0.0f);
-    lc_cut_start(sp, m, f, heap_size, leaf_sum, heap_sum, stats);
-    while (lc_cut_refine(sp, m, f, heap_size, leaf_sum, heap_sum, stats)) {
+    lc_cut_start(sp, m, f, heap_size, fixed_sum, heap_sum, stats);
+    while (lc_cut_refine(sp, m, f, heap_size, fixed_sum, heap_sum, stats)) {
     }
 }
 
 vec3 lc_shade_lightcuts(SurfacePoint sp, FrameParams f, LC_INOUT(ShadeStats) stats) {
     Material m = sp.mat;
     uint heap_size = 0u;
-    vec3 leaf_sum = vec3(0.0f);
-    lc_select_cut(sp, m, f, heap_size, leaf_sum, stats);
-    return lc_cut_result(heap_size, leaf_sum);
+    vec3 fixed_sum = vec3(0.0f);
+    lc_select_cut(sp, m, f, heap_size, fixed_sum, stats);
+    return lc_cut_result(sp, f.min_distance2, heap_size, fixed_sum);
 }
 
 // Stochastic Lightcuts (Yuksel 2019): the cut is selected exactly as above,
@@ -174,16 +234,19 @@ vec3 lc_shade_lightcuts(SurfacePoint sp, FrameParams f, LC_INOUT(ShadeStats) sta
 // (lc_shade_cluster_stochastic, f.light_samples draws of one shadow ray
 // each, averaged). Single lights are exact already. Each cluster's estimate
 // is unbiased given the cut, so the pixel is, and the mean over samples
-// converges to the exact image.
+// converges to the exact image; except for clusters frozen out of a full
+// heap (lc_heap_push), which keep their fixed representative's estimate in
+// fixed_sum: a bias within their error bounds, absent where no cut fills
+// the heap (the stats count the frozen clusters).
 vec3 lc_shade_stochastic(SurfacePoint sp, FrameParams f, uint stream, LC_INOUT(ShadeStats) stats) {
     Material m = sp.mat;
     uint heap_size = 0u;
-    vec3 result = vec3(0.0f);
+    vec3 result = vec3(0.0f);  // the cut's fixed_sum: single lights and frozen clusters
     lc_select_cut(sp, m, f, heap_size, result, stats);
     float weight = 1.0f / float(f.light_samples);
     for (uint i = 0u; i < heap_size; ++i)
         for (uint d = 0u; d < f.light_samples; ++d)
-            result += lc_shade_cluster_stochastic(sp, LC_HEAP_LOAD(i).node, f.min_distance2, stream, d, stats) *
+            result += lc_shade_cluster_stochastic(sp, lc_entry_node(LC_HEAP_LOAD(i)), f.min_distance2, stream, d, stats) *
                       weight;
     return result;
 }

@@ -179,6 +179,8 @@ struct ShadeStats {
     uint cut_indirect;  // ... of them virtual point lights (indirect light)
     uint shadow_rays;   // rays actually traced
     uint hit_max_cut;   // 1 if refinement stopped at max_cut, not at the threshold
+    uint frozen;        // clusters frozen because the cut heap was full
+    float frozen_error; // ... and the sum of their error bounds
 };
 
 // --- BRDF: Lambert kd/pi plus GGX with constant Fresnel ks and separable

@@ -183,15 +183,18 @@ struct GBufferTexel {
     float u, v;              // texture coordinates of the hit
 };
 
-// One entry of the per-pixel cut heap (20 bytes): a refinable interior node,
-// its error bound and the representative's unscaled contribution
-// (material * geometry * visibility), which its child with the same
-// representative inherits without another shadow ray.
+// One entry of the per-pixel cut heap (8 bytes): a refinable interior node
+// and its error bound. The representative's unscaled contribution
+// (material * geometry * visibility) is not stored: bit 31 of `node` keeps
+// the visibility its shadow ray found, and the contribution is evaluated
+// again from it when needed (lc_entry_unit, shared/lightcuts.h), which costs
+// no ray. The child with the same representative inherits the bit.
 struct CutEntry {
-    uint node;
+    uint node;    // light-node index in bits 0-30, kCutEntryVisible
     float error;
-    float unit_r, unit_g, unit_b;
 };
+LC_CONST uint kCutEntryVisible = 0x80000000u;
+LC_CONST uint kCutEntryNodeMask = 0x7FFFFFFFu;
 
 // How --method sampled draws its lights (FrameParams.light_pick):
 // through the light tree by importance at the shaded point, with the same

@@ -197,27 +197,28 @@ void expect_finite_image(const Image& image, const std::string& what) {
 // [0, bound * I_C] per channel, so |Y(T) - Y(R)| <= Y(bound * I_C), the
 // error bound its heap entry carries; leaves are exact. So at every shaded
 // point, whether or not refinement stopped at max_cut,
-//   |Y(lightcuts) - Y(brute force)| <= sum of the final cut's error bounds.
+//   |Y(lightcuts) - Y(brute force)| <= sum of the final cut's error bounds,
+// the bounds of the clusters frozen out of a full heap included.
 // The slack covers float rounding of the sums: 1e-5 of the magnitudes
 // summed (the estimate, the exact value and the bounds themselves).
 void expect_cut_guarantee(const PreparedScene& p, const RenderOptions& o,
                           const std::vector<ShadingPoint>& points, const std::string& what) {
     const gpu::FrameParams f = make_frame_params(p, o);
-    std::vector<gpu::CutEntry> heap(p.tree.cut_heap_capacity(f.max_cut));
-    Kernel k = cpu::make_shade_kernel(p, heap.data());
+    std::vector<gpu::CutEntry> heap(p.tree.cut_heap_slots(o.max_cut, o.cut_heap));
+    Kernel k = cpu::make_shade_kernel(p, heap.data(), std::uint32_t(heap.size()));
     int reports = 0;
     std::size_t violations = 0;
     double largest_share = 0.0;  // |difference| / sum of bounds, the tightest point
     for (const ShadingPoint& s : points) {
         const gpu::Material m = s.sp.mat;
-        Kernel::ShadeStats stats{0u, 0u, 0u, 0u};
+        Kernel::ShadeStats stats{};
         std::uint32_t heap_size = 0;
-        glm::vec3 leaf_sum, heap_sum;
-        k.lc_cut_start(s.sp, m, f, heap_size, leaf_sum, heap_sum, stats);
-        while (k.lc_cut_refine(s.sp, m, f, heap_size, leaf_sum, heap_sum, stats)) {
+        glm::vec3 fixed_sum, heap_sum;
+        k.lc_cut_start(s.sp, m, f, heap_size, fixed_sum, heap_sum, stats);
+        while (k.lc_cut_refine(s.sp, m, f, heap_size, fixed_sum, heap_sum, stats)) {
         }
-        const double a = luminance(k.lc_cut_result(heap_size, leaf_sum));
-        double bounds = 0.0;
+        const double a = luminance(k.lc_cut_result(s.sp, f.min_distance2, heap_size, fixed_sum));
+        double bounds = double(stats.frozen_error);
         for (std::uint32_t i = 0; i < heap_size; ++i) bounds += double(heap[i].error);
         const double r = luminance(k.lc_shade_brute(s.sp, f.light_count, f.min_distance2, stats));
         const double allowed = bounds + 1e-5 * (a + r + bounds);
@@ -294,6 +295,10 @@ CpuRenders run_cpu_checks(const PreparedScene& p, const RenderOptions& lightcuts
     out.brute = render_cpu(p, brute_options);
     expect_lightcuts_within_limits(out.lightcuts, out.brute, limits, what);
     expect_cut_guarantee(p, lightcuts_options, points, what);
+    // Again with a heap of 3 slots, which freezes clusters at most points.
+    RenderOptions small_heap = lightcuts_options;
+    small_heap.cut_heap = 3;
+    expect_cut_guarantee(p, small_heap, points, what + " (cut_heap 3)");
     return out;
 }
 

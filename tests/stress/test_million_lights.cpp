@@ -48,15 +48,17 @@ TEST(StressMillionLights, TreeAndRenderCpu) {
 
 // Lightcuts only: the GPU brute force over 10^6 lights would dominate the
 // label's run time on a software device. Limits against the CPU: relative
-// RMSE 5e-7 (measured 1.5e-7 on lavapipe), at most one pixel of 256 above 1%
-// (measured none).
+// RMSE 4e-4 (measured 1.2e-4 on lavapipe; 1.5e-7 with an unbounded heap: a
+// full heap freezes the smallest of clusters whose bounds may be within
+// rounding of each other, and each device may freeze another), at most one
+// pixel of 256 above 1% (measured none).
 TEST(StressMillionLights, VulkanMatchesCpu) {
     const PreparedScene p = prepare_scene(million_light_scene(), 1);
     const RenderOptions o = test::options("lightcuts", kSize);
     std::optional<RenderResult> gpu = stress::render_vulkan_if_available(p, o);
     if (!gpu) GTEST_SKIP() << "no Vulkan device (or a build without the Vulkan path)";
     const RenderResult cpu = render_cpu(p, o);
-    stress::expect_images_agree(gpu->image, cpu.image, 5e-7, 0.004, "MillionLights vulkan lightcuts");
+    stress::expect_images_agree(gpu->image, cpu.image, 4e-4, 0.004, "MillionLights vulkan lightcuts");
 }
 
 }  // namespace

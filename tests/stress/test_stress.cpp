@@ -222,6 +222,9 @@ struct StressCase {
 // representative stands for identical lights), so their limit is rounding.
 // Then the Vulkan limits {brute force RMSE, Lightcuts RMSE} against the CPU
 // (see VulkanMatchesCpu), about 3x the lavapipe measurement after "vk".
+// (*) Lightcuts was 2.8e-7 with an unbounded heap; a full heap (64 slots)
+// freezes the smallest of clusters whose bounds can be within rounding of
+// each other, and each device may freeze another one.
 const StressCase kCases[] = {
     {"IntensitiesFrom1em8To1e8WithBlackLights", intensity_range, {0.021, 0.01}, {1.2e-6, 1.2e-6}, {}},  // 0.0136, 0; vk 4.1e-7, 4.2e-7
     {"ThousandCoincidentLights", coincident_lights, {1e-5, 0.0}, {1.5e-6, 2.5e-8}, {}},                  // 0, 0; vk 4.9e-7, 8.2e-9
@@ -230,7 +233,7 @@ const StressCase kCases[] = {
     {"LightsExactlyOnSurfaces", [] { return lights_on_surfaces(0.0f); }, {0.021, 0.01}, {2.7e-6, 2.7e-6}, {}},       // 0.0137, 0.0017; vk 9.0e-7, 8.9e-7
     {"LightsJustInFrontOfSurfaces", [] { return lights_on_surfaces(1e-6f); }, {0.021, 0.01}, {6e-6, 4.3e-6}, {}},    // 0.0137, 0.0017; vk 2.0e-6, 1.4e-6
     {"LightsJustBehindSurfaces", [] { return lights_on_surfaces(-1e-6f); }, {0.021, 0.01}, {2.7e-6, 2.7e-6}, {}},    // 0.0138, 0.0017; vk 8.9e-7, 9.1e-7
-    {"ShadedPointsInsideClusterBoxes", points_inside_cluster_boxes, {0.033, 0.032}, {1.7e-6, 8.5e-7}, {}, true},     // 0.0220, 0.0208; vk 5.6e-7, 2.8e-7
+    {"ShadedPointsInsideClusterBoxes", points_inside_cluster_boxes, {0.033, 0.032}, {1.7e-6, 5e-4}, {}, true},       // 0.0220, 0.0208; vk 5.6e-7, 1.6e-4 (*)
     {"GrazingNormals", grazing_normals, {0.012, 0.01}, {4.5e-5, 5.6e-5}, {}},                           // 0.0080, 0; vk 1.5e-5, 1.9e-5
     {"BackFacingClusters", back_facing_clusters, {0.019, 0.01}, {7.2e-7, 6.4e-7}, {}, false, true},     // 0.0126, 0.0035; vk 2.4e-7, 2.1e-7
     {"SingleLight", single_light, {1e-6, 0.0}, {3.2e-6, 3.2e-6}, {}},                                   // 0, 0; vk 1.1e-6, 1.1e-6
@@ -277,9 +280,9 @@ TEST_P(Stress, VulkanMatchesCpu) {
         const RenderOptions o = options_for(p.scene, method);
         std::optional<RenderResult> gpu = stress::render_vulkan_if_available(p, o);
         if (!gpu) GTEST_SKIP() << "no Vulkan device (or a build without the Vulkan path)";
-        std::printf("[ stress   ] %s on %s: %llu samples spilled their heap (%u shared slots)\n", method,
-                    gpu->stats.device.c_str(), static_cast<unsigned long long>(gpu->stats.heap_spill_pixels),
-                    gpu->stats.heap_capacity_shared);
+        std::printf("[ stress   ] %s on %s: %llu samples froze clusters (%u heap slots in shared memory)\n",
+                    method, gpu->stats.device.c_str(),
+                    static_cast<unsigned long long>(gpu->stats.heap_frozen_samples), gpu->stats.heap_slots);
         const RenderResult cpu = render_cpu(p, o);
         const bool brute = std::string(method) == "brute";
         stress::expect_images_agree(gpu->image, cpu.image,

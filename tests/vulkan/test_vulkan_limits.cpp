@@ -29,39 +29,41 @@ std::uint64_t buffer_bytes(const RenderStats& stats, const std::string& name) {
     return 0;
 }
 
-// The cut heap holds interior nodes of the tree, so its capacity is
-// LightTree::cut_heap_capacity(max_cut), not max_cut: a max_cut of 4e9 over
-// 8 lights takes 7 slots per pixel (it was refused when the heap took
-// max_cut slots).
+// The cut heap holds interior nodes of the tree, so it never gets more
+// slots than LightTree::cut_heap_capacity(max_cut), whatever max_cut and
+// cut_heap say: a max_cut of 4e9 over 8 lights takes 7 slots per pixel (it
+// was refused when the heap took max_cut slots).
 TEST_F(Vulkan, HugeMaxCutTakesAHeapSizedByTheTree) {
     PreparedScene p = prepare_scene(random_scene(61, 8, 0, 8, 8), 1);
     RenderOptions o = options("lightcuts", 8, 8);
     o.max_cut = 4'000'000'000u;
+    o.cut_heap = 4'000'000'000u;
     o.relative_error = 0.0f;  // refine every cluster whose bound is not zero
     const RenderResult g = gpu(p, o);
     expect_lightcuts_matches(p, o, g);
     ASSERT_EQ(p.tree.cut_heap_capacity(o.max_cut), 7u);
-    EXPECT_EQ(buffer_bytes(g.stats, "heap spill"), 7u * sizeof(gpu::CutEntry) * 64);  // one workgroup
+    EXPECT_EQ(g.stats.heap_slots, 7u);
+    EXPECT_EQ(g.stats.heap_frozen_samples, 0u);
+    EXPECT_EQ(buffer_bytes(g.stats, "heap save"), 7u * sizeof(gpu::CutEntry) * 64);  // one workgroup
 }
 
-// A tree whose cut heap cannot fit one workgroup's spill region in a single
-// buffer (220000 lights: 219999 slots x 20 bytes x 64 invocations, past the
-// 256 MiB a buffer may use) is refused with the buffer, its size and the
-// limit named.
-TEST_F(Vulkan, HeapLargerThanABufferIsRefusedClearly) {
+// The heap lives in shared memory only: a cut_heap whose slots for a whole
+// workgroup pass the device's maxComputeSharedMemorySize is refused, naming
+// the setting, the bytes it needs and the largest cut_heap that fits.
+TEST_F(Vulkan, CutHeapLargerThanSharedMemoryIsRefusedClearly) {
     Scene s = random_scene(62, 0, 0, 8, 8);
-    s.lights = test::random_point_lights(220000, {-3, 0.5f, -3}, {3, 3, 3}, 20.0f, 62);
+    s.lights = test::random_point_lights(3000, {-3, 0.5f, -3}, {3, 3, 3}, 20.0f, 62);
     update_bounds(s);
     PreparedScene p = prepare_scene(std::move(s), 1);
     RenderOptions o = options("lightcuts", 8, 8);
-    o.max_cut = 4'000'000'000u;
+    o.cut_heap = 1000;  // 1000 slots x 8 bytes x 64 invocations = 512 000 bytes
     try {
         gpu(p, o);
         FAIL() << "expected an exception";
     } catch (const std::runtime_error& e) {
         const std::string what = e.what();
-        EXPECT_NE(what.find("buffer 'heap spill' needs 281598720 bytes"), std::string::npos) << what;
-        EXPECT_NE(what.find("219999 heap slots per pixel"), std::string::npos) << what;
+        EXPECT_NE(what.find("cut_heap 1000 needs 512000 bytes of shared memory"), std::string::npos) << what;
+        EXPECT_NE(what.find("so at most cut_heap "), std::string::npos) << what;
     }
 }
 

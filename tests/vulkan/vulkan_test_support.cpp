@@ -106,23 +106,36 @@ void expect_brute_matches(const PreparedScene& p, const RenderOptions& o, const 
 }
 
 // A pixel whose cut differs by a cluster differs by up to the error
-// threshold; the others only by rounding.
+// threshold; the others only by rounding. Pixels where a full heap froze
+// clusters (on either device) are compared at kFrozenRelative.
 void expect_lightcuts_matches(const PreparedScene& p, const RenderOptions& o,
                               const RenderResult& g, double relative) {
     const RenderResult c = render_cpu(p, o);
     ASSERT_EQ(g.image.width, c.image.width);
     ASSERT_EQ(g.image.height, c.image.height);
     ASSERT_EQ(g.stats.cut_size.size(), c.stats.cut_size.size());
-    std::vector<bool> cut_differs(c.stats.cut_size.size());
-    for (std::size_t i = 0; i < cut_differs.size(); ++i)
+    ASSERT_EQ(g.stats.heap_froze.size(), c.stats.heap_froze.size());
+    std::vector<bool> cut_differs(c.stats.cut_size.size()), froze(cut_differs.size()), skip_tight(cut_differs.size());
+    std::size_t differing = 0;  // pixels that froze nothing and whose cut differs
+    for (std::size_t i = 0; i < cut_differs.size(); ++i) {
+        froze[i] = g.stats.heap_froze[i] > 0.0f || c.stats.heap_froze[i] > 0.0f;
         cut_differs[i] = g.stats.cut_size[i] != c.stats.cut_size[i];
-    const std::size_t differing = pixels_with_different_cut(g.stats, c.stats);
-    std::printf("[ measured ] lightcuts: cut size differs at %zu of %zu pixels (tolerance %.3g)\n",
+        skip_tight[i] = cut_differs[i] || froze[i];
+        differing += cut_differs[i] && !froze[i] ? 1 : 0;
+    }
+    std::printf("[ measured ] lightcuts: cut size differs at %zu of %zu pixels that froze nothing (tolerance "
+                "%.3g); %zu pixels froze clusters\n",
                 differing, cut_differs.size(),
-                (p.vpls ? kVplCutsDifferFraction : kCutsDifferFraction) * double(cut_differs.size()));
+                (p.vpls ? kVplCutsDifferFraction : kCutsDifferFraction) * double(cut_differs.size()),
+                std::size_t(std::count(froze.begin(), froze.end(), true)));
     const double cuts_differ = p.vpls ? kVplCutsDifferFraction : kCutsDifferFraction;
     EXPECT_LE(double(differing), cuts_differ * double(cut_differs.size()));
-    EXPECT_LE(max_relative_difference(g.image, c.image, "lightcuts", relative, cut_differs), relative);
+    EXPECT_LE(max_relative_difference(g.image, c.image, "lightcuts", relative, skip_tight), relative);
+    std::vector<bool> not_frozen(froze.size());
+    for (std::size_t i = 0; i < froze.size(); ++i) not_frozen[i] = !froze[i];
+    if (std::count(froze.begin(), froze.end(), true) > 0)
+        EXPECT_LE(max_relative_difference(g.image, c.image, "lightcuts, frozen", kFrozenRelative, not_frozen),
+                  kFrozenRelative);
     // A refinement casts at most one ray (one child inherits the parent's
     // representative), so a pixel whose cut differs by d clusters may cast
     // up to d rays more or fewer.
@@ -133,7 +146,7 @@ void expect_lightcuts_matches(const PreparedScene& p, const RenderOptions& o,
                              cut_steps_apart);
     // Whether refinement stopped at max_cut can only differ where the cut does.
     EXPECT_NEAR(double(g.stats.max_cut_pixels), double(c.stats.max_cut_pixels),
-                double(differing) * o.spp + 1.0);
+                double(pixels_with_different_cut(g.stats, c.stats)) * o.spp + 1.0);
 }
 
 std::size_t pixels_with_different_cut(const RenderStats& a, const RenderStats& b) {
@@ -141,25 +154,6 @@ std::size_t pixels_with_different_cut(const RenderStats& a, const RenderStats& b
     for (std::size_t i = 0; i < std::min(a.cut_size.size(), b.cut_size.size()); ++i)
         n += a.cut_size[i] != b.cut_size[i] ? 1 : 0;
     return n;
-}
-
-std::uint64_t count_spilling_samples(const PreparedScene& p, const RenderOptions& o,
-                                     std::uint32_t shared_slots) {
-    const gpu::FrameParams f = make_frame_params(p, o);
-    std::vector<gpu::CutEntry> heap(p.tree.cut_heap_capacity(f.max_cut));
-    cpu::ShadeKernel k = cpu::make_shade_kernel(p, heap.data());
-    std::uint64_t spilled = 0;
-    for (std::uint32_t y = 0; y < f.height; ++y)
-        for (std::uint32_t x = 0; x < f.width; ++x)
-            for (std::uint32_t s = 0; s < f.spp; ++s) {
-                cpu::ShadeKernel::SurfacePoint sp;
-                if (!k.lc_camera_hit(f, x, y, s, sp)) continue;
-                cpu::ShadeKernel::ShadeStats stats{0u, 0u, 0u, 0u};
-                k.heap_high_water = 0;
-                k.lc_shade_lightcuts(sp, f, stats);
-                spilled += k.heap_high_water > shared_slots ? 1 : 0;
-            }
-    return spilled;
 }
 
 Scene random_scene(std::uint32_t seed, std::size_t point_lights, std::size_t directional_lights,
