@@ -21,6 +21,14 @@ namespace lc::vk {
 gpu::FrameParams frame_params(const Context& ctx, const PreparedScene& prepared,
                               const RenderOptions& options);
 
+// The tuning with the device's defaults filled in (Tuning::target_dispatch_ms,
+// presplit_on_llvmpipe).
+Tuning device_tuning(const Context& ctx, Tuning tuning);
+
+// The smallest tile worth a pass on this device: one pixel on a GPU; on a
+// CPU device enough workgroups to keep each of its threads busy.
+std::uint32_t min_tile_pixels(const Context& ctx);
+
 // scene_arrays() and then the frame constants: what the kernels read, in
 // binding order.
 std::vector<SceneArray> kernel_arrays(const PreparedScene& prepared, const gpu::FrameParams& frame);

@@ -9,7 +9,7 @@ namespace lc::vk {
 TileScheduler::TileScheduler(std::string device_name, Submitter& submitter, TilePass& pass,
                              ShadingMethod& method, const GpuResources& resources,
                              const gpu::FrameParams& frame, double target_dispatch_ms,
-                             bool progress)
+                             std::uint32_t min_tile_pixels, bool progress)
     : device_name_(std::move(device_name)),
       submitter_(submitter),
       pass_(pass),
@@ -17,17 +17,20 @@ TileScheduler::TileScheduler(std::string device_name, Submitter& submitter, Tile
       resources_(resources),
       frame_(frame),
       target_dispatch_ms_(target_dispatch_ms),
+      min_tile_pixels_(min_tile_pixels),
       progress_(progress) {}
 
 // Tiles: bands of rows, each cut into tiles of about `budget` pixels. The
 // budget adapts so one dispatch takes about target_dispatch_ms (growing at
 // most 2x per tile, as the next tile may be harder): starting small keeps
-// the first dispatch short on any device.
+// the first dispatch short on any device, and a pass that the driver's loop
+// limit spoils cheap. A tile never drops below min_tile_pixels (a CPU
+// device's threads each need workgroups) unless the buffers say so.
 void TileScheduler::render(RenderResult& result) {
     const std::uint32_t width = frame_.width, height = frame_.height;
     const std::uint32_t max_pixels = resources_.tiles().max_pixels;
     samples_total_ = std::uint64_t(width) * height * frame_.spp;
-    double budget = std::min<double>(4 * gpu::kWorkgroupSize, max_pixels);
+    double budget = std::min<double>(std::max(4 * gpu::kWorkgroupSize, min_tile_pixels_), max_pixels);
     for (std::uint32_t y0 = 0; y0 < height;) {
         const std::uint32_t band = std::min<std::uint32_t>(
             height - y0, std::max<std::uint32_t>(1, std::uint32_t(std::sqrt(budget))));
@@ -47,7 +50,8 @@ double TileScheduler::next_budget(double budget, double pixels, double slowest_m
     const double wanted =
         slowest_ms > 0.0 ? pixels * target_dispatch_ms_ / slowest_ms : 4 * budget;
     budget = std::clamp(wanted, budget / 4, budget * 2);
-    return std::clamp(budget, 1.0, double(resources_.tiles().max_pixels));
+    const double max_pixels = resources_.tiles().max_pixels;
+    return std::clamp(budget, std::min<double>(min_tile_pixels_, max_pixels), max_pixels);
 }
 
 double TileScheduler::render_tile(const Tile& tile, RenderResult& result) {

@@ -25,7 +25,8 @@ class TileScheduler {
 public:
     TileScheduler(std::string device_name, Submitter& submitter, TilePass& pass,
                   ShadingMethod& method, const GpuResources& resources,
-                  const gpu::FrameParams& frame, double target_dispatch_ms, bool progress);
+                  const gpu::FrameParams& frame, double target_dispatch_ms,
+                  std::uint32_t min_tile_pixels, bool progress);
 
     // Renders the whole image into result.image and adds to result.stats:
     // shadow rays, max-cut and spill counts, cut sizes (when the method
@@ -52,6 +53,7 @@ private:
     const GpuResources& resources_;
     const gpu::FrameParams frame_;
     const double target_dispatch_ms_;
+    const std::uint32_t min_tile_pixels_;  // unless the buffers allow fewer
     Progress progress_;
     std::uint64_t samples_done_ = 0, samples_total_ = 0;
 };

@@ -5,10 +5,12 @@
 // the tile's last sample. docs/vulkan.md describes the whole path.
 #include "vulkan_renderer.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "render_setup.h"
 #include "tile_scheduler.h"
@@ -30,9 +32,20 @@ static_assert(offsetof(gpu::PixelStats, max_cut_samples) == 16);
 static_assert(offsetof(gpu::PixelStats, flags) == 24);
 static_assert(sizeof(gpu::CutState) == 52);
 
+// True on llvmpipe (lavapipe), whose loop limiter cuts long kernels short.
+bool driver_limits_loops(const Context& ctx) {
+    auto driver = vk_struct<VkPhysicalDeviceDriverProperties>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES);
+    auto properties = vk_struct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
+    properties.pNext = &driver;
+    vkGetPhysicalDeviceProperties2(ctx.physical(), &properties);
+    return driver.driverID == VK_DRIVER_ID_MESA_LLVMPIPE;
+}
+
 RenderResult render(const Context& ctx, const PreparedScene& prepared,
-                    const RenderOptions& options, const Tuning& tuning) {
+                    const RenderOptions& options, const Tuning& requested) {
     const gpu::FrameParams frame = frame_params(ctx, prepared, options);
+    const Tuning tuning = device_tuning(ctx, requested);
     RenderResult result;
     result.image = Image(frame.width, frame.height);
     RenderStats& stats = result.stats;
@@ -45,7 +58,8 @@ RenderResult render(const Context& ctx, const PreparedScene& prepared,
         stats.heap_froze.assign(std::size_t(frame.width) * frame.height, 0.0f);
     }
     TileScheduler scheduler(ctx.device_name(), setup.submitter, setup.pass, *setup.method,
-                            setup.resources, frame, tuning.target_dispatch_ms, options.progress);
+                            setup.resources, frame, tuning.target_dispatch_ms,
+                            min_tile_pixels(ctx), options.progress);
     scheduler.render(result);
 
     stats.spp_done = frame.spp;
@@ -58,6 +72,24 @@ RenderResult render(const Context& ctx, const PreparedScene& prepared,
 }
 
 }  // namespace
+
+Tuning device_tuning(const Context& ctx, Tuning tuning) {
+    const bool cpu = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    if (tuning.target_dispatch_ms <= 0.0)
+        tuning.target_dispatch_ms = cpu ? Tuning::kCpuTargetMs : Tuning::kGpuTargetMs;
+    if (tuning.presplit_on_llvmpipe && tuning.refinements_per_dispatch == 0 && driver_limits_loops(ctx))
+        tuning.refinements_per_dispatch = Tuning::kLlvmpipeRefinements;
+    return tuning;
+}
+
+std::uint32_t min_tile_pixels(const Context& ctx) {
+    if (ctx.properties().deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) return 1;
+    // lavapipe runs each workgroup on one of its threads (LP_NUM_THREADS,
+    // by default one per core); four workgroups per thread keep them all
+    // busy to the end of most dispatches.
+    const std::uint32_t threads = std::max(1u, std::thread::hardware_concurrency());
+    return 4 * threads * gpu::kWorkgroupSize;
+}
 
 std::vector<SceneArray> kernel_arrays(const PreparedScene& prepared, const gpu::FrameParams& frame) {
     std::vector<SceneArray> arrays = scene_arrays(prepared);

@@ -20,8 +20,9 @@ struct Tuning {
     bool force_clearcoat = false;
     // Largest tile, in pixels (0: limited only by the buffer limits).
     std::uint32_t max_tile_pixels = 0;
-    // Tiles are resized so one dispatch takes about this long.
-    double target_dispatch_ms = 30.0;
+    // Tiles are resized so one dispatch takes about this long (0: the
+    // device's default, kGpuTargetMs or, on a CPU device, kCpuTargetMs).
+    double target_dispatch_ms = 0.0;
     // Split the work of each pixel from the start, as is otherwise done only
     // where the driver cuts long loops short (0: no split): brute force over
     // at most this many lights per dispatch (sampled: light samples),
@@ -29,6 +30,21 @@ struct Tuning {
     // stochastic cluster shaded).
     std::uint32_t lights_per_dispatch = 0;
     std::uint32_t refinements_per_dispatch = 0;
+    // On llvmpipe (lavapipe), whose loop limit cuts deep cuts short,
+    // Lightcuts starts with kLlvmpipeRefinements steps per dispatch when
+    // refinements_per_dispatch is 0, instead of finding the split by a
+    // failed pass over a tile. False: only a failed pass splits the work.
+    bool presplit_on_llvmpipe = true;
+
+    // One dispatch on a GPU stays well under any display watchdog.
+    static constexpr double kGpuTargetMs = 30.0;
+    // A CPU device (lavapipe) has no watchdog, and runs each workgroup on
+    // one of its threads: long dispatches of many workgroups keep them all
+    // busy (docs/results/lavapipe.md).
+    static constexpr double kCpuTargetMs = 1000.0;
+    // The refinement budget that llvmpipe's retries settle on for the
+    // shipped scenes (shading_method.cpp starts its retries with it).
+    static constexpr std::uint32_t kLlvmpipeRefinements = 128;
 
     // LC_VK_FORCE_FEATURES=ggx,shadows,oriented,textures,disney,sheen,clearcoat (or all), LC_VK_MAX_TILE_PIXELS=N, LC_VK_TARGET_MS=X,
     // LC_VK_LIGHTS_PER_DISPATCH=N, LC_VK_REFINEMENTS_PER_DISPATCH=N.

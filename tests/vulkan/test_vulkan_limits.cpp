@@ -155,7 +155,9 @@ TEST_F(Vulkan, LoopLimitSplitsBruteForceAutomatically) {
 
 // Cuts refined down to every one of 4000 lights: each refinement loops over
 // heap levels and a shadow ray's BVH nodes, about twice the limit in all
-// (1600 lights already pass it).
+// (1600 lights already pass it). On llvmpipe the renderer splits Lightcuts
+// from the start (Tuning::presplit_on_llvmpipe); without that, the failed
+// pass must split it.
 TEST_F(Vulkan, LoopLimitSplitsLightcutsAutomatically) {
     Scene s;
     s.materials = {test::lambert({0.6f, 0.5f, 0.4f})};
@@ -170,9 +172,18 @@ TEST_F(Vulkan, LoopLimitSplitsLightcutsAutomatically) {
     RenderOptions o = options("lightcuts", 4, 4);
     o.relative_error = 0.0f;
     o.max_cut = 100000;
-    const RenderResult g = gpu(p, o);
+    vk::Tuning no_presplit;
+    no_presplit.presplit_on_llvmpipe = false;
+    const RenderResult g = gpu(p, o, no_presplit);
     expect_lightcuts_matches(p, o, g);
     expect_resplit_on_llvmpipe(g.stats);
+
+    // Split from the start: no pass is spoilt, and the image is the same.
+    const RenderResult presplit = gpu(p, o);
+    expect_lightcuts_matches(p, o, presplit);
+    std::printf("[ measured ] %s, split from the start: %u loop-limit retries\n",
+                presplit.stats.device.c_str(), presplit.stats.loop_limit_retries);
+    EXPECT_EQ(presplit.stats.loop_limit_retries, 0u);
 }
 
 }  // namespace
