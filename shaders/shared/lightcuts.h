@@ -5,6 +5,7 @@
 //   LC_LIGHT_NODE(i)        -> LightNode
 //   LC_HEAP_LOAD(i)         -> CutEntry        (heap slot i of this point)
 //   LC_HEAP_STORE(i, e)     stores CutEntry e in slot i
+//   LC_PREFETCH_LIGHT_NODES(i) (optional) starts loading nodes i and i + 1
 // On the GPU the first slots live in workgroup shared memory and the rest
 // spill to a global buffer; on the CPU they are a per-thread array.
 // No include guard: each kernel context (a GLSL shader, a C++ kernel
@@ -12,7 +13,7 @@
 
 // Unscaled contribution of a light (material * geometry * visibility):
 // the representative's estimate is this times the cluster's RGB intensity.
-vec3 lc_rep_unit(SurfacePoint sp, uint light_index, float min_distance2,
+vec3 lc_rep_unit(LC_IN(SurfacePoint) sp, uint light_index, float min_distance2,
                  LC_INOUT(ShadeStats) stats) {
     return lc_light_unit_shadowed(sp, LC_LIGHT(light_index), min_distance2, stats);
 }
@@ -58,7 +59,7 @@ void lc_heap_pop(LC_INOUT(uint) size) {
 // all; leaves are final (exact, zero error) and go to leaf_sum, refinable
 // interior nodes go to the heap. `inherited` is true when the caller already
 // knows the representative's unit contribution (shared with the parent).
-void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, bool inherited,
+void lc_add_cluster(LC_IN(SurfacePoint) sp, LC_IN(Material) m, uint node_index, bool inherited,
                     vec3 inherited_unit, float min_distance2, LC_INOUT(uint) heap_size, LC_INOUT(vec3) leaf_sum,
                     LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
     LightNode node = LC_LIGHT_NODE(node_index);
@@ -82,6 +83,11 @@ void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, bool inherited
     e.unit_r = unit.x;
     e.unit_g = unit.y;
     e.unit_b = unit.z;
+#ifdef LC_PREFETCH_LIGHT_NODES
+    // The children are read when this entry is refined, if ever: start
+    // loading them now (the CPU; a no-op where the includer has no prefetch).
+    LC_PREFETCH_LIGHT_NODES(node.left);
+#endif
     lc_heap_push(heap_size, e);
     heap_sum += unit * intensity;
 }
