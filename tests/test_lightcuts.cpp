@@ -122,6 +122,46 @@ void push_entry(Kernel& k, std::uint32_t& size, std::uint32_t node, float error,
                    heap_sum, ss);
 }
 
+// lc_cos_h_max works with the cone's sine and cosines (no acos or cos): for
+// every direction towards the box, the half vector's cosine with n is at
+// most the bound. Small, far boxes around the mirror direction are the
+// case where sqrt(1 - cos^2) would lose the angle; a third of the cases
+// put the box there.
+TEST(LightcutsBounds, HalfVectorBoundHoldsForEveryDirectionInTheCone) {
+    std::mt19937 rng(777);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    Kernel k;
+    int checked = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        glm::vec3 n = random_unit(rng);
+        glm::vec3 wo = random_unit(rng);
+        if (glm::dot(n, wo) < 0.0f) wo = -wo;
+        const float cos_o = glm::dot(n, wo);
+        if (!(cos_o > 1e-3f)) continue;
+        const glm::vec3 mirror = glm::normalize(2.0f * cos_o * n - wo);
+        const float dist = std::pow(10.0f, 3.0f * u(rng) - 1.0f);     // 0.1 to 100
+        const float size = dist * std::pow(10.0f, -5.0f * u(rng));     // down to 1e-5 of it
+        const glm::vec3 dir = trial % 3 == 0 ? glm::normalize(mirror + 1e-4f * random_unit(rng)) : random_unit(rng);
+        const glm::vec3 centre = dist * dir;
+        const glm::vec3 half(size * u(rng), size * u(rng), size * u(rng));
+        const glm::vec3 lo = centre - half, hi = centre + half;
+        const float bound = k.lc_cos_h_max(k.lc_box_cone(lo, hi, glm::vec3(0.0f)), n, wo, cos_o);
+        ASSERT_LE(bound, 1.0f);
+        for (int s = 0; s < 16; ++s) {
+            const glm::vec3 p = lo + glm::vec3(u(rng), u(rng), u(rng)) * (hi - lo);
+            // The exact half vector, in double so that its own rounding
+            // does not count against the bound.
+            const glm::dvec3 wi = glm::normalize(glm::dvec3(p));
+            const glm::dvec3 sum = wi + glm::normalize(glm::dvec3(wo));
+            if (glm::length(sum) < 1e-3) continue;  // wi opposite wo: no half vector
+            const double cos_h = glm::dot(glm::normalize(sum), glm::normalize(glm::dvec3(n)));
+            ASSERT_GE(double(bound), cos_h) << "trial " << trial << " dist " << dist << " size " << size;
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 200000);
+}
+
 TEST(LightcutsHeap, PopsInDecreasingOrder) {
     std::vector<gpu::CutEntry> storage(1000);
     Kernel k;

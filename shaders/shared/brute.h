@@ -4,7 +4,7 @@
 // shading.h first.
 // No include guard: each kernel context includes it exactly once.
 
-vec3 lc_shade_brute(SurfacePoint sp, uint light_count, float min_distance2,
+vec3 lc_shade_brute(LC_IN(SurfacePoint) sp, uint light_count, float min_distance2,
                     LC_INOUT(ShadeStats) stats) {
     vec3 sum = vec3(0.0f);
     for (uint i = 0u; i < light_count; ++i) {

@@ -6,6 +6,7 @@
 //   LC_HEAP_LOAD(i)         -> CutEntry        (heap slot i of this point)
 //   LC_HEAP_STORE(i, e)     stores CutEntry e in slot i
 //   LC_HEAP_CAPACITY        K, the heap's capacity (see lc_heap_push)
+//   LC_PREFETCH_LIGHT_NODES(i) (optional) starts loading nodes i and i + 1
 // On the GPU the K slots live in workgroup shared memory; on the CPU they
 // are a per-thread array.
 // No include guard: each kernel context (a GLSL shader, a C++ kernel
@@ -15,7 +16,7 @@
 // * visibility): the cluster's estimate is this times its RGB intensity.
 // `visible` is what the shadow ray found (false when no ray was needed
 // because the light cannot reach the point).
-vec3 lc_rep_unit(SurfacePoint sp, uint light_index, float min_distance2, LC_OUT(bool) visible,
+vec3 lc_rep_unit(LC_IN(SurfacePoint) sp, uint light_index, float min_distance2, LC_OUT(bool) visible,
                  LC_INOUT(ShadeStats) stats) {
     vec3 wi;
     float t_max;
@@ -29,7 +30,7 @@ vec3 lc_rep_unit(SurfacePoint sp, uint light_index, float min_distance2, LC_OUT(
 
 // The same contribution again, from the visibility an earlier ray found:
 // the same function of the same inputs, without the ray.
-vec3 lc_rep_unit_known(SurfacePoint sp, uint light_index, float min_distance2, bool visible) {
+vec3 lc_rep_unit_known(LC_IN(SurfacePoint) sp, uint light_index, float min_distance2, bool visible) {
     if (!visible) return vec3(0.0f);
     vec3 wi;
     float t_max;
@@ -41,7 +42,7 @@ bool lc_entry_visible(CutEntry e) { return (e.node & kCutEntryVisible) != 0u; }
 
 // An entry's estimate: its representative's contribution times the
 // cluster's intensity.
-vec3 lc_entry_estimate(SurfacePoint sp, CutEntry e, float min_distance2) {
+vec3 lc_entry_estimate(LC_IN(SurfacePoint) sp, CutEntry e, float min_distance2) {
     LightNode node = LC_LIGHT_NODE(lc_entry_node(e));
     return lc_rep_unit_known(sp, node.rep_light, min_distance2, lc_entry_visible(e)) * lc_node_intensity(node);
 }
@@ -87,7 +88,7 @@ void lc_heap_pop(LC_INOUT(uint) size) {
 // moves from heap_sum into the frozen part of the sum, `fixed_sum`, and is
 // never refined. The smallest entry of a max-heap is one of its leaves,
 // slots size/2 and up; the new entry takes its slot and rises.
-void lc_heap_push(SurfacePoint sp, float min_distance2, LC_INOUT(uint) size, CutEntry e, vec3 estimate,
+void lc_heap_push(LC_IN(SurfacePoint) sp, float min_distance2, LC_INOUT(uint) size, CutEntry e, vec3 estimate,
                   LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
     if (size < uint(LC_HEAP_CAPACITY)) {
         size += 1u;
@@ -122,7 +123,7 @@ void lc_heap_push(SurfacePoint sp, float min_distance2, LC_INOUT(uint) size, Cut
 // interior nodes go to the heap. `inherited` is true when the caller already
 // knows the representative's unit contribution (shared with the parent) and
 // the visibility behind it.
-void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, bool inherited, vec3 inherited_unit,
+void lc_add_cluster(LC_IN(SurfacePoint) sp, LC_IN(Material) m, uint node_index, bool inherited, vec3 inherited_unit,
                     bool inherited_visible, float min_distance2, LC_INOUT(uint) heap_size,
                     LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
     LightNode node = LC_LIGHT_NODE(node_index);
@@ -144,6 +145,11 @@ void lc_add_cluster(SurfacePoint sp, Material m, uint node_index, bool inherited
     CutEntry e;
     e.node = node_index | (visible ? kCutEntryVisible : 0u);
     e.error = error;
+#ifdef LC_PREFETCH_LIGHT_NODES
+    // The children are read when this entry is refined, if ever: start
+    // loading them now (the CPU; the GLSL kernels have no prefetch).
+    LC_PREFETCH_LIGHT_NODES(node.left);
+#endif
     lc_heap_push(sp, min_distance2, heap_size, e, unit * intensity, fixed_sum, heap_sum, stats);
 }
 

@@ -30,7 +30,7 @@ uint lc_substream(uint stream, uint k) { return lc_hash(stream ^ lc_hash(k + 0x9
 // where the cosine or the emission bound is zero, i.e. where no light of
 // the cluster can contribute: tree sampling then never misses a light that
 // can, which keeps it unbiased.
-float lc_cluster_importance(SurfacePoint sp, LightNode node, float min_distance2) {
+float lc_cluster_importance(LC_IN(SurfacePoint) sp, LC_IN(LightNode) node, float min_distance2) {
     vec3 lo = vec3(node.min_x, node.min_y, node.min_z);
     vec3 hi = vec3(node.max_x, node.max_y, node.max_z);
     bool positional = lc_node_type(node) != kLightDirectional;
@@ -71,7 +71,7 @@ float lc_cluster_importance(SurfacePoint sp, LightNode node, float min_distance2
 // kLightPickTree, the luminance of the cluster's intensity for
 // kLightPickPower (which makes the descent pick each light in proportion to
 // its power, with no table beyond the tree).
-float lc_pick_weight(SurfacePoint sp, uint node_index, uint pick, float min_distance2) {
+float lc_pick_weight(LC_IN(SurfacePoint) sp, uint node_index, uint pick, float min_distance2) {
     LightNode node = LC_LIGHT_NODE(node_index);
     if (pick == kLightPickPower) return lc_luminance(lc_node_intensity(node));
     return lc_cluster_importance(sp, node, min_distance2);
@@ -83,7 +83,7 @@ float lc_pick_weight(SurfacePoint sp, uint node_index, uint pick, float min_dist
 // below can contribute) it goes by power instead: whatever light it reaches
 // contributes zero without a shadow ray, and the probabilities of all
 // lights still sum to one.
-float lc_left_probability(SurfacePoint sp, uint left, uint pick, float min_distance2) {
+float lc_left_probability(LC_IN(SurfacePoint) sp, uint left, uint pick, float min_distance2) {
     float wl = lc_pick_weight(sp, left, pick, min_distance2);
     float wr = lc_pick_weight(sp, left + 1u, pick, min_distance2);
     if (!(wl + wr > 0.0f) && pick != kLightPickPower) {
@@ -96,7 +96,7 @@ float lc_left_probability(SurfacePoint sp, uint left, uint pick, float min_dista
 
 // Probability of picking the tree of light type `type` (its root), in
 // proportion to the roots' weights; 0 when no tree has any.
-float lc_root_probability(SurfacePoint sp, FrameParams f, uint type, uint pick) {
+float lc_root_probability(LC_IN(SurfacePoint) sp, LC_IN(FrameParams) f, uint type, uint pick) {
     float total = 0.0f;
     float mine = 0.0f;
     for (uint t = 0u; t < kLightTypeCount; ++t) {
@@ -114,7 +114,7 @@ float lc_root_probability(SurfacePoint sp, FrameParams f, uint type, uint pick) 
 // taken. (Written as a loop with its test in the head: with a `return`
 // inside `while (true)` instead, lavapipe returned light 0 from the copy of
 // this function inlined into lightcuts.comp, though the pdf was right.)
-uint lc_descend(SurfacePoint sp, uint node_index, uint pick, float min_distance2, uint stream,
+uint lc_descend(LC_IN(SurfacePoint) sp, uint node_index, uint pick, float min_distance2, uint stream,
                 LC_INOUT(float) pdf) {
     uint h = stream;
     LightNode node = LC_LIGHT_NODE(node_index);
@@ -133,7 +133,7 @@ uint lc_descend(SurfacePoint sp, uint node_index, uint pick, float min_distance2
 // proportion to the roots' weights, then down its tree (tree and power), or
 // any light with the same probability (uniform). Its probability in `pdf`;
 // kInvalidIndex when no light can be drawn.
-uint lc_pick_light(SurfacePoint sp, FrameParams f, uint stream, LC_OUT(float) pdf) {
+uint lc_pick_light(LC_IN(SurfacePoint) sp, LC_IN(FrameParams) f, uint stream, LC_OUT(float) pdf) {
     pdf = 0.0f;
     if (f.light_count == 0u) return kInvalidIndex;
     float u = lc_unit_float(stream);
@@ -165,7 +165,7 @@ uint lc_pick_light(SurfacePoint sp, FrameParams f, uint stream, LC_OUT(float) pd
 // f.light_samples, each one light picked by lc_pick_light and one shadow
 // ray; returns their sum of contribution / probability (the caller divides
 // by f.light_samples, after every range is summed).
-vec3 lc_shade_sampled(SurfacePoint sp, FrameParams f, uint stream, uint first, uint count,
+vec3 lc_shade_sampled(LC_IN(SurfacePoint) sp, LC_IN(FrameParams) f, uint stream, uint first, uint count,
                       LC_INOUT(ShadeStats) stats) {
     vec3 sum = vec3(0.0f);
     for (uint k = first; k < first + count; ++k) {
@@ -186,7 +186,7 @@ vec3 lc_shade_sampled(SurfacePoint sp, FrameParams f, uint stream, uint first, u
 // probability P_j and the estimate is I_j * unit_j / P_j. `draw` numbers
 // the independent draws of one cluster at one camera sample
 // (f.light_samples of them; the caller averages).
-vec3 lc_shade_cluster_stochastic(SurfacePoint sp, uint node_index, float min_distance2, uint stream,
+vec3 lc_shade_cluster_stochastic(LC_IN(SurfacePoint) sp, uint node_index, float min_distance2, uint stream,
                                  uint draw, LC_INOUT(ShadeStats) stats) {
     float pdf = 1.0f;
     uint light = lc_descend(sp, node_index, kLightPickPower, min_distance2,

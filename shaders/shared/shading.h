@@ -45,7 +45,7 @@ vec2 lc_pixel_sample(uint x, uint y, uint s, uint spp, uint seed) {
                 float(y) + (float(s / cols) + jy) / float(rows));
 }
 
-vec3 lc_camera_ray_dir(FrameParams f, vec2 pixel) {
+vec3 lc_camera_ray_dir(LC_IN(FrameParams) f, vec2 pixel) {
     float u = 2.0f * pixel.x / float(f.width) - 1.0f;
     float v = 1.0f - 2.0f * pixel.y / float(f.height);  // row 0 at the top
     vec3 d = vec3(f.cam_fwd_x, f.cam_fwd_y, f.cam_fwd_z) +
@@ -111,7 +111,7 @@ SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) 
 
 // Radiance of the environment towards direction d (+Y up, lat-long map of
 // docs/scene-format.md; black without one).
-vec3 lc_environment_radiance(FrameParams f, vec3 d) {
+vec3 lc_environment_radiance(LC_IN(FrameParams) f, vec3 d) {
     if (f.env_width == 0u || f.env_height == 0u) return vec3(0.0f);
     float u = 0.5f + atan(d.x, -d.z) * (0.5f / kPi);
     float v = acos(clamp(d.y, -1.0f, 1.0f)) * (1.0f / kPi);
@@ -139,7 +139,7 @@ vec3 lc_surface_emission(uint tri_index, float b1, float b2, vec3 ray_dir) {
 // Sample `s` of pixel (x, y) traced into the scene: the triangle hit
 // (kInvalidIndex when the ray leaves the scene), its barycentrics, and the
 // ray's direction.
-uint lc_camera_trace(FrameParams f, uint x, uint y, uint s, LC_OUT(vec3) dir, LC_OUT(float) b1,
+uint lc_camera_trace(LC_IN(FrameParams) f, uint x, uint y, uint s, LC_OUT(vec3) dir, LC_OUT(float) b1,
                      LC_OUT(float) b2) {
     dir = lc_camera_ray_dir(f, lc_pixel_sample(x, y, s, f.spp, f.seed));
     vec3 org = vec3(f.cam_pos_x, f.cam_pos_y, f.cam_pos_z);
@@ -149,7 +149,7 @@ uint lc_camera_trace(FrameParams f, uint x, uint y, uint s, LC_OUT(vec3) dir, LC
 
 // A camera sample's first hit as a shaded point; false when the ray leaves
 // the scene.
-bool lc_camera_hit(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp) {
+bool lc_camera_hit(LC_IN(FrameParams) f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp) {
     vec3 dir;
     float b1, b2;
     uint tri = lc_camera_trace(f, x, y, s, dir, b1, b2);
@@ -160,7 +160,7 @@ bool lc_camera_hit(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint) s
 
 // lc_camera_hit, and what the ray sees without any light in `seen`: the
 // surface's emission, or the environment where the ray leaves the scene.
-bool lc_camera_sample(FrameParams f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp, LC_OUT(vec3) seen) {
+bool lc_camera_sample(LC_IN(FrameParams) f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp, LC_OUT(vec3) seen) {
     vec3 dir;
     float b1, b2;
     uint tri = lc_camera_trace(f, x, y, s, dir, b1, b2);
@@ -202,8 +202,8 @@ float lc_smith_g1(float cos_v, float alpha) {
     return 2.0f * cos_v / (cos_v + sqrt(a2 + (1.0f - a2) * cos_v * cos_v));
 }
 
-vec3 lc_kd(Material m) { return vec3(m.kd_r, m.kd_g, m.kd_b); }
-vec3 lc_ks(Material m) { return vec3(m.ks_r, m.ks_g, m.ks_b); }
+vec3 lc_kd(LC_IN(Material) m) { return vec3(m.kd_r, m.kd_g, m.kd_b); }
+vec3 lc_ks(LC_IN(Material) m) { return vec3(m.ks_r, m.ks_g, m.ks_b); }
 
 // --- The Disney BRDF (Burley 2012, "Physically-Based Shading at Disney",
 // and its BRDF Explorer's disney.brdf): isotropic, without subsurface and
@@ -226,23 +226,23 @@ float lc_schlick_weight(float cos_x) {
     return m2 * m2 * m;
 }
 
-vec3 lc_disney_tint(Material m) {
+vec3 lc_disney_tint(LC_IN(Material) m) {
     vec3 base = lc_kd(m);
     float lum = lc_luminance(base);
     return lum > 0.0f ? base / lum : vec3(1.0f);
 }
 
 // Reflectance of the specular lobe at normal incidence.
-vec3 lc_disney_spec0(Material m) {
+vec3 lc_disney_spec0(LC_IN(Material) m) {
     vec3 tinted = mix(vec3(1.0f), lc_disney_tint(m), m.specular_tint);
     return mix(tinted * (0.08f * m.specular), lc_kd(m), m.metallic);
 }
 
-vec3 lc_disney_sheen_color(Material m) {
+vec3 lc_disney_sheen_color(LC_IN(Material) m) {
     return m.sheen * mix(vec3(1.0f), lc_disney_tint(m), m.sheen_tint) * (1.0f - m.metallic);
 }
 
-float lc_clearcoat_alpha(Material m) { return mix(0.1f, 0.001f, m.clearcoat_gloss); }
+float lc_clearcoat_alpha(LC_IN(Material) m) { return mix(0.1f, 0.001f, m.clearcoat_gloss); }
 LC_KCONST float kClearcoatSmithAlpha = 0.25f;
 
 // Burley's GTR1 (Berry) distribution for alpha < 1; grows with cos_h like
@@ -254,7 +254,7 @@ float lc_gtr1_d(float cos_h, float alpha) {
 }
 
 // The diffuse lobe times cos_i, for a given F_D90.
-vec3 lc_disney_diffuse(Material m, float fd90, float cos_i, float cos_o) {
+vec3 lc_disney_diffuse(LC_IN(Material) m, float fd90, float cos_i, float cos_o) {
     float fl = 1.0f + (fd90 - 1.0f) * lc_schlick_weight(cos_i);
     float fv = 1.0f + (fd90 - 1.0f) * lc_schlick_weight(cos_o);
     return lc_kd(m) * ((1.0f - m.metallic) * fl * fv * cos_i / kPi);
@@ -266,7 +266,7 @@ float lc_microfacet_cos(float d, float cos_i, float cos_o, float alpha_g) {
     return d * lc_smith_g1(cos_i, alpha_g) * lc_smith_g1(cos_o, alpha_g) / (4.0f * cos_o);
 }
 
-vec3 lc_disney_brdf_cos(Material m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
+vec3 lc_disney_brdf_cos(LC_IN(Material) m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
     float cos_o = dot(n, wo);
     if (!(cos_o > 0.0f)) return vec3(0.0f);
     vec3 h = normalize(wi + wo);  // wi and wo are both above n, so wi + wo != 0
@@ -285,7 +285,7 @@ vec3 lc_disney_brdf_cos(Material m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
 }
 
 // f * cos(theta_i) of either kind of material; cos_i = n.wi > 0.
-vec3 lc_brdf_cos(Material m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
+vec3 lc_brdf_cos(LC_IN(Material) m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
     if (kEnableDisney && (m.flags & kMaterialDisney) != 0u) return lc_disney_brdf_cos(m, n, wi, wo, cos_i);
     vec3 value = lc_kd(m) * (cos_i / kPi);
     if (kEnableGgx && (m.flags & kMaterialHasSpecular) != 0u) {
@@ -303,7 +303,7 @@ vec3 lc_brdf_cos(Material m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
 
 // glTF KHR_lights_punctual's spot falloff: s = clamp((cos - cos_outer) /
 // max(1e-3, cos_inner - cos_outer), 0, 1); the intensity is scaled by s^2.
-float lc_spot_falloff(Light light, float cos_theta) {
+float lc_spot_falloff(LC_IN(Light) light, float cos_theta) {
     float s = clamp((cos_theta - light.cos_outer) / max(1e-3f, light.cos_inner - light.cos_outer), 0.0f, 1.0f);
     return s * s;
 }
@@ -321,7 +321,7 @@ float lc_falloff_clamp2(float min_distance2, uint type) {
 // surface or emits nothing towards it.
 // Walter 2005 §3: the one place where a light's type decides its emission;
 // everything else reads the light tree's nodes.
-vec3 lc_light_unit(SurfacePoint sp, Light light, float min_distance2, LC_OUT(vec3) wi,
+vec3 lc_light_unit(LC_IN(SurfacePoint) sp, LC_IN(Light) light, float min_distance2, LC_OUT(vec3) wi,
                    LC_OUT(float) t_max) {
     uint type = light.type & kLightTypeMask;
     wi = sp.n;
@@ -361,7 +361,7 @@ vec3 lc_light_unit(SurfacePoint sp, Light light, float min_distance2, LC_OUT(vec
     return lc_brdf_cos(sp.mat, sp.n, wi, sp.wo, cos_i) * factor;
 }
 
-bool lc_visible(SurfacePoint sp, vec3 wi, float t_max) {
+bool lc_visible(LC_IN(SurfacePoint) sp, vec3 wi, float t_max) {
 #ifdef LC_ON_SHADOW_RAY
     LC_ON_SHADOW_RAY(sp.p, wi, t_max);  // the CPU's ray recorder (host/cpu_kernel.h)
 #endif
@@ -370,7 +370,7 @@ bool lc_visible(SurfacePoint sp, vec3 wi, float t_max) {
 
 // lc_light_unit times visibility: one shadow ray, counted in stats, where
 // the light can contribute at all.
-vec3 lc_light_unit_shadowed(SurfacePoint sp, Light light, float min_distance2,
+vec3 lc_light_unit_shadowed(LC_IN(SurfacePoint) sp, LC_IN(Light) light, float min_distance2,
                             LC_INOUT(ShadeStats) stats) {
     vec3 wi;
     float t_max;
@@ -380,10 +380,10 @@ vec3 lc_light_unit_shadowed(SurfacePoint sp, Light light, float min_distance2,
     return lc_visible(sp, wi, t_max) ? unit : vec3(0.0f);
 }
 
-vec3 lc_light_intensity(Light light) { return vec3(light.r, light.g, light.b); }
+vec3 lc_light_intensity(LC_IN(Light) light) { return vec3(light.r, light.g, light.b); }
 
 // A cluster's summed RGB intensity.
-vec3 lc_node_intensity(LightNode node) {
+vec3 lc_node_intensity(LC_IN(LightNode) node) {
     return vec3(node.intensity_r, node.intensity_g, node.intensity_b);
 }
 
@@ -446,27 +446,38 @@ float lc_box_distance2(vec3 box_min, vec3 box_max, vec3 x) {
 // h -> wi = reflect(-wo, h) is 2-Lipschitz in angle and sends n to the mirror
 // direction wr, so angle(h, n) >= max(0, angle(wr, a) - theta_c) / 2.
 // The cone of directions from x towards the box, from the box's bounding
-// sphere: unit axis a (xyz) and half-angle theta_c (w); w < 0 when x is
-// inside the sphere, where the directions can be any.
+// sphere: unit axis a (xyz) and the sine of its half-angle theta_c (w); w < 0
+// when x is inside the sphere, where the directions can be any. The sine,
+// not the angle: the bounds below work with sines and cosines, without
+// asin, acos or cos on the way.
 vec4 lc_box_cone(vec3 box_min, vec3 box_max, vec3 x) {
     vec3 c = 0.5f * ((box_min - x) + (box_max - x));  // see lc_cosine_bound
     float radius = 0.5f * length(box_max - box_min);
     float dist = length(c);
     if (!(dist > radius)) return vec4(0.0f, 0.0f, 1.0f, -1.0f);
-    return vec4(c / dist, asin(clamp(radius / dist, 0.0f, 1.0f)));
+    return vec4(c / dist, min(radius / dist, 1.0f));
 }
 
 // The largest cos(theta_h) of any wi in the cone, for the view wo
-// (cos_o = n.wo > 0); the argument is lc_ggx_bound's.
+// (cos_o = n.wo > 0); the argument is lc_ggx_bound's. With delta =
+// angle(wr, a) - theta_c: cos(delta) = cos_r cos_c + sin_r sin_c, and
+// cos(delta / 2) = sqrt((1 + cos(delta)) / 2). sin_r comes from the cross
+// product, accurate for small angles where sqrt(1 - cos^2) is not; the sum
+// is widened by kCosineAbsSlack for the rounding of the products.
 float lc_cos_h_max(vec4 cone, vec3 n, vec3 wo, float cos_o) {
     if (cone.w < 0.0f) return 1.0f;
     vec3 wr = 2.0f * cos_o * n - wo;
-    float angle_r = acos(clamp(dot(wr, vec3(cone)), -1.0f, 1.0f));
-    float delta = max(angle_r - cone.w, 0.0f);
-    return min(cos(0.5f * delta) * kBoundSlack, 1.0f);
+    vec3 a = vec3(cone);
+    float cos_r = dot(wr, a);
+    float sin_c = cone.w;
+    float cos_c = sqrt(max(1.0f - sin_c * sin_c, 0.0f));
+    if (cos_r >= cos_c) return 1.0f;  // the mirror direction lies in the cone
+    float sin_r = length(cross(wr, a));
+    float cos_delta = min(cos_r * cos_c + sin_r * sin_c + kCosineAbsSlack, 1.0f);
+    return min(sqrt(max(0.5f + 0.5f * cos_delta, 0.0f)) * kBoundSlack, 1.0f);
 }
 
-float lc_ggx_bound(Material m, vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec3 wo) {
+float lc_ggx_bound(LC_IN(Material) m, vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec3 wo) {
     float cos_o = dot(n, wo);
     if (cos_o <= 0.0f) return 0.0f;
     float cos_h_max = lc_cos_h_max(lc_box_cone(box_min, box_max, x), n, wo, cos_o);
@@ -474,7 +485,7 @@ float lc_ggx_bound(Material m, vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec3 
            kBoundSlack;
 }
 
-uint lc_node_type(LightNode node) { return (node.flags >> kNodeTypeShift) & kNodeTypeMask; }
+uint lc_node_type(LC_IN(LightNode) node) { return (node.flags >> kNodeTypeShift) & kNodeTypeMask; }
 
 // Angles in the emission bound come from acos, whose float result is off by
 // up to ~3.5e-4 rad near 0 and pi; the bound gives away this much more.
@@ -493,7 +504,7 @@ float lc_safe_acos(float c) { return acos(clamp(c, -1.0f, 1.0f)); }
 // a spot at most s^2 with s = (cos theta' - cos theta_e) / w, w the
 // cluster's narrowest falloff (each light's s is below that: its outer
 // cosine is at least cos theta_e, its width at least w).
-float lc_emission_bound(LightNode node, vec3 x) {
+float lc_emission_bound(LC_IN(LightNode) node, vec3 x) {
     if (node.cos_theta_o <= -1.0f) return 1.0f;  // emits everywhere
     vec3 lo = vec3(node.min_x, node.min_y, node.min_z) - x;
     vec3 hi = vec3(node.max_x, node.max_y, node.max_z) - x;
@@ -525,8 +536,9 @@ float lc_emission_bound(LightNode node, vec3 x) {
 vec2 lc_cos_d_range(vec4 cone, vec3 wo) {
     if (cone.w < 0.0f) return vec2(0.0f, 1.0f);
     float angle_o = lc_safe_acos(dot(wo, vec3(cone)));
-    float nearest = max(angle_o - cone.w - kAngleSlack, 0.0f);
-    float farthest = min(angle_o + cone.w + kAngleSlack, kPi);
+    float theta_c = asin(cone.w);
+    float nearest = max(angle_o - theta_c - kAngleSlack, 0.0f);
+    float farthest = min(angle_o + theta_c + kAngleSlack, kPi);
     return vec2(max(cos(0.5f * farthest) / kBoundSlack - kCosineAbsSlack, 0.0f),
                 min(cos(0.5f * nearest) * kBoundSlack, 1.0f));
 }
@@ -536,7 +548,7 @@ vec2 lc_cos_d_range(vec4 cone, vec3 wo) {
 // F_D90 at the largest cos_d, Schlick's weight (sheen, both Fresnel factors)
 // at the smallest cos_d, GGX and GTR1 at the largest cos_h. cos_bound bounds
 // cos(theta_i).
-vec3 lc_disney_bound(Material m, vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec3 wo, float cos_bound) {
+vec3 lc_disney_bound(LC_IN(Material) m, vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec3 wo, float cos_bound) {
     float cos_o = dot(n, wo);
     if (!(cos_o > 0.0f)) return vec3(0.0f);
     vec4 cone = lc_box_cone(box_min, box_max, x);
@@ -567,7 +579,7 @@ vec3 lc_disney_bound(Material m, vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec
 // holds positions, G <= 1/d_min^2 with the same clamp as the exact term.
 // Directional lights: the box holds unit directions, so x is the origin and
 // G = 1.
-vec3 lc_cluster_bound(SurfacePoint sp, Material m, LightNode node, float min_distance2) {
+vec3 lc_cluster_bound(LC_IN(SurfacePoint) sp, LC_IN(Material) m, LC_IN(LightNode) node, float min_distance2) {
     vec3 box_min = vec3(node.min_x, node.min_y, node.min_z);
     vec3 box_max = vec3(node.max_x, node.max_y, node.max_z);
     bool positional = lc_node_type(node) != kLightDirectional;

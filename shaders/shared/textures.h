@@ -52,7 +52,7 @@ vec4 lc_texture_sample(uint index, vec2 uv, bool srgb) {
 }
 
 // Whether material m has texture `index` (one of its *_texture fields).
-bool lc_has_texture(Material m, uint index) {
+bool lc_has_texture(LC_IN(Material) m, uint index) {
     return kEnableTextures && (m.flags & kMaterialTextured) != 0u && index != kInvalidIndex;
 }
 
@@ -97,7 +97,7 @@ Material lc_material_at(uint index, vec2 uv) {
 // `t`. The tangent frame is the triangle's: T along +u and B towards -v
 // (glTF's +Y, image up; v grows downwards), both made orthogonal to ns. A
 // triangle whose UVs are degenerate keeps ns.
-vec3 lc_normal_mapped(Material m, vec2 uv, vec3 ns, vec3 v0, vec3 v1, vec3 v2, TriangleUvs t) {
+vec3 lc_normal_mapped(LC_IN(Material) m, vec2 uv, vec3 ns, vec3 v0, vec3 v1, vec3 v2, LC_IN(TriangleUvs) t) {
     if (!lc_has_texture(m, m.normal_texture)) return ns;
     vec3 dp1 = v1 - v0;
     vec3 dp2 = v2 - v0;

@@ -20,7 +20,7 @@ vec3 lc_tri_v2(Triangle t) { return vec3(t.v2_x, t.v2_y, t.v2_z); }
 // a shared edge or vertex hit at least one of the triangles, so nothing leaks
 // between neighbours. Returns t in (0, t_max), or -1 for a miss; b1 and b2
 // are the barycentric weights of v1 and v2.
-float lc_intersect_triangle(vec3 org, vec3 dir, Triangle tri, float t_max,
+float lc_intersect_triangle(vec3 org, vec3 dir, LC_IN(Triangle) tri, float t_max,
                             LC_OUT(float) b1, LC_OUT(float) b2) {
     b1 = 0.0f;
     b2 = 0.0f;
@@ -64,7 +64,7 @@ float lc_intersect_triangle(vec3 org, vec3 dir, Triangle tri, float t_max,
 
 // Slab test. The far distance is widened by 2*gamma(3) (Ize, "Robust BVH Ray
 // Traversal", JCGT 2013) so rounding never culls a box the ray touches.
-bool lc_hit_box(BvhNode node, vec3 org, vec3 inv_dir, float t_max, LC_OUT(float) t_entry) {
+bool lc_hit_box(LC_IN(BvhNode) node, vec3 org, vec3 inv_dir, float t_max, LC_OUT(float) t_entry) {
     vec3 t0 = (vec3(node.min_x, node.min_y, node.min_z) - org) * inv_dir;
     vec3 t1 = (vec3(node.max_x, node.max_y, node.max_z) - org) * inv_dir;
     vec3 tn = min(t0, t1);
@@ -175,7 +175,7 @@ bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
 // tests/stress, Transformed.*.)
 LC_KCONST float kHitOffsetRelative = 1.0f / 1048576.0f;
 
-vec3 lc_offset_hit_point(vec3 p, vec3 ng, Triangle tri) {
+vec3 lc_offset_hit_point(vec3 p, vec3 ng, LC_IN(Triangle) tri) {
     vec3 m = max(max(abs(lc_tri_v0(tri)), abs(lc_tri_v1(tri))), abs(lc_tri_v2(tri)));
     return p + ng * (kHitOffsetRelative * max(max(m.x, m.y), m.z));
 }
