@@ -25,10 +25,6 @@
 #include <numeric>
 #include <thread>
 
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
-
 #include <glm/glm.hpp>
 
 #include "light_bounds.h"
@@ -105,31 +101,6 @@ void merge(Build& build, std::uint32_t a, std::uint32_t b) {
     merge_into(build, a, b, id);
 }
 
-// Asks the kernel to back [data, data + bytes) with huge pages where it
-// does so only on request (transparent_hugepage=madvise, Debian's default).
-// The build's arrays reach gigabytes at 10^7 lights: with 4 KiB pages,
-// first touches and TLB misses of flatten()'s and the merges' scattered
-// reads took a good part of the build. Call before the memory is first
-// written; a no-op elsewhere.
-void advise_huge_pages(const void* data, std::size_t bytes) {
-#ifdef __linux__
-    constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
-    const auto begin = (reinterpret_cast<std::uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
-    const auto end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kHuge - 1);
-    if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-#else
-    (void)data;
-    (void)bytes;
-#endif
-}
-
-// reserve() with huge pages advised for the reserved memory.
-template <typename T>
-void reserve_huge(std::vector<T>& v, std::size_t n) {
-    v.reserve(n);
-    advise_huge_pages(v.data(), v.capacity() * sizeof(T));
-}
-
 // The threads parallel_for uses for n items, and the range of thread t.
 unsigned thread_count(std::size_t n) {
     return n < 4096 ? 1u : std::max(1u, std::thread::hardware_concurrency());
@@ -181,9 +152,7 @@ void sort_morton(const std::vector<Cluster>& all, std::vector<std::uint32_t>& ac
     }
     glm::vec3 extent = glm::max(hi - lo, glm::vec3(1e-30f));
     using Keyed = std::pair<std::uint64_t, std::uint32_t>;
-    std::vector<Keyed> keyed;
-    reserve_huge(keyed, active.size());
-    keyed.resize(active.size());
+    std::vector<Keyed> keyed(active.size());
     parallel_for(active.size(), [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) {
             const Cluster& c = all[active[i]];
@@ -260,10 +229,7 @@ std::size_t best_partner(const Build& b, const std::vector<CostKey>& keys, std::
 struct PointKeys {
     std::vector<float> lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, weight;
     void resize(std::size_t n) {
-        for (auto* v : {&lo_x, &lo_y, &lo_z, &hi_x, &hi_y, &hi_z, &weight}) {
-            if (v->capacity() < n) reserve_huge(*v, n);
-            v->resize(n);
-        }
+        for (auto* v : {&lo_x, &lo_y, &lo_z, &hi_x, &hi_y, &hi_z, &weight}) v->resize(n);
     }
     void set(std::size_t i, const Cluster& c) {
         lo_x[i] = c.lo.x; lo_y[i] = c.lo.y; lo_z[i] = c.lo.z;
@@ -364,7 +330,7 @@ std::size_t best_partner_points(const PointKeys& k, std::size_t i) {
 // clusters; the lights (Cluster::rep) and every merge are as before.
 void renumber_leaves(Build& build, std::vector<std::uint32_t>& active) {
     std::vector<Cluster> sorted;
-    reserve_huge(sorted, build.all.capacity());
+    sorted.reserve(build.all.capacity());
     sorted.resize(active.size());
     parallel_for(active.size(), [&](std::size_t begin, std::size_t end) {
         for (std::size_t i = begin; i < end; ++i) sorted[i] = build.all[active[i]];
@@ -590,8 +556,8 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
                            double cone_scale) {
     auto start = std::chrono::steady_clock::now();
     LightTree tree;
-    reserve_huge(tree.lights, lights.size());
-    reserve_huge(tree.nodes, 2 * lights.size());
+    tree.lights.reserve(lights.size());
+    tree.nodes.reserve(2 * lights.size());
     for (const gpu::Light& l : lights) tree_point(l);  // unknown types fail before any work
     for (std::uint32_t type = 0; type < gpu::kLightTypeCount; ++type) {
         Build build;
@@ -602,7 +568,7 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
         const auto of_type = [type](const gpu::Light& l) { return (l.type & gpu::kLightTypeMask) == type; };
         const std::size_t type_count = std::size_t(std::count_if(lights.begin(), lights.end(), of_type));
         if (type_count == 0) continue;
-        reserve_huge(all, 2 * type_count);
+        all.reserve(2 * type_count);
         all.resize(type_count);
         const unsigned threads = thread_count(lights.size());
         std::vector<std::size_t> made(threads + 1, 0);  // leaves before each thread's range
