@@ -71,14 +71,14 @@ double merge_cost(const Build& b, const C& x, const C& y) {
 }
 
 
-// Merges clusters a and b (build ids) into a new cluster appended to `all`.
+// Merges clusters a and b (build ids) into the cluster of build id `id`.
 // The representative is one of the children's, chosen with probability
 // proportional to their intensities from a hash of (seed, new id), so the
 // choice is the same whatever order or thread made it.
-void merge(Build& build, std::uint32_t a, std::uint32_t b) {
+void merge_into(Build& build, std::uint32_t a, std::uint32_t b, std::uint32_t id) {
     std::vector<Cluster>& all = build.all;
     const std::uint32_t seed = build.seed;
-    Cluster c;
+    Cluster& c = all[id];
     const Cluster& ca = all[a];
     const Cluster& cb = all[b];
     c.lo = glm::min(ca.lo, cb.lo);
@@ -88,29 +88,49 @@ void merge(Build& build, std::uint32_t a, std::uint32_t b) {
     c.cone = quantized(cone_union(ca.cone, cb.cone), c.axis_packed);
     c.left = a;
     c.right = b;
-    auto id = static_cast<std::uint32_t>(all.size());
     double u = gpu::lc_unit_float(gpu::lc_hash(seed ^ gpu::lc_hash(id)));
     double p_left = c.weight > 0.0 ? ca.weight / c.weight : 0.5;
     c.rep_from_right = u >= p_left;
     c.rep = c.rep_from_right ? cb.rep : ca.rep;
-    all.push_back(c);
+}
+
+// Merges clusters a and b into a new cluster appended to `all`.
+void merge(Build& build, std::uint32_t a, std::uint32_t b) {
+    const auto id = static_cast<std::uint32_t>(build.all.size());
+    build.all.emplace_back();
+    merge_into(build, a, b, id);
+}
+
+// The threads parallel_for uses for n items, and the range of thread t.
+unsigned thread_count(std::size_t n) {
+    return n < 4096 ? 1u : std::max(1u, std::thread::hardware_concurrency());
+}
+std::pair<std::size_t, std::size_t> thread_range(std::size_t n, unsigned threads, unsigned t) {
+    const std::size_t chunk = (n + threads - 1) / threads;
+    return {std::min(n, t * chunk), std::min(n, (t + 1) * chunk)};
+}
+
+// Runs fn(begin, end, t) over [0, n) on up to hardware_concurrency threads,
+// t the thread's number: the same ranges as thread_range().
+template <typename Fn>
+void parallel_for_ranges(std::size_t n, Fn fn) {
+    const unsigned threads = thread_count(n);
+    if (threads == 1) {
+        fn(std::size_t(0), n, 0u);
+        return;
+    }
+    std::vector<std::thread> pool;
+    for (unsigned t = 0; t < threads; ++t) {
+        auto [b, e] = thread_range(n, threads, t);
+        if (b < e) pool.emplace_back(fn, b, e, t);
+    }
+    for (auto& th : pool) th.join();
 }
 
 // Runs fn(begin, end) over [0, n) on up to hardware_concurrency threads.
 template <typename Fn>
 void parallel_for(std::size_t n, Fn fn) {
-    unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-    if (n < 4096 || threads == 1) {
-        fn(std::size_t(0), n);
-        return;
-    }
-    std::vector<std::thread> pool;
-    std::size_t chunk = (n + threads - 1) / threads;
-    for (unsigned t = 0; t < threads; ++t) {
-        std::size_t b = t * chunk, e = std::min(n, b + chunk);
-        if (b < e) pool.emplace_back(fn, b, e);
-    }
-    for (auto& th : pool) th.join();
+    parallel_for_ranges(n, [&fn](std::size_t b, std::size_t e, unsigned) { fn(b, e); });
 }
 
 // Interleaves the 10-bit coordinates q[0..dims) into one Morton key.
@@ -131,16 +151,28 @@ void sort_morton(const std::vector<Cluster>& all, std::vector<std::uint32_t>& ac
         hi = glm::max(hi, all[id].hi);
     }
     glm::vec3 extent = glm::max(hi - lo, glm::vec3(1e-30f));
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(active.size());
-    for (std::size_t i = 0; i < active.size(); ++i) {
-        const Cluster& c = all[active[i]];
-        const glm::vec3 t = glm::clamp((0.5f * (c.lo + c.hi) - lo) / extent, 0.0f, 1.0f) * 1023.0f;
-        const glm::vec3 a = glm::clamp(0.5f * (c.cone.axis + 1.0f), 0.0f, 1.0f) * 1023.0f;
-        const std::uint32_t q[6] = {std::uint32_t(t.x), std::uint32_t(t.y), std::uint32_t(t.z),
-                                    std::uint32_t(a.x), std::uint32_t(a.y), std::uint32_t(a.z)};
-        keyed[i] = {morton_key(q, with_axis ? 6 : 3), active[i]};
+    using Keyed = std::pair<std::uint64_t, std::uint32_t>;
+    std::vector<Keyed> keyed(active.size());
+    parallel_for(active.size(), [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+            const Cluster& c = all[active[i]];
+            const glm::vec3 t = glm::clamp((0.5f * (c.lo + c.hi) - lo) / extent, 0.0f, 1.0f) * 1023.0f;
+            const glm::vec3 a = glm::clamp(0.5f * (c.cone.axis + 1.0f), 0.0f, 1.0f) * 1023.0f;
+            const std::uint32_t q[6] = {std::uint32_t(t.x), std::uint32_t(t.y), std::uint32_t(t.z),
+                                        std::uint32_t(a.x), std::uint32_t(a.y), std::uint32_t(a.z)};
+            keyed[i] = {morton_key(q, with_axis ? 6 : 3), active[i]};
+        }
+    });
+    // Each thread sorts its range, then the ranges merge: the order of one
+    // std::sort, as (key, id) pairs are all distinct.
+    const unsigned threads = thread_count(keyed.size());
+    parallel_for_ranges(keyed.size(), [&](std::size_t b, std::size_t e, unsigned) {
+        std::sort(keyed.begin() + std::ptrdiff_t(b), keyed.begin() + std::ptrdiff_t(e));
+    });
+    for (unsigned t = 1; t < threads; ++t) {
+        auto [b, e] = thread_range(keyed.size(), threads, t);
+        std::inplace_merge(keyed.begin(), keyed.begin() + std::ptrdiff_t(b), keyed.begin() + std::ptrdiff_t(e));
     }
-    std::sort(keyed.begin(), keyed.end());
     for (std::size_t i = 0; i < keyed.size(); ++i) active[i] = keyed[i].second;
 }
 
@@ -190,46 +222,217 @@ std::size_t best_partner(const Build& b, const std::vector<CostKey>& keys, std::
     return best_j;
 }
 
+// The boxes and weights of the clusters of a round in Morton order, one
+// array per coordinate, for trees without a cone term: the metric then
+// needs nothing else, and best_partner_points reads a window of partners
+// as contiguous floats that the compiler turns into vector instructions.
+struct PointKeys {
+    std::vector<float> lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, weight;
+    void resize(std::size_t n) {
+        for (auto* v : {&lo_x, &lo_y, &lo_z, &hi_x, &hi_y, &hi_z, &weight}) v->resize(n);
+    }
+    void set(std::size_t i, const Cluster& c) {
+        lo_x[i] = c.lo.x; lo_y[i] = c.lo.y; lo_z[i] = c.lo.z;
+        hi_x[i] = c.hi.x; hi_y[i] = c.hi.y; hi_z[i] = c.hi.z;
+        weight[i] = float(c.weight);
+    }
+    void copy(std::size_t i, const PointKeys& from, std::size_t j) {
+        lo_x[i] = from.lo_x[j]; lo_y[i] = from.lo_y[j]; lo_z[i] = from.lo_z[j];
+        hi_x[i] = from.hi_x[j]; hi_y[i] = from.hi_y[j]; hi_z[i] = from.hi_z[j];
+        weight[i] = from.weight[j];
+    }
+};
+
+// Walter 2005 §4.1 without the cone term, in float, for keys[i] and the
+// partners [j0, j0 + count): cost[k] for partner j0 + k.
+template <std::size_t kCount>
+void point_costs(const PointKeys& k, std::size_t i, std::size_t j0, float* cost) {
+    const float lx = k.lo_x[i], ly = k.lo_y[i], lz = k.lo_z[i];
+    const float hx = k.hi_x[i], hy = k.hi_y[i], hz = k.hi_z[i], w = k.weight[i];
+    const float* __restrict jlx = k.lo_x.data() + j0;
+    const float* __restrict jly = k.lo_y.data() + j0;
+    const float* __restrict jlz = k.lo_z.data() + j0;
+    const float* __restrict jhx = k.hi_x.data() + j0;
+    const float* __restrict jhy = k.hi_y.data() + j0;
+    const float* __restrict jhz = k.hi_z.data() + j0;
+    const float* __restrict jw = k.weight.data() + j0;
+    for (std::size_t t = 0; t < kCount; ++t) {
+        const float dx = std::max(hx, jhx[t]) - std::min(lx, jlx[t]);
+        const float dy = std::max(hy, jhy[t]) - std::min(ly, jly[t]);
+        const float dz = std::max(hz, jhz[t]) - std::min(lz, jlz[t]);
+        cost[t] = (w + jw[t]) * (dx * dx + dy * dy + dz * dz);
+    }
+}
+
+// best_partner for trees without a cone term, over PointKeys: the same
+// choice, tie rule included, with the costs in float. The costs of the
+// whole window come first (vectorized), then their smallest; the rule then
+// looks only at the partners of that cost.
+std::size_t best_partner_points(const PointKeys& k, std::size_t i) {
+    const std::size_t n = k.weight.size();
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    float cost[2 * kWindow + 1];
+    std::size_t jb, je;
+    if (i >= std::size_t(kWindow) && i + kWindow < n) {
+        // cost[kWindow - d]: partner i - d; cost[kWindow + d]: partner i + d.
+        point_costs<kWindow>(k, i, i - kWindow, cost);
+        point_costs<kWindow>(k, i, i + 1, cost + kWindow + 1);
+        // The smallest in 4 lanes (vector minimums), then across them;
+        // NaN never wins a comparison, so it is never the smallest.
+        float lane[4] = {inf, inf, inf, inf};
+        for (std::size_t t = 0; t < 2 * kWindow; t += 4)
+            for (std::size_t l = 0; l < 4; ++l) {
+                const float c = cost[t + (t >= std::size_t(kWindow) ? 1 : 0) + l];
+                lane[l] = c < lane[l] ? c : lane[l];
+            }
+        const float smallest = std::min(std::min(lane[0], lane[1]), std::min(lane[2], lane[3]));
+        if (smallest < inf) {
+            // The nearest partner of that cost; both sides at the same
+            // distance: the tie rule of best_partner.
+            for (std::size_t d = 1; d <= std::size_t(kWindow); ++d) {
+                const bool left = cost[kWindow - d] == smallest;
+                const bool right = cost[kWindow + d] == smallest;
+                if (left && right) return (i / d) % 2 == 0 ? i + d : i - d;
+                if (left || right) return right ? i + d : i - d;
+            }
+        }
+        jb = i - kWindow;
+        je = i + kWindow + 1;
+    } else {
+        jb = i >= std::size_t(kWindow) ? i - kWindow : 0;
+        je = std::min(n, i + kWindow + 1);
+        for (std::size_t j = jb; j < je; ++j) point_costs<1>(k, i, j, cost + (j - jb));
+    }
+    cost[i - jb] = inf;
+    float smallest = inf;
+    for (std::size_t t = 0; t < je - jb; ++t) smallest = cost[t] < smallest ? cost[t] : smallest;
+    float best_cost = inf;
+    std::size_t best_j = i == 0 ? 1 : i - 1;
+    for (std::size_t j = jb; j < je; ++j) {
+        const float c = cost[j - jb];
+        if (j == i || !(c == smallest)) continue;  // NaN: never chosen
+        if (c == best_cost) {
+            const std::size_t dist = j > i ? j - i : i - j;
+            const std::size_t best_dist = best_j > i ? best_j - i : i - best_j;
+            if (dist > best_dist) continue;
+            if (dist == best_dist && (j > i) != ((i / dist) % 2 == 0)) continue;
+        }
+        best_cost = c;
+        best_j = j;
+    }
+    return best_j;
+}
+
+// Puts the leaves (build ids [0, active.size())) in the order of `active`,
+// renumbering them 0, 1, ...: the windows of the first round, the merges
+// and flatten() then read neighbouring clusters from neighbouring memory
+// (the input order of a light file is arbitrary). Leaf ids only name
+// clusters; the lights (Cluster::rep) and every merge are as before.
+void renumber_leaves(Build& build, std::vector<std::uint32_t>& active) {
+    std::vector<Cluster> sorted;
+    sorted.reserve(build.all.capacity());
+    sorted.resize(active.size());
+    parallel_for(active.size(), [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) sorted[i] = build.all[active[i]];
+    });
+    build.all.swap(sorted);
+    std::iota(active.begin(), active.end(), 0u);
+}
+
 // Locally-ordered clustering; returns the root's build id.
 std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
-    sort_morton(build.all, active, build.cone_weight > 0.0);
+    const bool points = !(build.cone_weight > 0.0);
+    sort_morton(build.all, active, !points);
+    if (active.size() == build.all.size()) renumber_leaves(build, active);
     std::vector<std::uint32_t> best(active.size());
-    std::vector<CostKey> keys(active.size());
+    std::vector<CostKey> keys;
+    PointKeys point_keys, next_point_keys;
+    if (points) {
+        point_keys.resize(active.size());
+        parallel_for(active.size(), [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i) point_keys.set(i, build.all[active[i]]);
+        });
+    }
     std::vector<std::uint32_t> next;
+    std::vector<std::size_t> kept_before, merged_before;  // per thread: prefix counts
     while (active.size() > 1) {
         const std::size_t n = active.size();
         best.resize(n);
-        keys.resize(n);
-        parallel_for(n, [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end; ++i) {
-                const Cluster& c = build.all[active[i]];
-                keys[i] = CostKey{c.lo, c.hi, c.weight, c.cone};
-            }
-        });
-        parallel_for(n, [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end; ++i)
-                best[i] = static_cast<std::uint32_t>(best_partner(build, keys, i));
-        });
-        // Mutual best pairs merge (in place of their first member, so the
-        // Morton order holds); the others wait for the next round.
-        next.clear();
-        std::size_t merged = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            const std::size_t j = best[i];
-            if (best[j] != i) {
-                next.push_back(active[i]);
-            } else if (i < j) {
-                merge(build, active[i], active[j]);
-                next.push_back(static_cast<std::uint32_t>(build.all.size() - 1));
-                ++merged;
-            }
+        if (points) {
+            parallel_for(n, [&](std::size_t begin, std::size_t end) {
+                for (std::size_t i = begin; i < end; ++i)
+                    best[i] = static_cast<std::uint32_t>(best_partner_points(point_keys, i));
+            });
+        } else {
+            keys.resize(n);
+            parallel_for(n, [&](std::size_t begin, std::size_t end) {
+                for (std::size_t i = begin; i < end; ++i) {
+                    const Cluster& c = build.all[active[i]];
+                    keys[i] = CostKey{c.lo, c.hi, c.weight, c.cone};
+                }
+            });
+            parallel_for(n, [&](std::size_t begin, std::size_t end) {
+                for (std::size_t i = begin; i < end; ++i)
+                    best[i] = static_cast<std::uint32_t>(best_partner(build, keys, i));
+            });
         }
+        // Mutual best pairs merge (in place of their first member, so the
+        // Morton order holds); the others wait for the next round. Each
+        // thread counts its range's survivors and merges first, so that the
+        // new clusters get the build ids, and the survivors the places, of
+        // one pass in order.
+        const unsigned threads = thread_count(n);
+        kept_before.assign(threads + 1, 0);
+        merged_before.assign(threads + 1, 0);
+        parallel_for_ranges(n, [&](std::size_t begin, std::size_t end, unsigned t) {
+            std::size_t kept = 0, merged = 0;
+            for (std::size_t i = begin; i < end; ++i) {
+                const std::size_t j = best[i];
+                const bool mutual = best[j] == i;
+                kept += !mutual || i < j ? 1 : 0;
+                merged += mutual && i < j ? 1 : 0;
+            }
+            kept_before[t + 1] = kept;
+            merged_before[t + 1] = merged;
+        });
+        for (unsigned t = 0; t < threads; ++t) {
+            kept_before[t + 1] += kept_before[t];
+            merged_before[t + 1] += merged_before[t];
+        }
+        const std::size_t merged = merged_before[threads];
+        const auto first_id = static_cast<std::uint32_t>(build.all.size());
+        build.all.resize(build.all.size() + merged);
+        next.resize(kept_before[threads]);
+        if (points) next_point_keys.resize(next.size());
+        parallel_for_ranges(n, [&](std::size_t begin, std::size_t end, unsigned t) {
+            std::size_t out = kept_before[t];
+            auto id = static_cast<std::uint32_t>(first_id + merged_before[t]);
+            for (std::size_t i = begin; i < end; ++i) {
+                const std::size_t j = best[i];
+                if (best[j] != i) {
+                    next[out] = active[i];
+                    if (points) next_point_keys.copy(out, point_keys, i);
+                    ++out;
+                } else if (i < j) {
+                    merge_into(build, active[i], active[j], id);
+                    next[out] = id;
+                    if (points) next_point_keys.set(out, build.all[id]);
+                    ++out;
+                    ++id;
+                }
+            }
+        });
+        if (points) std::swap(point_keys, next_point_keys);
         if (merged == 0) {
             // Cannot happen with the tie-breaking above (the cheapest pair in
             // any window is mutual); merge neighbours rather than loop forever.
             merge(build, active[0], active[1]);
             next.erase(next.begin(), next.begin() + 2);
             next.insert(next.begin(), static_cast<std::uint32_t>(build.all.size() - 1));
+            if (points) {
+                point_keys.resize(next.size());
+                for (std::size_t i = 0; i < next.size(); ++i) point_keys.set(i, build.all[next[i]]);
+            }
         }
         active.swap(next);
     }
@@ -358,31 +561,69 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
     auto start = std::chrono::steady_clock::now();
     LightTree tree;
     tree.lights.reserve(lights.size());
+    tree.nodes.reserve(2 * lights.size());
     for (const gpu::Light& l : lights) tree_point(l);  // unknown types fail before any work
     for (std::uint32_t type = 0; type < gpu::kLightTypeCount; ++type) {
         Build build;
         build.seed = seed ^ type;
         std::vector<Cluster>& all = build.all;
-        std::vector<std::uint32_t> leaves;
-        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-        for (std::uint32_t i = 0; i < lights.size(); ++i) {
-            const gpu::Light& l = lights[i];
-            if ((l.type & gpu::kLightTypeMask) != type) continue;
-            Cluster c;
-            c.lo = c.hi = tree_point(l);
-            c.cone = quantized(EmissionCone::of_light(l), c.axis_packed);
-            c.intensity = glm::dvec3(l.r, l.g, l.b);
-            c.weight = gpu::lc_luminance(glm::vec3(l.r, l.g, l.b));
-            if (!(c.weight > 0.0)) {
-                tree.black_lights += 1;
-                continue;
+        // The leaves, in light order: each thread makes those of its range
+        // of lights, then they are packed in order (black lights left out).
+        const auto of_type = [type](const gpu::Light& l) { return (l.type & gpu::kLightTypeMask) == type; };
+        const std::size_t type_count = std::size_t(std::count_if(lights.begin(), lights.end(), of_type));
+        if (type_count == 0) continue;
+        all.reserve(2 * type_count);
+        all.resize(type_count);
+        const unsigned threads = thread_count(lights.size());
+        std::vector<std::size_t> made(threads + 1, 0);  // leaves before each thread's range
+        std::vector<glm::vec3> range_lo(threads, glm::vec3(std::numeric_limits<float>::max()));
+        std::vector<glm::vec3> range_hi(threads, glm::vec3(-std::numeric_limits<float>::max()));
+        std::vector<std::size_t> range_black(threads, 0);
+        // Pass 1: lights of this type before each range, so each range
+        // writes where one pass in order would.
+        parallel_for_ranges(lights.size(), [&](std::size_t begin, std::size_t end, unsigned t) {
+            made[t + 1] = std::size_t(std::count_if(lights.begin() + std::ptrdiff_t(begin),
+                                                     lights.begin() + std::ptrdiff_t(end), of_type));
+        });
+        for (unsigned t = 0; t < threads; ++t) made[t + 1] += made[t];
+        std::vector<std::size_t> range_end(threads, 0);  // one past each range's last leaf
+        parallel_for_ranges(lights.size(), [&](std::size_t begin, std::size_t end, unsigned t) {
+            std::size_t out = made[t];
+            for (std::size_t i = begin; i < end; ++i) {
+                const gpu::Light& l = lights[i];
+                if (!of_type(l)) continue;
+                Cluster& c = all[out];
+                c = Cluster{};
+                c.lo = c.hi = tree_point(l);
+                c.cone = quantized(EmissionCone::of_light(l), c.axis_packed);
+                c.intensity = glm::dvec3(l.r, l.g, l.b);
+                c.weight = gpu::lc_luminance(glm::vec3(l.r, l.g, l.b));
+                if (!(c.weight > 0.0)) {
+                    range_black[t] += 1;
+                    continue;
+                }
+                c.rep = std::uint32_t(i);
+                range_lo[t] = glm::min(range_lo[t], c.lo);
+                range_hi[t] = glm::max(range_hi[t], c.hi);
+                ++out;
             }
-            c.rep = i;
-            lo = glm::min(lo, c.lo);
-            hi = glm::max(hi, c.hi);
-            leaves.push_back(static_cast<std::uint32_t>(all.size()));
-            all.push_back(c);
+            range_end[t] = out;
+        });
+        // Pack the ranges together where black lights left gaps.
+        glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+        std::size_t packed = 0;
+        for (unsigned t = 0; t < threads; ++t) {
+            tree.black_lights += range_black[t];
+            lo = glm::min(lo, range_lo[t]);
+            hi = glm::max(hi, range_hi[t]);
+            if (packed != made[t])
+                std::copy(all.begin() + std::ptrdiff_t(made[t]), all.begin() + std::ptrdiff_t(range_end[t]),
+                          all.begin() + std::ptrdiff_t(packed));
+            packed += range_end[t] - made[t];
         }
+        all.resize(packed);
+        std::vector<std::uint32_t> leaves(packed);
+        std::iota(leaves.begin(), leaves.end(), 0u);
         if (leaves.empty()) continue;
         // Walter 2005 §4.1 sets c, which weighs directional against spatial
         // similarity, to the scene's diagonal; here the diagonal of this
@@ -391,7 +632,6 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
                                            [&](std::uint32_t id) { return !all[id].cone.emits_everywhere(); });
         if (has_cones)
             build.cone_weight = cone_scale * cone_scale * glm::dot(glm::dvec3(hi - lo), glm::dvec3(hi - lo));
-        all.reserve(2 * leaves.size());
         std::uint32_t root = builder == TreeBuilder::kExact ? cluster_exact(build, leaves) : cluster_fast(build, leaves);
         auto base = static_cast<std::uint32_t>(tree.nodes.size());
         tree.nodes.resize(tree.nodes.size() + 2 * leaves.size() - 1);

@@ -33,7 +33,18 @@ LC_CONST uint kBindingRadiance = 12u;     // 3 floats per tile pixel, summed ove
 LC_CONST uint kBindingPixelStats = 13u;   // PixelStats per tile pixel, summed over samples
 LC_CONST uint kBindingHeapSave = 14u;     // cut heaps paused between dispatches (see heap.glsl)
 LC_CONST uint kBindingCutState = 15u;     // CutState per tile pixel, between Lightcuts dispatches
-LC_CONST uint kBindingCount = 16u;
+LC_CONST uint kBindingChunkTable = 16u;   // ChunkTable: where the chunks of a split scene array are
+LC_CONST uint kBindingCount = 17u;
+
+// Scene arrays (bindings 0 .. kSceneArrayCount - 1) larger than one buffer
+// may be are split into chunks of 2^shift elements each. Chunk 0 stays at
+// the array's binding; every chunk's buffer device address is in the
+// ChunkTable, whose std430 layout is:
+//   uint first[kSceneArrayCount];  // index in addr of each array's chunk 0
+//   uvec2 addr[];                  // device addresses, low word first
+// (shaders/kernel.glsl reads it; GpuResources writes it.)
+LC_CONST uint kSceneArrayCount = 10u;
+LC_CONST uint kChunkTableHeaderBytes = 4u * kSceneArrayCount;
 
 // Specialization constant ids.
 LC_CONST uint kSpecWorkgroupSize = 0u;    // local_size_x
@@ -47,6 +58,9 @@ LC_CONST uint kSpecEnableTextures = 8u;   // any material has a texture
 LC_CONST uint kSpecEnableDisney = 9u;     // any Disney material
 LC_CONST uint kSpecEnableSheen = 10u;     // any Disney material with sheen > 0
 LC_CONST uint kSpecEnableClearcoat = 11u; // any Disney material with clearcoat > 0
+LC_CONST uint kSpecSplitScene = 12u;      // some scene array is split into chunks
+LC_CONST uint kSpecChunkShift = 13u;      // 13 + b: log2 of the elements per chunk of the scene
+                                          // array at binding b (b < kSceneArrayCount)
 
 // PixelStats.flags
 LC_CONST uint kPixelLoopLimit = 2u;     // the driver cut the invocation's loops short

@@ -4,6 +4,11 @@
 #ifndef LC_KERNEL_GLSL
 #define LC_KERNEL_GLSL
 
+// The chunks of a split scene array are read through device addresses,
+// made from the two 32-bit words in the ChunkTable (no shaderInt64 needed).
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_buffer_reference_uvec2 : require
+
 #include "bindings.glsl"
 
 layout(local_size_x_id = kSpecWorkgroupSize) in;
@@ -23,30 +28,51 @@ layout(constant_id = kSpecEnableClearcoat) const bool kEnableClearcoat = true;
 layout(push_constant) uniform Push { PushConstants push; };
 layout(std430, binding = kBindingFrame) readonly buffer Frame { FrameParams frame; };
 
-layout(std430, binding = kBindingBvhNodes) readonly buffer BvhNodes { BvhNode bvh_nodes[]; };
-layout(std430, binding = kBindingTriangles) readonly buffer Triangles { Triangle triangles[]; };
-layout(std430, binding = kBindingNormals) readonly buffer Normals { TriangleNormals normals[]; };
-layout(std430, binding = kBindingUvs) readonly buffer Uvs { TriangleUvs uvs[]; };
-layout(std430, binding = kBindingMaterials) readonly buffer Materials { Material materials[]; };
-layout(std430, binding = kBindingTextures) readonly buffer Textures { TextureInfo textures[]; };
-layout(std430, binding = kBindingTexels) readonly buffer Texels { uint texels[]; };
-layout(std430, binding = kBindingLights) readonly buffer Lights { Light lights[]; };
-layout(std430, binding = kBindingLightNodes) readonly buffer LightNodes { LightNode light_nodes[]; };
-layout(std430, binding = kBindingEnvironment) readonly buffer Environment { float environment[]; };
+// The scene arrays. Each is read through lc_<name>(i): element i of the
+// array, which is at the array's binding when the array fits one buffer (or
+// i lies in its first chunk), else in chunk i >> shift, read through the
+// chunk's buffer device address (docs/vulkan.md, "Scene arrays larger than a
+// buffer"). With no array split, kSplitScene folds the second path away.
+layout(constant_id = kSpecSplitScene) const bool kSplitScene = false;
+layout(std430, binding = kBindingChunkTable) readonly buffer ChunkTable {
+    uint chunk_first[kSceneArrayCount];
+    uvec2 chunk_addr[];
+};
+#define LC_SCENE_ARRAY(Type, name, binding_index)                                                      \
+    layout(std430, binding = binding_index) readonly buffer name##_block { Type name[]; };            \
+    layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer name##_chunk {       \
+        Type v[];                                                                                      \
+    };                                                                                                 \
+    layout(constant_id = kSpecChunkShift + binding_index) const uint name##_shift = 31u;               \
+    Type lc_##name(uint i) {                                                                           \
+        const uint chunk = i >> name##_shift;                                                          \
+        if (!kSplitScene || chunk == 0u) return name[i];                                               \
+        return name##_chunk(chunk_addr[chunk_first[binding_index] + chunk]).v[i & ((1u << name##_shift) - 1u)]; \
+    }
+LC_SCENE_ARRAY(BvhNode, bvh_nodes, kBindingBvhNodes)
+LC_SCENE_ARRAY(Triangle, triangles, kBindingTriangles)
+LC_SCENE_ARRAY(TriangleNormals, normals, kBindingNormals)
+LC_SCENE_ARRAY(TriangleUvs, uvs, kBindingUvs)
+LC_SCENE_ARRAY(Material, materials, kBindingMaterials)
+LC_SCENE_ARRAY(TextureInfo, textures, kBindingTextures)
+LC_SCENE_ARRAY(uint, texels, kBindingTexels)
+LC_SCENE_ARRAY(Light, lights, kBindingLights)
+LC_SCENE_ARRAY(LightNode, light_nodes, kBindingLightNodes)
+LC_SCENE_ARRAY(float, environment, kBindingEnvironment)
 layout(std430, binding = kBindingGBuffer) buffer GBuffer { GBufferTexel gbuffer[]; };
 layout(std430, binding = kBindingRadiance) buffer Radiance { float radiance[]; };
 layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_stats[]; };
 
-#define LC_BVH_NODE(i) bvh_nodes[i]
-#define LC_TRIANGLE(i) triangles[i]
-#define LC_MATERIAL(i) materials[i]
-#define LC_UVS(i) uvs[i]
-#define LC_TEXTURE(i) textures[i]
-#define LC_TEXEL(i) texels[i]
-#define LC_NORMALS(i) normals[i]
-#define LC_LIGHT_NODE(i) light_nodes[i]
+#define LC_BVH_NODE(i) lc_bvh_nodes(i)
+#define LC_TRIANGLE(i) lc_triangles(i)
+#define LC_MATERIAL(i) lc_materials(i)
+#define LC_UVS(i) lc_uvs(i)
+#define LC_TEXTURE(i) lc_textures(i)
+#define LC_TEXEL(i) lc_texels(i)
+#define LC_NORMALS(i) lc_normals(i)
+#define LC_LIGHT_NODE(i) lc_light_nodes(i)
 #define LC_VPL_MIN_DISTANCE2 frame.vpl_min_distance2
-#define LC_ENVIRONMENT_TEXEL(i) vec3(environment[3u * (i)], environment[3u * (i) + 1u], environment[3u * (i) + 2u])
+#define LC_ENVIRONMENT_TEXEL(i) vec3(lc_environment(3u * (i)), lc_environment(3u * (i) + 1u), lc_environment(3u * (i) + 2u))
 // LC_LIGHT is defined by each kernel (brute force offsets it by light_first).
 
 #include "shared/glsl_compat.h"

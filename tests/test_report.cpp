@@ -35,7 +35,8 @@ TEST(Report, JsonHasEveryKeyScriptsReadAndTheBlackLights) {
                             "buffer_bytes", "bvh_nodes", "normals", "materials", "light_tree_nodes", "lightcuts",
                             "relative_error", "max_cut", "tree_nodes", "tree_bytes", "cut_size_mean",
                             "cut_size_p50", "cut_size_p99", "cut_size_max", "max_cut_samples",
-                            "heap_capacity_shared", "heap_spill_samples"}) {
+                            "cut_heap", "heap_slots", "heap_bytes_per_workgroup", "heap_frozen_samples",
+                            "heap_paused_samples"}) {
         std::string quoted = "\"";
         quoted.append(key).append("\": ");
         EXPECT_THAT(json, HasSubstr(quoted));

@@ -48,8 +48,10 @@ static_assert(gpu::kBindingRadiance == gpu::kBindingGBuffer + 1 &&
               gpu::kBindingPixelStats == gpu::kBindingGBuffer + 2 &&
               gpu::kBindingHeapSave == gpu::kBindingGBuffer + 3 &&
               gpu::kBindingCutState == gpu::kBindingGBuffer + 4 &&
-              gpu::kBindingCount == gpu::kBindingGBuffer + 5,
-              "GpuResources::TileIndex follows the per-tile bindings");
+              gpu::kBindingChunkTable == gpu::kBindingGBuffer + 5 &&
+              gpu::kBindingCount == gpu::kBindingChunkTable + 1,
+              "GpuResources::TileIndex follows the per-tile bindings, then the chunk table");
+static_assert(gpu::kSceneArrayCount == gpu::kBindingFrame, "every scene array before the frame constants can be split");
 
 void check_scene_order(const std::vector<SceneArray>& scene) {
     bool ok = scene.size() == std::size(kSceneBindings);
@@ -72,8 +74,9 @@ std::string mib(VkDeviceSize bytes) {
 
 GpuResources::GpuResources(const Context& ctx, Submitter& submitter,
                            const std::vector<SceneArray>& scene, const ShadingMethod& method,
-                           std::uint64_t image_pixels, std::uint32_t max_tile_pixels)
-    : ctx_(ctx), submitter_(submitter) {
+                           std::uint64_t image_pixels, std::uint32_t max_tile_pixels,
+                           std::uint64_t split_bytes)
+    : ctx_(ctx), submitter_(submitter), split_bytes_(split_bytes) {
     const VkPhysicalDeviceLimits& limits = ctx.properties().limits;
     max_buffer_ = std::min<VkDeviceSize>(limits.maxStorageBufferRange, ctx.max_allocation_size());
     upload_scene(scene);
@@ -111,24 +114,17 @@ Buffer GpuResources::storage_buffer(const std::string& name, VkDeviceSize bytes,
     return buffer;
 }
 
-// Device-local buffer holding the array: written through the mapping where
-// the device memory is host-visible (lavapipe, integrated GPUs), through a
-// staging buffer and a copy otherwise. An empty array gets one zeroed
-// element so that every binding has a buffer.
-Buffer GpuResources::upload(const SceneArray& array) {
-    const std::vector<unsigned char> zero_element(array.count == 0 ? array.element_bytes : 0);
-    const void* source = array.count == 0 ? zero_element.data() : array.data;
-    const VkDeviceSize bytes = array.count == 0 ? array.element_bytes : array.bytes();
-    // The array's own name, so that the report lists each array once.
-    const std::string name = array.name;
-    Buffer buffer = storage_buffer(name, bytes, MemoryUse::kDevice, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+// Fills a device-local buffer with `bytes` bytes from `data`: through the
+// mapping where the device memory is host-visible (lavapipe, integrated
+// GPUs), through a staging buffer and a copy otherwise.
+void GpuResources::upload(const std::string& name, const void* data, VkDeviceSize bytes, Buffer& buffer) {
     if (buffer.mapped()) {
-        std::memcpy(buffer.mapped(), source, bytes);
-        return buffer;
+        std::memcpy(buffer.mapped(), data, bytes);
+        return;
     }
     Buffer staging(ctx_.device(), ctx_.memory(), bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                    MemoryUse::kUpload, name + " staging");
-    std::memcpy(staging.mapped(), source, bytes);
+    std::memcpy(staging.mapped(), data, bytes);
     VkCommandBuffer cmd = submitter_.begin();
     VkBufferCopy region{0, 0, bytes};
     ctx_.fn().vkCmdCopyBuffer(cmd, staging.get(), buffer.get(), 1, &region);
@@ -140,12 +136,76 @@ Buffer GpuResources::upload(const SceneArray& array) {
                                    VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0,
                                    nullptr, 0, nullptr);
     submitter_.submit_and_wait();  // the staging buffer dies at the end of this function
-    return buffer;
+}
+
+// The array in one device-local buffer if it fits one (maxStorageBufferRange,
+// maxMemoryAllocationSize and the forced split size), else in chunks of the
+// largest power of two of elements that does, each its own buffer, read by
+// the kernels through its device address. An empty array gets one zeroed
+// element so that every binding has a buffer.
+std::vector<Buffer> GpuResources::upload_chunks(const SceneArray& array, std::uint32_t binding) {
+    const std::vector<unsigned char> zero_element(array.count == 0 ? array.element_bytes : 0);
+    const auto* source = static_cast<const unsigned char*>(array.count == 0 ? zero_element.data() : array.data);
+    const std::uint64_t count = std::max<std::uint64_t>(array.count, 1);
+    const VkDeviceSize element = array.element_bytes;
+    const VkDeviceSize bytes = count * element;
+    // The array's own name, so that the report lists each array once.
+    const std::string name = array.name;
+
+    VkDeviceSize limit = max_buffer_;
+    if (split_bytes_ > 0) limit = std::min(limit, split_bytes_);
+    std::uint32_t shift = 31;
+    if (binding < gpu::kSceneArrayCount && bytes > limit && element <= limit) {
+        shift = 0;
+        while (shift < 30 && (VkDeviceSize(2) << shift) * element <= limit) ++shift;
+    }
+    const std::uint64_t per_chunk = std::uint64_t(1) << shift;
+    if (binding < gpu::kSceneArrayCount) chunks_.shift[binding] = shift;
+
+    constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                          VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                                          VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+    std::vector<Buffer> chunks;
+    for (std::uint64_t first = 0; first < count; first += per_chunk) {
+        const VkDeviceSize chunk_bytes = std::min(per_chunk, count - first) * element;
+        const std::string chunk_name =
+            per_chunk >= count ? name : name + " chunk " + std::to_string(chunks.size());
+        // Still refuses an array that cannot be split (the frame constants)
+        // or whose single element is larger than a buffer may be.
+        check_fits(chunk_name, chunk_bytes);
+        Buffer buffer(ctx_.device(), ctx_.memory(), chunk_bytes, kUsage, MemoryUse::kDevice, chunk_name);
+        upload(chunk_name, source + first * element, chunk_bytes, buffer);
+        chunks.push_back(std::move(buffer));
+    }
+    if (chunks.size() > 1) chunks_.split = true;
+    buffer_bytes_.emplace_back(name, bytes);
+    return chunks;
 }
 
 void GpuResources::upload_scene(const std::vector<SceneArray>& scene) {
     check_scene_order(scene);
-    for (const SceneArray& array : scene) scene_.push_back(upload(array));
+    for (std::uint32_t b = 0; b < scene.size(); ++b) scene_.push_back(upload_chunks(scene[b], b));
+    create_chunk_table();
+}
+
+// ChunkTable (shaders/bindings.glsl): for each scene array, the index of its
+// chunk 0 in the address list, then the device address of every chunk.
+void GpuResources::create_chunk_table() {
+    std::vector<std::uint32_t> words(gpu::kSceneArrayCount);
+    for (std::uint32_t b = 0; b < gpu::kSceneArrayCount; ++b) {
+        words[b] = std::uint32_t((words.size() - gpu::kSceneArrayCount) / 2);
+        for (const Buffer& chunk : scene_[b]) {
+            auto info = vk_struct<VkBufferDeviceAddressInfo>(VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO);
+            info.buffer = chunk.get();
+            const VkDeviceAddress address = ctx_.fn().vkGetBufferDeviceAddress(ctx_.device().get(), &info);
+            words.push_back(std::uint32_t(address));
+            words.push_back(std::uint32_t(address >> 32));
+        }
+    }
+    static_assert(gpu::kChunkTableHeaderBytes % 8 == 0, "the uvec2 addresses follow the header unpadded");
+    const VkDeviceSize bytes = words.size() * sizeof(std::uint32_t);
+    chunk_table_ = storage_buffer("chunk addresses", bytes, MemoryUse::kDevice, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    upload("chunk addresses", words.data(), bytes, chunk_table_);
 }
 
 std::vector<TileBuffer> GpuResources::tile_buffers(const ShadingMethod& method) const {
@@ -248,7 +308,9 @@ void GpuResources::create_descriptors() {
     VkDescriptorBufferInfo infos[gpu::kBindingCount];
     VkWriteDescriptorSet writes[gpu::kBindingCount];
     for (std::uint32_t b = 0; b < gpu::kBindingCount; ++b) {
-        const Buffer& buffer = b < gpu::kBindingGBuffer ? scene_[b] : tile_[b - gpu::kBindingGBuffer];
+        const Buffer& buffer = b < gpu::kBindingGBuffer    ? scene_[b][0]
+                               : b == gpu::kBindingChunkTable ? chunk_table_
+                                                              : tile_[b - gpu::kBindingGBuffer];
         infos[b] = {buffer.get(), 0, VK_WHOLE_SIZE};
         writes[b] = vk_struct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
         writes[b].dstSet = descriptor_set_;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bindings.glsl"
+#include "kernels.h"
 #include "lightcuts/render.h"
 #include "shading_method.h"
 #include "vk_commands.h"
@@ -30,11 +31,17 @@ public:
     // `method` and an image of `image_pixels` (tiles of at most
     // `max_tile_pixels`, 0: no cap), and binds everything. Throws naming
     // the buffer, its size and the device limit when something cannot fit.
+    // A scene array larger than one buffer may be (or than `split_bytes`, if
+    // not 0) is split into chunks of 2^k elements, each its own buffer.
     GpuResources(const Context& ctx, Submitter& submitter, const std::vector<SceneArray>& scene,
                  const ShadingMethod& method, std::uint64_t image_pixels,
-                 std::uint32_t max_tile_pixels);
+                 std::uint32_t max_tile_pixels, std::uint64_t split_bytes = 0);
 
     const TileLayout& tiles() const { return tiles_; }
+    // How the scene arrays were split, for the kernels' specialization.
+    const SceneChunks& chunks() const { return chunks_; }
+    // Chunks of the scene array at `binding` (1 where it fits one buffer).
+    std::size_t chunk_count(std::uint32_t binding) const { return scene_[binding].size(); }
     VkDescriptorSet descriptor_set() const { return descriptor_set_; }
     VkPipelineLayout pipeline_layout() const { return pipeline_layout_.get(); }
 
@@ -62,8 +69,10 @@ private:
     Buffer storage_buffer(const std::string& name, VkDeviceSize bytes, MemoryUse use,
                           VkBufferUsageFlags extra_usage = 0);
     void check_fits(const std::string& name, VkDeviceSize bytes) const;
-    Buffer upload(const SceneArray& array);
+    void upload(const std::string& name, const void* data, VkDeviceSize bytes, Buffer& buffer);
+    std::vector<Buffer> upload_chunks(const SceneArray& array, std::uint32_t binding);
     void upload_scene(const std::vector<SceneArray>& scene);
+    void create_chunk_table();
     std::vector<TileBuffer> tile_buffers(const ShadingMethod& method) const;
     void fit_tiles(const std::vector<TileBuffer>& buffers, std::uint64_t image_pixels,
                    std::uint32_t max_tile_pixels);
@@ -74,11 +83,16 @@ private:
     const Context& ctx_;
     Submitter& submitter_;
     VkDeviceSize max_buffer_ = 0;  // min(maxStorageBufferRange, maxMemoryAllocationSize)
+    VkDeviceSize split_bytes_ = 0;  // a smaller chunk size forced by Tuning (0: none)
+    SceneChunks chunks_;
     TileLayout tiles_;
     std::vector<std::pair<std::string, std::uint64_t>> buffer_bytes_;
 
     // Destroyed in reverse: layouts and descriptors before the buffers.
-    std::vector<Buffer> scene_;                 // bindings kBindingBvhNodes ..
+    // Bindings kBindingBvhNodes .. kBindingFrame, each one or more chunks
+    // (chunk 0 is what the binding holds).
+    std::vector<std::vector<Buffer>> scene_;
+    Buffer chunk_table_;                        // binding kBindingChunkTable
     Buffer tile_[kTileBufferCount];             // bindings kBindingGBuffer ..
     Buffer radiance_readback_, stats_readback_;
     DescriptorSetLayout set_layout_;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "spirv/primary.h"
 #include "vk_check.h"
@@ -26,6 +27,8 @@ struct SpecData {
     VkBool32 enable_disney;
     VkBool32 enable_sheen;
     VkBool32 enable_clearcoat;
+    VkBool32 split_scene;
+    std::uint32_t chunk_shift[gpu::kSceneArrayCount];
 };
 
 Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const KernelCode& code,
@@ -40,7 +43,7 @@ Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const Ker
     VK_CHECK(vkd.vkCreateShaderModule(device, &module_info, nullptr, &module_handle));
     ShaderModule module = own<ShaderModule>(ctx.device(), module_handle, name + " module");
 
-    const VkSpecializationMapEntry entries[] = {
+    std::vector<VkSpecializationMapEntry> entries = {
         {gpu::kSpecWorkgroupSize, offsetof(SpecData, workgroup_size), sizeof(std::uint32_t)},
         {gpu::kSpecEnableGgx, offsetof(SpecData, enable_ggx), sizeof(VkBool32)},
         {gpu::kSpecEnableShadows, offsetof(SpecData, enable_shadows), sizeof(VkBool32)},
@@ -52,10 +55,15 @@ Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const Ker
         {gpu::kSpecEnableDisney, offsetof(SpecData, enable_disney), sizeof(VkBool32)},
         {gpu::kSpecEnableSheen, offsetof(SpecData, enable_sheen), sizeof(VkBool32)},
         {gpu::kSpecEnableClearcoat, offsetof(SpecData, enable_clearcoat), sizeof(VkBool32)},
+        {gpu::kSpecSplitScene, offsetof(SpecData, split_scene), sizeof(VkBool32)},
     };
+    for (std::uint32_t b = 0; b < gpu::kSceneArrayCount; ++b)
+        entries.push_back({gpu::kSpecChunkShift + b,
+                           std::uint32_t(offsetof(SpecData, chunk_shift) + b * sizeof(std::uint32_t)),
+                           sizeof(std::uint32_t)});
     VkSpecializationInfo spec_info{};
-    spec_info.mapEntryCount = std::uint32_t(std::size(entries));
-    spec_info.pMapEntries = entries;
+    spec_info.mapEntryCount = std::uint32_t(entries.size());
+    spec_info.pMapEntries = entries.data();
     spec_info.dataSize = sizeof spec;
     spec_info.pData = &spec;
 
@@ -88,6 +96,8 @@ Kernels::Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMetho
     spec.enable_disney = switches.disney;
     spec.enable_sheen = switches.sheen;
     spec.enable_clearcoat = switches.clearcoat;
+    spec.split_scene = switches.chunks.split;
+    for (std::uint32_t b = 0; b < gpu::kSceneArrayCount; ++b) spec.chunk_shift[b] = switches.chunks.shift[b];
     primary_ = compute_pipeline(
         ctx, layout, {lc_spirv_primary, sizeof lc_spirv_primary, "primary.comp (camera rays)"}, spec);
     shading_ = compute_pipeline(ctx, layout, method.kernel(), spec);

@@ -5,12 +5,24 @@
 
 #include <cstdint>
 
+#include "bindings.glsl"
+
 #include "shading_method.h"
 #include "vk_context.h"
 
 namespace lc::vk {
 
 // Values of the specialization constants that do not come from the method.
+// How the scene arrays are split into chunks (shaders/kernel.glsl,
+// LC_SCENE_ARRAY): the kernels' specialization constants kSplitScene and
+// kSpecChunkShift + binding.
+struct SceneChunks {
+    bool split = false;  // some array has more than one chunk
+    // log2 of the elements per chunk of the array at each binding; 31 for an
+    // array in one buffer (no index reaches 2^31).
+    std::uint32_t shift[gpu::kSceneArrayCount] = {31, 31, 31, 31, 31, 31, 31, 31, 31, 31};
+};
+
 struct KernelSwitches {
     bool ggx = true;                 // compile the GGX lobe in
     bool shadows = true;             // compile shadow rays in
@@ -20,6 +32,7 @@ struct KernelSwitches {
     bool sheen = true;               // ... and its sheen lobe
     bool clearcoat = true;           // ... and its clearcoat lobe
     std::uint32_t save_stride = 1;   // invocations the heap-save buffer is laid out for
+    SceneChunks chunks;              // how the scene arrays are split (GpuResources)
 };
 
 class Kernels {

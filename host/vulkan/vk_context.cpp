@@ -118,6 +118,16 @@ Instance create_instance(bool validation, MessageLog* log, bool& debug_utils) {
     return Instance(instance, {});
 }
 
+// Vulkan 1.2's bufferDeviceAddress: the kernels read the chunks of a scene
+// array split over several buffers through their addresses.
+bool has_buffer_device_address(VkPhysicalDevice handle) {
+    auto v12 = vk_struct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
+    auto features = vk_struct<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
+    features.pNext = &v12;
+    vkGetPhysicalDeviceFeatures2(handle, &features);
+    return v12.bufferDeviceAddress == VK_TRUE;
+}
+
 std::vector<PhysicalDeviceInfo> physical_devices(VkInstance instance) {
     std::uint32_t count = 0;
     VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
@@ -149,6 +159,9 @@ std::vector<PhysicalDeviceInfo> physical_devices(VkInstance instance) {
                         ", needs 1.2";
         else if (d.compute_family == UINT32_MAX)
             d.refusal = "has no compute queue";
+        else if (!has_buffer_device_address(handle))
+            d.refusal = "has no bufferDeviceAddress (a Vulkan 1.2 feature, needed for scene arrays "
+                        "larger than one buffer)";
         devices.push_back(std::move(d));
     }
     return devices;
@@ -278,7 +291,8 @@ Context::Context(const VulkanOptions& options, MessageLog* log) {
     vkGetPhysicalDeviceQueueFamilyProperties(physical_.handle, &family_count, families.data());
     timestamp_valid_bits_ = families[physical_.compute_family].timestampValidBits;
 
-    // One compute queue; the kernels need no optional feature or extension.
+    // One compute queue and one feature, Vulkan 1.2's bufferDeviceAddress
+    // (scene arrays split over several buffers); no extension.
     const float priority = 1.0f;
     auto queue_info = vk_struct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
     queue_info.queueFamilyIndex = physical_.compute_family;
@@ -287,6 +301,9 @@ Context::Context(const VulkanOptions& options, MessageLog* log) {
     auto device_info = vk_struct<VkDeviceCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO);
     device_info.queueCreateInfoCount = 1;
     device_info.pQueueCreateInfos = &queue_info;
+    auto v12 = vk_struct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
+    v12.bufferDeviceAddress = VK_TRUE;
+    device_info.pNext = &v12;
     VkDevice device = VK_NULL_HANDLE;
     VK_CHECK(vkCreateDevice(physical_.handle, &device_info, nullptr, &device));
     device_ = Device(device, debug_utils);

@@ -94,6 +94,10 @@ Buffer::Buffer(const Device& device, const VkPhysicalDeviceMemoryProperties& mem
     auto alloc_info = vk_struct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
     alloc_info.allocationSize = requirements.size;
     alloc_info.memoryTypeIndex = type;
+    // A buffer read through its device address needs memory allocated for it.
+    auto flags_info = vk_struct<VkMemoryAllocateFlagsInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO);
+    flags_info.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+    if ((usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0) alloc_info.pNext = &flags_info;
     VkDeviceMemory allocation = VK_NULL_HANDLE;
     VK_CHECK(vkd.vkAllocateMemory(device.get(), &alloc_info, nullptr, &allocation));
     memory_ = own<DeviceMemory>(device, allocation, name + " memory");

@@ -117,12 +117,13 @@ RenderSetup::RenderSetup(const Context& context, const PreparedScene& prepared,
       method(make_shading_method(options, frame, prepared.tree, tuning,
                                  context.properties().limits.maxComputeSharedMemorySize)),
       resources(context, submitter, kernel_arrays(prepared, frame), *method,
-                std::uint64_t(frame.width) * frame.height, tuning.max_tile_pixels),
+                std::uint64_t(frame.width) * frame.height, tuning.max_tile_pixels, tuning.split_bytes),
       kernels(context, resources.pipeline_layout(), *method,
               {tuning.force_ggx || prepared.has_specular, tuning.force_shadows || prepared.has_occluders,
                tuning.force_oriented || prepared.has_oriented, tuning.force_textures || prepared.has_textures,
                tuning.force_disney || prepared.has_disney, tuning.force_sheen || prepared.has_sheen,
-               tuning.force_clearcoat || prepared.has_clearcoat, resources.tiles().invocations}),
+               tuning.force_clearcoat || prepared.has_clearcoat, resources.tiles().invocations,
+               resources.chunks()}),
       pass(context, resources, kernels, *method, timestamps) {}
 
 RenderSetup::~RenderSetup() { ctx.fn().vkDeviceWaitIdle(ctx.device().get()); }
@@ -146,6 +147,8 @@ Tuning Tuning::from_environment() {
         tuning.lights_per_dispatch = std::uint32_t(std::strtoul(v, nullptr, 10));
     if (const char* v = std::getenv("LC_VK_REFINEMENTS_PER_DISPATCH"))
         tuning.refinements_per_dispatch = std::uint32_t(std::strtoul(v, nullptr, 10));
+    if (const char* v = std::getenv("LC_VK_SPLIT_BYTES"))
+        tuning.split_bytes = std::strtoull(v, nullptr, 10);
     if (const char* v = std::getenv("LC_VK_TARGET_MS")) {
         const double ms = std::strtod(v, nullptr);
         if (ms > 0.0) tuning.target_dispatch_ms = ms;

@@ -46,8 +46,13 @@ struct Tuning {
     // shipped scenes (shading_method.cpp starts its retries with it).
     static constexpr std::uint32_t kLlvmpipeRefinements = 128;
 
+    // Split every scene array into chunks of at most this many bytes, as is
+    // otherwise done only for arrays larger than one buffer may be (0: no
+    // forced split), so that small scenes test the split.
+    std::uint64_t split_bytes = 0;
+
     // LC_VK_FORCE_FEATURES=ggx,shadows,oriented,textures,disney,sheen,clearcoat (or all), LC_VK_MAX_TILE_PIXELS=N, LC_VK_TARGET_MS=X,
-    // LC_VK_LIGHTS_PER_DISPATCH=N, LC_VK_REFINEMENTS_PER_DISPATCH=N.
+    // LC_VK_LIGHTS_PER_DISPATCH=N, LC_VK_REFINEMENTS_PER_DISPATCH=N, LC_VK_SPLIT_BYTES=N.
     static Tuning from_environment();
 };
 

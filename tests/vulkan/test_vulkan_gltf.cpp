@@ -46,5 +46,18 @@ TEST_F(Vulkan, TexturedGltfSceneMatchesTheCpu) {
     expect_brute_matches(p, o, gpu(p, o), kTexturedRelative);
 }
 
+// The same with every scene array split into chunks of at most 4 KiB, so
+// the texels of the textures lie in several buffers (docs/vulkan.md).
+TEST_F(Vulkan, TexturedGltfSceneSplitIntoChunksMatchesTheCpu) {
+    Scene s = load_scene(LC_SOURCE_DIR "/scenes/gltf/textured.gltf");
+    s.render.area_light_samples = 1024;
+    const PreparedScene p = prepare_scene(std::move(s), 1);
+    ASSERT_GT(p.scene.texels.size() * sizeof(std::uint32_t), 4u * 4096u);
+    vk::Tuning split;
+    split.split_bytes = 4096;
+    const RenderOptions o = options("brute", 32, 24);
+    expect_brute_matches(p, o, gpu(p, o, split), kTexturedRelative);
+}
+
 }  // namespace
 }  // namespace lc

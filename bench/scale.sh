@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Scale: a room of COUNT point lights (default 10^7) rendered on the CPU path
+# and through Vulkan on lavapipe, at SIZE x SIZE (default 128) with the
+# scene's settings otherwise (lightcuts, 1 spp, 2% error, max cut 1000).
+# Prints, per device: loading the light file, building the light tree, the
+# render, the peak resident memory of the process, and the buffer sizes that
+# grow with the light count; then the difference between the two images.
+# docs/results/scale.md has the figures and how to read them.
+#
+# The light file (586 MB at 10^7) is made once with scripts/gen_lights.py
+# into OUT (default out/scale) and reused.
+#
+#   bench/scale.sh [COUNT] [SIZE] [OUT]
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+count="${1:-10000000}"
+size="${2:-128}"
+out="${3:-$root/out/scale}"
+exe="$root/build/host/lightcuts"
+lvp="${LC_LAVAPIPE_ICD:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}"
+mkdir -p "$out"
+
+lights="$out/lights_$count.csv"
+scene="$out/room_$count.json"
+if [ ! -f "$lights" ]; then
+  python3 "$root/scripts/gen_lights.py" --shape room --count "$count" --seed 1 --out "$lights"
+fi
+# The shipped room with this light file (paths relative to the scene file).
+python3 - "$root/scenes/room/room_1e4.json" "$scene" "$(basename "$lights")" "$root/scenes/room" <<'PY'
+import json, os, sys
+src, dst, csv, room = sys.argv[1:]
+s = json.load(open(src))
+for m in s["meshes"]:
+    m["obj"] = os.path.relpath(os.path.join(room, os.path.basename(m["obj"])), os.path.dirname(dst))
+s["lights"] = [{"type": "points_csv", "file": csv}]
+json.dump(s, open(dst, "w"), indent=1)
+PY
+
+"$exe" info "$scene" | sed -n '/buffers:/,$p'
+for device in cpu vulkan; do
+  env=()
+  [ "$device" = vulkan ] && env=(VK_DRIVER_FILES="$lvp")
+  env "${env[@]}" /usr/bin/time -f "peak resident memory %M KiB, wall %e s, user %U s, sys %S s" \
+    "$exe" render "$scene" -o "$out/$device.exr" --device "$device" --width "$size" --height "$size" \
+    --stats "$out/$device.json" 2>&1 | grep -v '^\s*$'
+  python3 - "$out/$device.json" "$count" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1])); n = int(sys.argv[2]); sec = s["seconds"]
+print(f"  load {sec['load']:.2f} s, light tree {sec['light_tree_build']:.2f} s, render {sec['render']:.2f} s")
+b = s.get("buffer_bytes", {})
+per_light = b.get("lights", 0) + b.get("light_tree_nodes", 0)
+print(f"  lights {b.get('lights', 0) / 2**20:.1f} MiB + light-tree nodes {b.get('light_tree_nodes', 0) / 2**20:.1f} MiB"
+      f" = {per_light / n:.1f} bytes per light; all buffers {sum(b.values()) / 2**20:.1f} MiB")
+PY
+done
+"$exe" compare "$out/vulkan.exr" "$out/cpu.exr"
