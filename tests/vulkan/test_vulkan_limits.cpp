@@ -194,9 +194,11 @@ TEST_F(Vulkan, SceneArraysSplitIntoChunksMatchTheCpu) {
     }
 }
 
-// Cuts refined down to every one of 4000 lights: each refinement loops over
-// heap levels and a shadow ray's BVH nodes, about twice the limit in all
-// (1600 lights already pass it). On llvmpipe the renderer splits Lightcuts
+// Cuts refined at error 0 over 20000 lights: each refinement loops over
+// heap levels, the search for the smallest entry of a full heap (64 slots)
+// and a shadow ray's BVH nodes, through a grid of boxes; together past the
+// limit (with 4000 lights and no grid, the full heap ends the cuts at about
+// 400 refinements, under it). On llvmpipe the renderer splits Lightcuts
 // from the start (Tuning::presplit_on_llvmpipe); without that, the failed
 // pass must split it.
 TEST_F(Vulkan, LoopLimitSplitsLightcutsAutomatically) {
@@ -206,7 +208,14 @@ TEST_F(Vulkan, LoopLimitSplitsLightcutsAutomatically) {
     test::add_box(s, {-1.0f, 0.0f, -1.0f}, {-0.3f, 0.6f, -0.3f}, 0);
     test::add_box(s, {0.4f, 0.0f, 0.2f}, {0.9f, 0.4f, 0.8f}, 0);
     test::add_box(s, {-0.5f, 0.8f, 0.5f}, {0.0f, 1.0f, 1.0f}, 0);
-    s.lights = test::random_point_lights(4000, {-2, 0.5f, -2}, {2, 2, 2}, 10.0f, 65);
+    // A grid of small boxes over the floor, which every shadow ray crosses:
+    // longer BVH walks.
+    for (int i = 0; i < 12; ++i)
+        for (int j = 0; j < 12; ++j) {
+            const glm::vec3 lo(-1.8f + 0.3f * float(i), 0.3f, -1.8f + 0.3f * float(j));
+            test::add_box(s, lo, lo + glm::vec3(0.12f, 0.12f, 0.12f), 0);
+        }
+    s.lights = test::random_point_lights(20000, {-2, 0.5f, -2}, {2, 2, 2}, 10.0f, 65);
     s.camera = test::camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 50.0f, 4, 4);
     update_bounds(s);
     const PreparedScene p = prepare_scene(std::move(s), 1);
