@@ -98,7 +98,8 @@ struct TransformCase {
 // ScaledTo1em4 brute 1.8e-7, none; lightcuts 2.1e-5, none.
 const TransformCase kTransforms[] = {
     {"TranslatedBy1e5", 50.0f, 1.0f, {1e5f, 1e5f, -1e5f}, 0.02, 0.1, {0.019, 0.013}, {{5.5e-4, 0.005}, {4e-4, 0.002}}},  // 0.0127, 0.0087
-    {"SmallRoomTranslatedBy1e5", 1.0f, 1.0f, {1e5f, 1e5f, -1e5f}, -1.0, 0.0, {0.018, 0.016}, {{0.02, 0.25}, {0.02, 0.25}}},  // 0.0115, 0.0104
+    // 0.0115, 0.0104 with a heap the tree cannot fill; 0.0115, 0.0208 with the default heap of 64 slots
+    {"SmallRoomTranslatedBy1e5", 1.0f, 1.0f, {1e5f, 1e5f, -1e5f}, -1.0, 0.0, {0.018, 0.03}, {{0.02, 0.25}, {0.02, 0.25}}},
     {"ScaledTo1em4", 1.0f, 1e-4f, {0.0f, 0.0f, 0.0f}, 1e-4, 0.01, {0.019, 0.013}, {{5e-7, 0.002}, {6e-5, 0.002}}},  // 0.0126, 0.0087
 };
 

@@ -1,0 +1,164 @@
+#!/usr/bin/env python3
+"""Speed and the bounded heap, in one run (docs/results/speed.md).
+
+  bench/speed.py [--out DIR] [--size N] [--heaps 8,16,32,64] [--quick]
+
+1. Lightcuts against brute force on the shipped room with 10^4 and 10^5
+   lights (scenes/room/room_1e4.json, room_1e5.json) at SIZE x SIZE on the
+   CPU path, both at full resolution in this run: render times, shadow rays,
+   the cost of a shadow ray (render time over shadow rays; the CPU path does
+   not time its camera rays apart, which are one per pixel against hundreds
+   of shadow rays) and the speedup.
+2. The K table: every shipped scene rendered with lightcuts on the CPU with a
+   cut heap of K slots for each K of --heaps and with a heap as large as the
+   tree needs (nothing frozen), against brute force: relative RMSE, pixels
+   above 2%, mean cut, shadow rays per pixel, the share of samples that froze
+   clusters, and the time.
+3. The Vulkan path (lavapipe) on the room with 10^4 lights at the same size
+   for each K that fits its shared memory, with the CPU path in the same run:
+   the Vulkan/CPU time ratio, and the samples whose heap waited in global
+   memory between dispatches.
+
+Writes DIR/speed.md and DIR/speed.json (default out/speed). Nothing here
+passes or fails. --quick: 32x32, two scenes (CI's bench label runs it).
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+EXE = os.path.join(ROOT, "build", "host", "lightcuts")
+LAVAPIPE = os.environ.get("LC_LAVAPIPE_ICD", "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json")
+SCENES = ["scenes/room/room_1e4.json", "scenes/room/room_1e5.json", "scenes/panels/panels.json",
+          "scenes/gallery/gallery.json", "scenes/sky/sky.json", "scenes/materials/materials.json",
+          "scenes/bunny/bunny.json"]
+UNBOUNDED = 1000000  # more slots than any tree here can fill
+
+
+def render(out, scene, name, size, method, device="cpu", cut_heap=None):
+    exr = os.path.join(out, name + ".exr")
+    stats = os.path.join(out, name + ".json")
+    cmd = [EXE, "render", os.path.join(ROOT, scene), "-o", exr, "--method", method, "--device", device,
+           "--width", str(size), "--height", str(size), "--stats", stats, "--no-png"]
+    if cut_heap is not None:
+        cmd += ["--cut-heap", str(cut_heap)]
+    env = dict(os.environ)
+    if device == "vulkan":
+        env["VK_DRIVER_FILES"] = LAVAPIPE
+    subprocess.run(cmd, check=True, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return exr, json.load(open(stats))
+
+
+def compare(image, reference):
+    text = subprocess.run([EXE, "compare", image, reference], check=True, capture_output=True, text=True).stdout
+    values = {}
+    for line in text.splitlines():
+        if line.startswith("relative RMSE"):
+            values["rmse"] = float(line.split()[-1])
+        elif line.startswith("pixels above 2%"):
+            values["above_2pct"] = float(line.split()[-1].rstrip("%")) / 100.0
+    return values
+
+
+def missing(scene):
+    needs = {"room_1e4": "scenes/room/lights_1e4.csv", "room_1e5": "scenes/room/lights_1e5.csv",
+             "gallery": "scenes/gallery/spots_1e4.csv", "bunny": "scenes/bunny/bunny.obj",
+             "sky": "scenes/bunny/bunny.obj"}
+    for key, path in needs.items():
+        if key in scene and not os.path.exists(os.path.join(ROOT, path)):
+            return path
+    return None
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "speed"))
+    ap.add_argument("--size", type=int, default=128)
+    ap.add_argument("--heaps", default="8,16,32,64")
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--no-vulkan", action="store_true")
+    ap.add_argument("--exe", default=EXE, help="the lightcuts binary (default build/host/lightcuts)")
+    a = ap.parse_args()
+    global EXE
+    EXE = a.exe
+    size = 32 if a.quick else a.size
+    scenes = SCENES[:1] + SCENES[3:4] if a.quick else SCENES
+    heaps = [int(k) for k in a.heaps.split(",")]
+    os.makedirs(a.out, exist_ok=True)
+    results = {"size": size, "speed": [], "heaps": [], "vulkan": []}
+    lines = [f"# Speed and the bounded heap ({size}x{size}, CPU path unless said)", "",
+             "Command: `bench/speed.py " + " ".join(sys.argv[1:]) + "`", ""]
+
+    # 1 and 2: brute force once per scene, lightcuts per heap size.
+    lines += ["## Lightcuts against brute force (defaults: error 0.02, max cut 1000, cut_heap 64)", "",
+              "| scene | brute s | brute rays/px | lightcuts s | rays/px | us per brute ray | us per lightcuts ray "
+              "| ratio | speedup |", "|---|---|---|---|---|---|---|---|---|"]
+    table = ["## The cut heap: K slots against a heap as large as the tree needs", "",
+             "| scene | K | relative RMSE | above 2% | mean cut | rays/px | samples that froze | time s |",
+             "|---|---|---|---|---|---|---|---|"]
+    for scene in scenes:
+        why = missing(scene)
+        if why:
+            print(f"skipping {scene}: {why} is missing", file=sys.stderr)
+            continue
+        name = os.path.splitext(os.path.basename(scene))[0]
+        print(f"{scene}: brute force", file=sys.stderr)
+        ref, bstats = render(a.out, scene, name + "_brute", size, "brute")
+        pixels = size * size
+        for k in heaps + [UNBOUNDED]:
+            print(f"{scene}: lightcuts, cut_heap {k}", file=sys.stderr)
+            img, s = render(a.out, scene, f"{name}_k{k}", size, "lightcuts", cut_heap=k)
+            c = compare(img, ref)
+            lc = s["lightcuts"]
+            row = {"scene": scene, "cut_heap": k, "seconds": s["seconds"]["render"],
+                   "rays_per_pixel": s["shadow_rays"] / pixels, "cut_mean": lc["cut_size_mean"],
+                   "frozen": lc["heap_frozen_samples"] / pixels, **c}
+            results["heaps"].append(row)
+            label = "as needed" if k == UNBOUNDED else str(k)
+            table.append(f"| {name} | {label} | {c['rmse']:.4f} | {100 * c['above_2pct']:.1f}% | "
+                         f"{row['cut_mean']:.1f} | {row['rays_per_pixel']:.1f} | {100 * row['frozen']:.1f}% | "
+                         f"{row['seconds']:.3f} |")
+            if k == 64 and name.startswith("room_1e"):
+                tb, tl = bstats["seconds"]["render"], s["seconds"]["render"]
+                rb, rl = bstats["shadow_rays"], s["shadow_rays"]
+                cb, cl = 1e6 * tb / rb, 1e6 * tl / rl
+                results["speed"].append({"scene": scene, "brute_seconds": tb, "brute_rays": rb,
+                                         "lightcuts_seconds": tl, "lightcuts_rays": rl,
+                                         "us_per_brute_ray": cb, "us_per_lightcuts_ray": cl,
+                                         "ratio": cl / cb, "speedup": tb / tl})
+                lines.append(f"| {name} | {tb:.2f} | {rb / pixels:.0f} | {tl:.3f} | {rl / pixels:.1f} | {cb:.4f} | "
+                             f"{cl:.4f} | {cl / cb:.2f} | {tb / tl:.1f}x |")
+    lines += [""] + table + [""]
+
+    # 3: Vulkan against the CPU, room 10^4, for the heap sizes that fit.
+    if not a.no_vulkan:
+        scene = SCENES[0]
+        if not missing(scene):
+            lines += ["## Vulkan (lavapipe) against the CPU path, room 10^4 lights", "",
+                      "| K | CPU s | Vulkan s | Vulkan/CPU | heaps paused in global memory | relative RMSE vulkan vs cpu |",
+                      "|---|---|---|---|---|---|"]
+            for k in heaps:
+                cimg, cs = render(a.out, scene, f"vk_cpu_k{k}", size, "lightcuts", cut_heap=k)
+                try:
+                    vimg, vs = render(a.out, scene, f"vk_k{k}", size, "lightcuts", device="vulkan", cut_heap=k)
+                except subprocess.CalledProcessError:
+                    lines.append(f"| {k} | {cs['seconds']['render']:.3f} | does not fit | | | |")
+                    continue
+                c = compare(vimg, cimg)
+                tc, tv = cs["seconds"]["render"], vs["seconds"]["render"]
+                paused = vs["lightcuts"]["heap_paused_samples"] / (size * size)
+                results["vulkan"].append({"cut_heap": k, "cpu_seconds": tc, "vulkan_seconds": tv,
+                                          "ratio": tv / tc, "paused": paused, "rmse": c["rmse"]})
+                lines.append(f"| {k} | {tc:.3f} | {tv:.3f} | {tv / tc:.1f} | {100 * paused:.1f}% | "
+                             f"{c['rmse']:.2e} |")
+            lines.append("")
+
+    open(os.path.join(a.out, "speed.md"), "w").write("\n".join(lines) + "\n")
+    json.dump(results, open(os.path.join(a.out, "speed.json"), "w"), indent=1)
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
