@@ -55,7 +55,7 @@ BENCHMARK(BM_BvhBuild)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)
 struct Fixture {
     lc::PreparedScene prepared;
     lc::gpu::FrameParams frame;
-    std::vector<lc::gpu::CutEntry> heap;
+    std::vector<lc::cpu::HeapEntry> heap;
     ShadeKernel k;
     std::vector<ShadeKernel::SurfacePoint> points;
 

@@ -50,6 +50,15 @@ struct TextureKernel {
 #undef LC_TEXEL
 };
 
+// The CPU's cut-heap entry: the GPU's CutEntry (node and visibility bit,
+// error bound) and the representative's unit contribution, which the GPU
+// evaluates again instead of storing (shared/lightcuts.h, lc_entry_unit).
+struct HeapEntry {
+    uint node;
+    float error;
+    vec3 unit;
+};
+
 // A shadow ray as the kernels cast it (origin, unit direction, length).
 struct ShadowRayRecord {
     vec3 org;
@@ -75,7 +84,7 @@ struct BasicShadeKernel {
     const LightNode* light_nodes = nullptr;
     const float* environment = nullptr;  // RGB texels of the environment map
     float vpl_min_distance2 = 0.0f;      // FrameParams.vpl_min_distance2
-    CutEntry* heap = nullptr;
+    HeapEntry* heap = nullptr;
     uint heap_slots = 1u;
     std::vector<ShadowRayRecord>* ray_log = nullptr;  // kRecordRays only
 
@@ -108,6 +117,7 @@ struct BasicShadeKernel {
 #define LC_HEAP_LOAD(i) heap[i]
 #define LC_HEAP_STORE(i, e) heap[i] = (e)
 #define LC_HEAP_CAPACITY heap_slots
+#define LC_HEAP_KEEPS_UNITS
 // Both children of a node pushed on the heap, 128 bytes: the profile
 // showed the node reads in lc_add_cluster stalling on cache misses.
 #define LC_PREFETCH_LIGHT_NODES(i) \
@@ -135,6 +145,7 @@ struct BasicShadeKernel {
 #undef LC_HEAP_LOAD
 #undef LC_HEAP_STORE
 #undef LC_HEAP_CAPACITY
+#undef LC_HEAP_KEEPS_UNITS
 #undef LC_PREFETCH_LIGHT_NODES
 #undef LC_ON_SHADOW_RAY
 #undef LC_SEED_LOBE_BOUND
@@ -145,7 +156,7 @@ using ShadeKernel = BasicShadeKernel<false>;
 // A kernel reading the prepared scene's arrays, with `heap` (`heap_slots`
 // entries) as its cut heap.
 template <bool kRecordRays = false>
-BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, CutEntry* heap = nullptr, uint heap_slots = 0u) {
+BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, HeapEntry* heap = nullptr, uint heap_slots = 0u) {
     BasicShadeKernel<kRecordRays> k;
     k.bvh_nodes = p.bvh.nodes.data();
     k.triangles = p.scene.triangles.data();

@@ -20,7 +20,7 @@ namespace {
 
 // What each worker thread owns: its cut heap and its counters.
 struct Worker {
-    std::vector<gpu::CutEntry> heap;
+    std::vector<cpu::HeapEntry> heap;
     std::uint64_t shadow_rays = 0;
     std::uint64_t max_cut_hits = 0;
     std::uint64_t cut_indirect = 0;

@@ -30,6 +30,7 @@ void lc_heap_restore(uint heap_size) {
     for (uint slot = 0u; slot < heap_size; ++slot) s_heap[lc_shared_slot(slot)] = heap_save[lc_saved_slot(slot)];
 }
 
+#define HeapEntry CutEntry
 #define LC_HEAP_LOAD(i) s_heap[lc_shared_slot(i)]
 #define LC_HEAP_STORE(i, e) s_heap[lc_shared_slot(i)] = (e)
 #define LC_HEAP_CAPACITY kHeapSlots

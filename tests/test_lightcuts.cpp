@@ -118,7 +118,7 @@ TEST(LightcutsBounds, GgxBoundIsTighterThanThePeak) {
 // visibility bit clear (a frozen entry's estimate is then zero).
 void push_entry(Kernel& k, std::uint32_t& size, std::uint32_t node, float error, Kernel::ShadeStats& ss) {
     glm::vec3 fixed_sum(0.0f), heap_sum(0.0f);
-    k.lc_heap_push(Kernel::SurfacePoint{}, 0.0f, size, gpu::CutEntry{node, error}, glm::vec3(0.0f), fixed_sum,
+    k.lc_heap_push(Kernel::SurfacePoint{}, 0.0f, size, cpu::HeapEntry{node, error, glm::vec3(0.0f)}, glm::vec3(0.0f), fixed_sum,
                    heap_sum, ss);
 }
 
@@ -163,7 +163,7 @@ TEST(LightcutsBounds, HalfVectorBoundHoldsForEveryDirectionInTheCone) {
 }
 
 TEST(LightcutsHeap, PopsInDecreasingOrder) {
-    std::vector<gpu::CutEntry> storage(1000);
+    std::vector<cpu::HeapEntry> storage(1000);
     Kernel k;
     k.heap = storage.data();
     k.heap_slots = 1000;
@@ -200,7 +200,7 @@ TEST(LightcutsHeap, PopsInDecreasingOrder) {
 // up in the stats.
 TEST(LightcutsHeap, BoundedHeapKeepsTheLargestAndFreezesTheRest) {
     for (std::uint32_t capacity : {1u, 2u, 7u, 16u}) {
-        std::vector<gpu::CutEntry> storage(capacity);
+        std::vector<cpu::HeapEntry> storage(capacity);
         std::vector<gpu::LightNode> nodes(600, gpu::LightNode{});
         Kernel k;
         k.heap = storage.data();
@@ -273,7 +273,7 @@ TEST(Lightcuts, MaxCutOneUsesTheRootRepresentative) {
     o.max_cut = 1;
     RenderResult r = render_cpu(p, o);
     gpu::FrameParams f = make_frame_params(p, o);
-    std::vector<gpu::CutEntry> heap(2);
+    std::vector<cpu::HeapEntry> heap(2);
     Kernel k = cpu::make_shade_kernel(p, heap.data(), 2);
     const gpu::LightNode& root = p.tree.nodes[p.tree.roots[gpu::kLightPoint]];
     glm::vec3 root_intensity(root.intensity_r, root.intensity_g, root.intensity_b);

@@ -3,8 +3,11 @@
 //
 // The includer defines:
 //   LC_LIGHT_NODE(i)        -> LightNode
-//   LC_HEAP_LOAD(i)         -> CutEntry        (heap slot i of this point)
-//   LC_HEAP_STORE(i, e)     stores CutEntry e in slot i
+//   HeapEntry               the heap's entry: CutEntry, or (with
+//                           LC_HEAP_KEEPS_UNITS) a record with the same
+//                           node and error and the unit contribution `unit`
+//   LC_HEAP_LOAD(i)         -> HeapEntry       (heap slot i of this point)
+//   LC_HEAP_STORE(i, e)     stores HeapEntry e in slot i
 //   LC_HEAP_CAPACITY        K, the heap's capacity (see lc_heap_push)
 //   LC_PREFETCH_LIGHT_NODES(i) (optional) starts loading nodes i and i + 1
 // On the GPU the K slots live in workgroup shared memory; on the CPU they
@@ -37,20 +40,35 @@ vec3 lc_rep_unit_known(LC_IN(SurfacePoint) sp, uint light_index, float min_dista
     return lc_light_unit(sp, LC_LIGHT(light_index), min_distance2, wi, t_max);
 }
 
-uint lc_entry_node(CutEntry e) { return e.node & kCutEntryNodeMask; }
-bool lc_entry_visible(CutEntry e) { return (e.node & kCutEntryVisible) != 0u; }
+uint lc_entry_node(HeapEntry e) { return e.node & kCutEntryNodeMask; }
+bool lc_entry_visible(HeapEntry e) { return (e.node & kCutEntryVisible) != 0u; }
+
+// An entry's representative's unit contribution. The GPU evaluates it again
+// from the visibility bit (its heap must stay small); the CPU, which has
+// the memory, keeps it beside the entry (LC_HEAP_KEEPS_UNITS). Both are the
+// same function of the same inputs.
+vec3 lc_entry_unit(LC_IN(SurfacePoint) sp, HeapEntry e, LC_IN(LightNode) node, float min_distance2) {
+#ifdef LC_HEAP_KEEPS_UNITS
+    (void)sp;
+    (void)node;
+    (void)min_distance2;
+    return e.unit;
+#else
+    return lc_rep_unit_known(sp, node.rep_light, min_distance2, lc_entry_visible(e));
+#endif
+}
 
 // An entry's estimate: its representative's contribution times the
 // cluster's intensity.
-vec3 lc_entry_estimate(LC_IN(SurfacePoint) sp, CutEntry e, float min_distance2) {
+vec3 lc_entry_estimate(LC_IN(SurfacePoint) sp, HeapEntry e, float min_distance2) {
     LightNode node = LC_LIGHT_NODE(lc_entry_node(e));
-    return lc_rep_unit_known(sp, node.rep_light, min_distance2, lc_entry_visible(e)) * lc_node_intensity(node);
+    return lc_entry_unit(sp, e, node, min_distance2) * lc_node_intensity(node);
 }
 
-void lc_heap_sift_up(uint i, CutEntry e) {
+void lc_heap_sift_up(uint i, HeapEntry e) {
     while (i > 0u) {
         uint parent = (i - 1u) / 2u;
-        CutEntry p = LC_HEAP_LOAD(parent);
+        HeapEntry p = LC_HEAP_LOAD(parent);
         if (p.error >= e.error) break;
         LC_HEAP_STORE(i, p);
         i = parent;
@@ -62,14 +80,14 @@ void lc_heap_sift_up(uint i, CutEntry e) {
 void lc_heap_pop(LC_INOUT(uint) size) {
     size -= 1u;
     if (size == 0u) return;
-    CutEntry last = LC_HEAP_LOAD(size);
+    HeapEntry last = LC_HEAP_LOAD(size);
     uint i = 0u;
     while (true) {
         uint child = 2u * i + 1u;
         if (child >= size) break;
-        CutEntry c = LC_HEAP_LOAD(child);
+        HeapEntry c = LC_HEAP_LOAD(child);
         if (child + 1u < size) {
-            CutEntry r = LC_HEAP_LOAD(child + 1u);
+            HeapEntry r = LC_HEAP_LOAD(child + 1u);
             if (r.error > c.error) {
                 child += 1u;
                 c = r;
@@ -88,7 +106,7 @@ void lc_heap_pop(LC_INOUT(uint) size) {
 // moves from heap_sum into the frozen part of the sum, `fixed_sum`, and is
 // never refined. The smallest entry of a max-heap is one of its leaves,
 // slots size/2 and up; the new entry takes its slot and rises.
-void lc_heap_push(LC_IN(SurfacePoint) sp, float min_distance2, LC_INOUT(uint) size, CutEntry e, vec3 estimate,
+void lc_heap_push(LC_IN(SurfacePoint) sp, float min_distance2, LC_INOUT(uint) size, HeapEntry e, vec3 estimate,
                   LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
     if (size < uint(LC_HEAP_CAPACITY)) {
         size += 1u;
@@ -142,9 +160,12 @@ void lc_add_cluster(LC_IN(SurfacePoint) sp, LC_IN(Material) m, uint node_index, 
         fixed_sum += unit * intensity;
         return;
     }
-    CutEntry e;
+    HeapEntry e;
     e.node = node_index | (visible ? kCutEntryVisible : 0u);
     e.error = error;
+#ifdef LC_HEAP_KEEPS_UNITS
+    e.unit = unit;
+#endif
 #ifdef LC_PREFETCH_LIGHT_NODES
     // The children are read when this entry is refined, if ever: start
     // loading them now (the CPU; the GLSL kernels have no prefetch).
@@ -186,7 +207,7 @@ void lc_cut_start(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_
 bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) heap_size,
                    LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
     if (heap_size == 0u) return false;
-    CutEntry top = LC_HEAP_LOAD(0u);
+    HeapEntry top = LC_HEAP_LOAD(0u);
     float estimate = lc_luminance(fixed_sum + heap_sum);
     if (!(top.error > f.relative_error * estimate)) return false;
     if (stats.cut_size >= f.max_cut) {
@@ -196,7 +217,7 @@ bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) he
     lc_heap_pop(heap_size);
     LightNode node = LC_LIGHT_NODE(lc_entry_node(top));
     bool visible = lc_entry_visible(top);
-    vec3 unit = lc_rep_unit_known(sp, node.rep_light, f.min_distance2, visible);
+    vec3 unit = lc_entry_unit(sp, top, node, f.min_distance2);
     heap_sum -= unit * lc_node_intensity(node);
     bool right_shares = (node.flags & kNodeRepFromRight) != 0u;
     lc_add_cluster(sp, m, node.left, !right_shares, unit, visible, f.min_distance2, heap_size, fixed_sum,

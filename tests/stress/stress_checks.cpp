@@ -204,7 +204,7 @@ void expect_finite_image(const Image& image, const std::string& what) {
 void expect_cut_guarantee(const PreparedScene& p, const RenderOptions& o,
                           const std::vector<ShadingPoint>& points, const std::string& what) {
     const gpu::FrameParams f = make_frame_params(p, o);
-    std::vector<gpu::CutEntry> heap(p.tree.cut_heap_slots(o.max_cut, o.cut_heap));
+    std::vector<cpu::HeapEntry> heap(p.tree.cut_heap_slots(o.max_cut, o.cut_heap));
     Kernel k = cpu::make_shade_kernel(p, heap.data(), std::uint32_t(heap.size()));
     int reports = 0;
     std::size_t violations = 0;

@@ -133,9 +133,10 @@ void expect_lightcuts_matches(const PreparedScene& p, const RenderOptions& o,
     EXPECT_LE(max_relative_difference(g.image, c.image, "lightcuts", relative, skip_tight), relative);
     std::vector<bool> not_frozen(froze.size());
     for (std::size_t i = 0; i < froze.size(); ++i) not_frozen[i] = !froze[i];
-    if (std::count(froze.begin(), froze.end(), true) > 0)
+    if (std::count(froze.begin(), froze.end(), true) > 0) {
         EXPECT_LE(max_relative_difference(g.image, c.image, "lightcuts, frozen", kFrozenRelative, not_frozen),
                   kFrozenRelative);
+    }
     // A refinement casts at most one ray (one child inherits the parent's
     // representative), so a pixel whose cut differs by d clusters may cast
     // up to d rays more or fewer.
