@@ -51,7 +51,7 @@ LC_CONST uint kSpecWorkgroupSize = 0u;    // local_size_x
 LC_CONST uint kSpecEnableGgx = 1u;        // any material has a GGX lobe
 LC_CONST uint kSpecEnableShadows = 2u;    // any triangle can block a light
 LC_CONST uint kSpecHeapSlots = 3u;        // K: cut-heap slots per invocation, in shared memory
-LC_CONST uint kSpecSaveStride = 5u;       // invocations the heap-save buffer is laid out for
+// 5 was the heap-save stride, now PushConstants.heap_save_stride.
 LC_CONST uint kSpecEnableOriented = 6u;   // any spot or oriented light (emission cones)
 LC_CONST uint kSpecStochastic = 7u;       // lightcuts.comp: Stochastic Lightcuts' fresh representatives
 LC_CONST uint kSpecEnableTextures = 8u;   // any material has a texture
@@ -119,7 +119,7 @@ LC_CONST uint kCutLastDispatch = 2u;   // every cut must be final by the end of 
 LC_CONST uint kUnlimitedRefinements = 0xFFFFFFFFu;
 
 // Push constants of every kernel: what changes from dispatch to dispatch
-// (36 bytes; the frame's constants are in the kBindingFrame buffer).
+// (40 bytes; the frame's constants are in the kBindingFrame buffer).
 struct PushConstants {
     uint tile_x, tile_y;    // first pixel of the dispatched tile
     uint tile_width, tile_height;
@@ -128,6 +128,10 @@ struct PushConstants {
     uint light_count;
     uint cut_flags;         // lightcuts: kCut*Dispatch bits
     uint refine_budget;     // lightcuts: refinements per pixel in this dispatch
+    // lightcuts: invocations the heap-save buffer is laid out for. A push
+    // constant, not a specialization constant: it follows the image size,
+    // and a new pipeline per size costs seconds of compilation on lavapipe.
+    uint heap_save_stride;
 };
 
 #ifdef __cplusplus

@@ -11,7 +11,6 @@
 #define LC_HEAP_GLSL
 
 layout(constant_id = kSpecHeapSlots) const uint kHeapSlots = 1u;
-layout(constant_id = kSpecSaveStride) const uint kSaveStride = 1u;
 
 layout(std430, binding = kBindingHeapSave) buffer HeapSave { CutEntry heap_save[]; };
 
@@ -19,7 +18,7 @@ layout(std430, binding = kBindingHeapSave) buffer HeapSave { CutEntry heap_save[
 shared CutEntry s_heap[kHeapSlots * gl_WorkGroupSize.x];
 
 uint lc_shared_slot(uint slot) { return slot * gl_WorkGroupSize.x + gl_LocalInvocationIndex; }
-uint lc_saved_slot(uint slot) { return slot * kSaveStride + gl_GlobalInvocationID.x; }
+uint lc_saved_slot(uint slot) { return slot * push.heap_save_stride + gl_GlobalInvocationID.x; }
 
 // Shared slots to global memory and back, around a pause between dispatches.
 void lc_heap_save(uint heap_size) {

@@ -20,7 +20,6 @@ struct SpecData {
     VkBool32 enable_ggx;
     VkBool32 enable_shadows;
     std::uint32_t heap_slots;
-    std::uint32_t save_stride;
     VkBool32 enable_oriented;
     VkBool32 stochastic;
     VkBool32 enable_textures;
@@ -48,7 +47,6 @@ Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const Ker
         {gpu::kSpecEnableGgx, offsetof(SpecData, enable_ggx), sizeof(VkBool32)},
         {gpu::kSpecEnableShadows, offsetof(SpecData, enable_shadows), sizeof(VkBool32)},
         {gpu::kSpecHeapSlots, offsetof(SpecData, heap_slots), sizeof(std::uint32_t)},
-        {gpu::kSpecSaveStride, offsetof(SpecData, save_stride), sizeof(std::uint32_t)},
         {gpu::kSpecEnableOriented, offsetof(SpecData, enable_oriented), sizeof(VkBool32)},
         {gpu::kSpecStochastic, offsetof(SpecData, stochastic), sizeof(VkBool32)},
         {gpu::kSpecEnableTextures, offsetof(SpecData, enable_textures), sizeof(VkBool32)},
@@ -89,7 +87,6 @@ Kernels::Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMetho
     spec.enable_shadows = switches.shadows;
     // Kernels without a heap do not declare its constants; any valid value does.
     spec.heap_slots = std::max(method.heap_slots(), 1u);
-    spec.save_stride = switches.save_stride;
     spec.enable_oriented = switches.oriented;
     spec.stochastic = method.stochastic();
     spec.enable_textures = switches.textures;

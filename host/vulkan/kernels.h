@@ -31,7 +31,6 @@ struct KernelSwitches {
     bool disney = true;              // compile the Disney BRDF in
     bool sheen = true;               // ... and its sheen lobe
     bool clearcoat = true;           // ... and its clearcoat lobe
-    std::uint32_t save_stride = 1;   // invocations the heap-save buffer is laid out for
     SceneChunks chunks;              // how the scene arrays are split (GpuResources)
 };
 

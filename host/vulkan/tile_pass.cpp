@@ -55,6 +55,7 @@ void TilePass::record(VkCommandBuffer cmd, const gpu::PushConstants& tile, bool 
     push.light_count = 0;
     push.cut_flags = 0;
     push.refine_budget = gpu::kUnlimitedRefinements;
+    push.heap_save_stride = resources_.tiles().invocations;
     VkPipelineLayout layout = resources_.pipeline_layout();
     VkDescriptorSet set = resources_.descriptor_set();
     vkd_.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);

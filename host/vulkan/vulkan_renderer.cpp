@@ -22,7 +22,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // The GLSL push-constant block of shaders/kernel.glsl.
-static_assert(sizeof(gpu::PushConstants) == 36);
+static_assert(sizeof(gpu::PushConstants) == 40);
 static_assert(offsetof(gpu::PushConstants, sample_index) == 16);
 static_assert(offsetof(gpu::PushConstants, refine_budget) == 32);
 // The std430 layouts of bindings.glsl's records: 4-byte scalars only.
@@ -122,8 +122,7 @@ RenderSetup::RenderSetup(const Context& context, const PreparedScene& prepared,
               {tuning.force_ggx || prepared.has_specular, tuning.force_shadows || prepared.has_occluders,
                tuning.force_oriented || prepared.has_oriented, tuning.force_textures || prepared.has_textures,
                tuning.force_disney || prepared.has_disney, tuning.force_sheen || prepared.has_sheen,
-               tuning.force_clearcoat || prepared.has_clearcoat, resources.tiles().invocations,
-               resources.chunks()}),
+               tuning.force_clearcoat || prepared.has_clearcoat, resources.chunks()}),
       pass(context, resources, kernels, *method, timestamps) {}
 
 RenderSetup::~RenderSetup() { ctx.fn().vkDeviceWaitIdle(ctx.device().get()); }
