@@ -34,7 +34,15 @@ LC_CONST uint kBindingPixelStats = 13u;   // PixelStats per tile pixel, summed o
 LC_CONST uint kBindingHeapSave = 14u;     // cut heaps paused between dispatches (see heap.glsl)
 LC_CONST uint kBindingCutState = 15u;     // CutState per tile pixel, between Lightcuts dispatches
 LC_CONST uint kBindingChunkTable = 16u;   // ChunkTable: where the chunks of a split scene array are
-LC_CONST uint kBindingCount = 17u;
+LC_CONST uint kBindingCount = 17u;        // storage-buffer bindings: 0 .. kBindingCount - 1
+// Uniform texel buffers (RGBA32UI views) over four of the scene arrays
+// above: the arrays the shadow rays and cut selection read most, read
+// through these instead where kSpecTexelReads is set (docs/vulkan.md).
+LC_CONST uint kBindingBvhNodeTexels = 17u;
+LC_CONST uint kBindingTriangleTexels = 18u;
+LC_CONST uint kBindingLightTexels = 19u;
+LC_CONST uint kBindingLightNodeTexels = 20u;
+LC_CONST uint kTexelBindingCount = 4u;
 
 // Scene arrays (bindings 0 .. kSceneArrayCount - 1) larger than one buffer
 // may be are split into chunks of 2^shift elements each. Chunk 0 stays at
@@ -51,7 +59,7 @@ LC_CONST uint kSpecWorkgroupSize = 0u;    // local_size_x
 LC_CONST uint kSpecEnableGgx = 1u;        // any material has a GGX lobe
 LC_CONST uint kSpecEnableShadows = 2u;    // any triangle can block a light
 LC_CONST uint kSpecHeapSlots = 3u;        // K: cut-heap slots per invocation, in shared memory
-// 5 was the heap-save stride, now PushConstants.heap_save_stride.
+LC_CONST uint kSpecTexelReads = 5u;       // read the four texel-buffer arrays through their views
 LC_CONST uint kSpecEnableOriented = 6u;   // any spot or oriented light (emission cones)
 LC_CONST uint kSpecStochastic = 7u;       // lightcuts.comp: Stochastic Lightcuts' fresh representatives
 LC_CONST uint kSpecEnableTextures = 8u;   // any material has a texture

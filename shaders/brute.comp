@@ -6,7 +6,7 @@
 #extension GL_GOOGLE_include_directive : require
 
 #include "kernel.glsl"
-#define LC_LIGHT(i) lc_lights(push.light_first + (i))
+#define LC_LIGHT(i) lc_light(push.light_first + (i))
 #include "shared/brute.h"
 
 void main() {

@@ -63,14 +63,60 @@ layout(std430, binding = kBindingGBuffer) buffer GBuffer { GBufferTexel gbuffer[
 layout(std430, binding = kBindingRadiance) buffer Radiance { float radiance[]; };
 layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_stats[]; };
 
-#define LC_BVH_NODE(i) lc_bvh_nodes(i)
-#define LC_TRIANGLE(i) lc_triangles(i)
+// The same four arrays as 16-byte texels (kBindingBvhNodeTexels ..). On
+// llvmpipe a storage-buffer load whose address differs between lanes is a
+// loop over the lanes, a texel fetch one gather (docs/results/lavapipe.md);
+// the host sets kTexelReads where it measured that to pay and every array
+// fits a texel buffer's limit. The fields are unpacked in struct order.
+layout(constant_id = kSpecTexelReads) const bool kTexelReads = false;
+layout(binding = kBindingBvhNodeTexels) uniform usamplerBuffer bvh_node_texels;
+layout(binding = kBindingTriangleTexels) uniform usamplerBuffer triangle_texels;
+layout(binding = kBindingLightTexels) uniform usamplerBuffer light_texels;
+layout(binding = kBindingLightNodeTexels) uniform usamplerBuffer light_node_texels;
+
+BvhNode lc_bvh_node(uint i) {
+    if (!kTexelReads) return lc_bvh_nodes(i);
+    const uvec4 a = texelFetch(bvh_node_texels, int(2u * i));
+    const uvec4 b = texelFetch(bvh_node_texels, int(2u * i + 1u));
+    return BvhNode(uintBitsToFloat(a.x), uintBitsToFloat(a.y), uintBitsToFloat(a.z), a.w,
+                   uintBitsToFloat(b.x), uintBitsToFloat(b.y), uintBitsToFloat(b.z), b.w);
+}
+
+Triangle lc_triangle(uint i) {
+    if (!kTexelReads) return lc_triangles(i);
+    const vec4 a = uintBitsToFloat(texelFetch(triangle_texels, int(3u * i)));
+    const vec4 b = uintBitsToFloat(texelFetch(triangle_texels, int(3u * i + 1u)));
+    const uvec4 c = texelFetch(triangle_texels, int(3u * i + 2u));
+    return Triangle(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, uintBitsToFloat(c.x), c.y, c.z, c.w);
+}
+
+Light lc_light(uint i) {
+    if (!kTexelReads) return lc_lights(i);
+    const vec4 a = uintBitsToFloat(texelFetch(light_texels, int(3u * i)));
+    const vec4 b = uintBitsToFloat(texelFetch(light_texels, int(3u * i + 1u)));
+    const uvec4 c = texelFetch(light_texels, int(3u * i + 2u));
+    return Light(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, uintBitsToFloat(c.x), uintBitsToFloat(c.y),
+                 uintBitsToFloat(c.z), c.w);
+}
+
+LightNode lc_light_node(uint i) {
+    if (!kTexelReads) return lc_light_nodes(i);
+    const vec4 a = uintBitsToFloat(texelFetch(light_node_texels, int(4u * i)));
+    const vec4 b = uintBitsToFloat(texelFetch(light_node_texels, int(4u * i + 1u)));
+    const uvec4 c = texelFetch(light_node_texels, int(4u * i + 2u));
+    const uvec4 d = texelFetch(light_node_texels, int(4u * i + 3u));
+    return LightNode(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, uintBitsToFloat(c.x), c.y, c.z, c.w, d.x,
+                     uintBitsToFloat(d.y), uintBitsToFloat(d.z), uintBitsToFloat(d.w));
+}
+
+#define LC_BVH_NODE(i) lc_bvh_node(i)
+#define LC_TRIANGLE(i) lc_triangle(i)
 #define LC_MATERIAL(i) lc_materials(i)
 #define LC_UVS(i) lc_uvs(i)
 #define LC_TEXTURE(i) lc_textures(i)
 #define LC_TEXEL(i) lc_texels(i)
 #define LC_NORMALS(i) lc_normals(i)
-#define LC_LIGHT_NODE(i) lc_light_nodes(i)
+#define LC_LIGHT_NODE(i) lc_light_node(i)
 #define LC_VPL_MIN_DISTANCE2 frame.vpl_min_distance2
 #define LC_ENVIRONMENT_TEXEL(i) vec3(lc_environment(3u * (i)), lc_environment(3u * (i) + 1u), lc_environment(3u * (i) + 2u))
 // LC_LIGHT is defined by each kernel (brute force offsets it by light_first).

@@ -15,7 +15,7 @@
 
 #include "kernel.glsl"
 #include "heap.glsl"
-#define LC_LIGHT(i) lc_lights(i)
+#define LC_LIGHT(i) lc_light(i)
 #include "shared/sampling.h"
 #include "shared/lightcuts.h"
 

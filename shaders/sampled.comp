@@ -9,7 +9,7 @@
 #extension GL_GOOGLE_include_directive : require
 
 #include "kernel.glsl"
-#define LC_LIGHT(i) lc_lights(i)
+#define LC_LIGHT(i) lc_light(i)
 #include "shared/sampling.h"
 
 void main() {

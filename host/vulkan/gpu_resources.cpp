@@ -53,6 +53,33 @@ static_assert(gpu::kBindingRadiance == gpu::kBindingGBuffer + 1 &&
               "GpuResources::TileIndex follows the per-tile bindings, then the chunk table");
 static_assert(gpu::kSceneArrayCount == gpu::kBindingFrame, "every scene array before the frame constants can be split");
 
+// The scene arrays that also have a texel view (RGBA32UI, 16 bytes a
+// texel), at the bindings kBindingBvhNodeTexels ...
+struct TexelArray {
+    std::uint32_t binding;        // the array's storage binding
+    std::uint32_t texel_binding;  // its view's binding
+};
+constexpr TexelArray kTexelArrays[] = {
+    {gpu::kBindingBvhNodes, gpu::kBindingBvhNodeTexels},
+    {gpu::kBindingTriangles, gpu::kBindingTriangleTexels},
+    {gpu::kBindingLights, gpu::kBindingLightTexels},
+    {gpu::kBindingLightNodes, gpu::kBindingLightNodeTexels},
+};
+constexpr VkFormat kTexelFormat = VK_FORMAT_R32G32B32A32_UINT;
+constexpr VkDeviceSize kTexelBytes = 16;
+static_assert(std::size(kTexelArrays) == gpu::kTexelBindingCount &&
+              gpu::kBindingBvhNodeTexels == gpu::kBindingCount &&
+              gpu::kBindingLightNodeTexels == gpu::kBindingCount + gpu::kTexelBindingCount - 1);
+static_assert(sizeof(gpu::BvhNode) == 2 * kTexelBytes && sizeof(gpu::Triangle) == 3 * kTexelBytes &&
+              sizeof(gpu::Light) == 3 * kTexelBytes && sizeof(gpu::LightNode) == 4 * kTexelBytes,
+              "shaders/kernel.glsl unpacks these structs from whole texels");
+
+bool has_texel_view(std::uint32_t binding) {
+    for (const TexelArray& a : kTexelArrays)
+        if (a.binding == binding) return true;
+    return false;
+}
+
 void check_scene_order(const std::vector<SceneArray>& scene) {
     bool ok = scene.size() == std::size(kSceneBindings);
     for (std::size_t i = 0; ok && i < scene.size(); ++i)
@@ -75,11 +102,13 @@ std::string mib(VkDeviceSize bytes) {
 GpuResources::GpuResources(const Context& ctx, Submitter& submitter,
                            const std::vector<SceneArray>& scene, const ShadingMethod& method,
                            std::uint64_t image_pixels, std::uint32_t max_tile_pixels,
-                           std::uint64_t split_bytes)
+                           std::uint64_t split_bytes, bool texel_reads)
     : ctx_(ctx), submitter_(submitter), split_bytes_(split_bytes) {
     const VkPhysicalDeviceLimits& limits = ctx.properties().limits;
     max_buffer_ = std::min<VkDeviceSize>(limits.maxStorageBufferRange, ctx.max_allocation_size());
     upload_scene(scene);
+    texel_reads_ = texel_reads && texel_views_fit();
+    create_texel_views();
     const std::vector<TileBuffer> buffers = tile_buffers(method);
     fit_tiles(buffers, image_pixels, max_tile_pixels);
     create_tile_buffers(buffers);
@@ -162,9 +191,10 @@ std::vector<Buffer> GpuResources::upload_chunks(const SceneArray& array, std::ui
     const std::uint64_t per_chunk = std::uint64_t(1) << shift;
     if (binding < gpu::kSceneArrayCount) chunks_.shift[binding] = shift;
 
-    constexpr VkBufferUsageFlags kUsage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                          VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-                                          VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+    const VkBufferUsageFlags usage =
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+        VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
+        (has_texel_view(binding) ? VkBufferUsageFlags(VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT) : VkBufferUsageFlags(0));
     std::vector<Buffer> chunks;
     for (std::uint64_t first = 0; first < count; first += per_chunk) {
         const VkDeviceSize chunk_bytes = std::min(per_chunk, count - first) * element;
@@ -173,7 +203,7 @@ std::vector<Buffer> GpuResources::upload_chunks(const SceneArray& array, std::ui
         // Still refuses an array that cannot be split (the frame constants)
         // or whose single element is larger than a buffer may be.
         check_fits(chunk_name, chunk_bytes);
-        Buffer buffer(ctx_.device(), ctx_.memory(), chunk_bytes, kUsage, MemoryUse::kDevice, chunk_name);
+        Buffer buffer(ctx_.device(), ctx_.memory(), chunk_bytes, usage, MemoryUse::kDevice, chunk_name);
         upload(chunk_name, source + first * element, chunk_bytes, buffer);
         chunks.push_back(std::move(buffer));
     }
@@ -206,6 +236,34 @@ void GpuResources::create_chunk_table() {
     const VkDeviceSize bytes = words.size() * sizeof(std::uint32_t);
     chunk_table_ = storage_buffer("chunk addresses", bytes, MemoryUse::kDevice, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     upload("chunk addresses", words.data(), bytes, chunk_table_);
+}
+
+// Texel views can cover the four arrays: none is split (a view sees one
+// buffer), each is within maxTexelBufferElements, and the format can be a
+// uniform texel buffer (the spec makes RGBA32UI's support mandatory).
+bool GpuResources::texel_views_fit() const {
+    if (chunks_.split) return false;
+    VkFormatProperties format{};
+    vkGetPhysicalDeviceFormatProperties(ctx_.physical(), kTexelFormat, &format);
+    if (!(format.bufferFeatures & VK_FORMAT_FEATURE_UNIFORM_TEXEL_BUFFER_BIT)) return false;
+    const VkDeviceSize max_texels = ctx_.properties().limits.maxTexelBufferElements;
+    for (const TexelArray& a : kTexelArrays)
+        if (scene_[a.binding][0].size() / kTexelBytes > max_texels) return false;
+    return true;
+}
+
+void GpuResources::create_texel_views() {
+    for (const TexelArray& a : kTexelArrays) {
+        const Buffer& buffer = scene_[a.binding][0];
+        auto info = vk_struct<VkBufferViewCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO);
+        info.buffer = buffer.get();
+        info.format = kTexelFormat;
+        info.offset = 0;
+        info.range = texel_reads_ ? buffer.size() / kTexelBytes * kTexelBytes : kTexelBytes;
+        VkBufferView view = VK_NULL_HANDLE;
+        VK_CHECK(ctx_.fn().vkCreateBufferView(ctx_.device().get(), &info, nullptr, &view));
+        texel_views_.push_back(own<BufferView>(ctx_.device(), view, std::string(kSceneBindings[a.binding].array_name) + " texels"));
+    }
 }
 
 std::vector<TileBuffer> GpuResources::tile_buffers(const ShadingMethod& method) const {
@@ -279,21 +337,27 @@ const gpu::PixelStats* GpuResources::pixel_stats_sums() const {
 void GpuResources::create_descriptors() {
     VkDevice device = ctx_.device().get();
     const VolkDeviceTable& vkd = ctx_.fn();
-    VkDescriptorSetLayoutBinding bindings[gpu::kBindingCount];
-    for (std::uint32_t b = 0; b < gpu::kBindingCount; ++b)
-        bindings[b] = {b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+    constexpr std::uint32_t kAllBindings = gpu::kBindingCount + gpu::kTexelBindingCount;
+    VkDescriptorSetLayoutBinding bindings[kAllBindings];
+    for (std::uint32_t b = 0; b < kAllBindings; ++b)
+        bindings[b] = {b,
+                       b < gpu::kBindingCount ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
+                                              : VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+                       1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
     auto layout_info = vk_struct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
-    layout_info.bindingCount = gpu::kBindingCount;
+    layout_info.bindingCount = kAllBindings;
     layout_info.pBindings = bindings;
     VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
     VK_CHECK(vkd.vkCreateDescriptorSetLayout(device, &layout_info, nullptr, &set_layout));
     set_layout_ = own<DescriptorSetLayout>(ctx_.device(), set_layout, "kernel buffers layout");
 
-    VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, gpu::kBindingCount};
+    const VkDescriptorPoolSize pool_sizes[] = {
+        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, gpu::kBindingCount},
+        {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, gpu::kTexelBindingCount}};
     auto pool_info = vk_struct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
     pool_info.maxSets = 1;
-    pool_info.poolSizeCount = 1;
-    pool_info.pPoolSizes = &pool_size;
+    pool_info.poolSizeCount = std::uint32_t(std::size(pool_sizes));
+    pool_info.pPoolSizes = pool_sizes;
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VK_CHECK(vkd.vkCreateDescriptorPool(device, &pool_info, nullptr, &pool));
     descriptor_pool_ = own<DescriptorPool>(ctx_.device(), pool, "descriptor pool");
@@ -306,7 +370,8 @@ void GpuResources::create_descriptors() {
     ctx_.device().set_name(descriptor_set_, "kernel buffers");
 
     VkDescriptorBufferInfo infos[gpu::kBindingCount];
-    VkWriteDescriptorSet writes[gpu::kBindingCount];
+    VkBufferView views[gpu::kTexelBindingCount];
+    VkWriteDescriptorSet writes[kAllBindings];
     for (std::uint32_t b = 0; b < gpu::kBindingCount; ++b) {
         const Buffer& buffer = b < gpu::kBindingGBuffer    ? scene_[b][0]
                                : b == gpu::kBindingChunkTable ? chunk_table_
@@ -319,7 +384,17 @@ void GpuResources::create_descriptors() {
         writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
         writes[b].pBufferInfo = &infos[b];
     }
-    vkd.vkUpdateDescriptorSets(device, gpu::kBindingCount, writes, 0, nullptr);
+    for (std::uint32_t t = 0; t < gpu::kTexelBindingCount; ++t) {
+        const std::uint32_t b = gpu::kBindingCount + t;
+        views[t] = texel_views_[t].get();
+        writes[b] = vk_struct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
+        writes[b].dstSet = descriptor_set_;
+        writes[b].dstBinding = b;
+        writes[b].descriptorCount = 1;
+        writes[b].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+        writes[b].pTexelBufferView = &views[t];
+    }
+    vkd.vkUpdateDescriptorSets(device, kAllBindings, writes, 0, nullptr);
 }
 
 void GpuResources::create_pipeline_layout() {

@@ -33,13 +33,20 @@ public:
     // the buffer, its size and the device limit when something cannot fit.
     // A scene array larger than one buffer may be (or than `split_bytes`, if
     // not 0) is split into chunks of 2^k elements, each its own buffer.
+    // `texel_reads`: let the kernels read the BVH nodes, triangles, lights
+    // and light-tree nodes through texel views, where the device allows
+    // (texel_reads() says whether it did).
     GpuResources(const Context& ctx, Submitter& submitter, const std::vector<SceneArray>& scene,
                  const ShadingMethod& method, std::uint64_t image_pixels,
-                 std::uint32_t max_tile_pixels, std::uint64_t split_bytes = 0);
+                 std::uint32_t max_tile_pixels, std::uint64_t split_bytes = 0,
+                 bool texel_reads = false);
 
     const TileLayout& tiles() const { return tiles_; }
     // How the scene arrays were split, for the kernels' specialization.
     const SceneChunks& chunks() const { return chunks_; }
+    // The texel views cover the four arrays (kBindingBvhNodeTexels ..): the
+    // kernels may read them there.
+    bool texel_reads() const { return texel_reads_; }
     // Chunks of the scene array at `binding` (1 where it fits one buffer).
     std::size_t chunk_count(std::uint32_t binding) const { return scene_[binding].size(); }
     VkDescriptorSet descriptor_set() const { return descriptor_set_; }
@@ -73,6 +80,8 @@ private:
     std::vector<Buffer> upload_chunks(const SceneArray& array, std::uint32_t binding);
     void upload_scene(const std::vector<SceneArray>& scene);
     void create_chunk_table();
+    bool texel_views_fit() const;
+    void create_texel_views();
     std::vector<TileBuffer> tile_buffers(const ShadingMethod& method) const;
     void fit_tiles(const std::vector<TileBuffer>& buffers, std::uint64_t image_pixels,
                    std::uint32_t max_tile_pixels);
@@ -85,6 +94,7 @@ private:
     VkDeviceSize max_buffer_ = 0;  // min(maxStorageBufferRange, maxMemoryAllocationSize)
     VkDeviceSize split_bytes_ = 0;  // a smaller chunk size forced by Tuning (0: none)
     SceneChunks chunks_;
+    bool texel_reads_ = false;
     TileLayout tiles_;
     std::vector<std::pair<std::string, std::uint64_t>> buffer_bytes_;
 
@@ -93,6 +103,10 @@ private:
     // (chunk 0 is what the binding holds).
     std::vector<std::vector<Buffer>> scene_;
     Buffer chunk_table_;                        // binding kBindingChunkTable
+    // Bindings kBindingBvhNodeTexels ..: over the whole array where
+    // texel_reads_, else over its first texel (the kernels do not read them,
+    // but every binding needs a valid descriptor).
+    std::vector<BufferView> texel_views_;
     Buffer tile_[kTileBufferCount];             // bindings kBindingGBuffer ..
     Buffer radiance_readback_, stats_readback_;
     DescriptorSetLayout set_layout_;

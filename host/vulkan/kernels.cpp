@@ -27,6 +27,7 @@ struct SpecData {
     VkBool32 enable_sheen;
     VkBool32 enable_clearcoat;
     VkBool32 split_scene;
+    VkBool32 texel_reads;
     std::uint32_t chunk_shift[gpu::kSceneArrayCount];
 };
 
@@ -54,6 +55,7 @@ Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const Ker
         {gpu::kSpecEnableSheen, offsetof(SpecData, enable_sheen), sizeof(VkBool32)},
         {gpu::kSpecEnableClearcoat, offsetof(SpecData, enable_clearcoat), sizeof(VkBool32)},
         {gpu::kSpecSplitScene, offsetof(SpecData, split_scene), sizeof(VkBool32)},
+        {gpu::kSpecTexelReads, offsetof(SpecData, texel_reads), sizeof(VkBool32)},
     };
     for (std::uint32_t b = 0; b < gpu::kSceneArrayCount; ++b)
         entries.push_back({gpu::kSpecChunkShift + b,
@@ -94,6 +96,7 @@ Kernels::Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMetho
     spec.enable_sheen = switches.sheen;
     spec.enable_clearcoat = switches.clearcoat;
     spec.split_scene = switches.chunks.split;
+    spec.texel_reads = switches.texel_reads;
     for (std::uint32_t b = 0; b < gpu::kSceneArrayCount; ++b) spec.chunk_shift[b] = switches.chunks.shift[b];
     primary_ = compute_pipeline(
         ctx, layout, {lc_spirv_primary, sizeof lc_spirv_primary, "primary.comp (camera rays)"}, spec);

@@ -31,6 +31,7 @@ struct KernelSwitches {
     bool disney = true;              // compile the Disney BRDF in
     bool sheen = true;               // ... and its sheen lobe
     bool clearcoat = true;           // ... and its clearcoat lobe
+    bool texel_reads = false;        // read four scene arrays through their texel views
     SceneChunks chunks;              // how the scene arrays are split (GpuResources)
 };
 

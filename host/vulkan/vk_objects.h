@@ -117,6 +117,7 @@ using DeviceHandle = UniqueHandle<Handle, DeviceDeleter<Handle, Destroy>>;
 using ShaderModule = DeviceHandle<VkShaderModule, &VolkDeviceTable::vkDestroyShaderModule>;
 using PipelineLayout = DeviceHandle<VkPipelineLayout, &VolkDeviceTable::vkDestroyPipelineLayout>;
 using Pipeline = DeviceHandle<VkPipeline, &VolkDeviceTable::vkDestroyPipeline>;
+using BufferView = DeviceHandle<VkBufferView, &VolkDeviceTable::vkDestroyBufferView>;
 using DescriptorSetLayout =
     DeviceHandle<VkDescriptorSetLayout, &VolkDeviceTable::vkDestroyDescriptorSetLayout>;
 using DescriptorPool = DeviceHandle<VkDescriptorPool, &VolkDeviceTable::vkDestroyDescriptorPool>;
@@ -167,6 +168,7 @@ constexpr VkObjectType object_type();
 template <> constexpr VkObjectType object_type<VkQueue>() { return VK_OBJECT_TYPE_QUEUE; }
 template <> constexpr VkObjectType object_type<VkCommandBuffer>() { return VK_OBJECT_TYPE_COMMAND_BUFFER; }
 template <> constexpr VkObjectType object_type<VkBuffer>() { return VK_OBJECT_TYPE_BUFFER; }
+template <> constexpr VkObjectType object_type<VkBufferView>() { return VK_OBJECT_TYPE_BUFFER_VIEW; }
 template <> constexpr VkObjectType object_type<VkDeviceMemory>() { return VK_OBJECT_TYPE_DEVICE_MEMORY; }
 template <> constexpr VkObjectType object_type<VkShaderModule>() { return VK_OBJECT_TYPE_SHADER_MODULE; }
 template <> constexpr VkObjectType object_type<VkPipelineLayout>() { return VK_OBJECT_TYPE_PIPELINE_LAYOUT; }

@@ -77,6 +77,8 @@ Tuning device_tuning(const Context& ctx, Tuning tuning) {
     const bool cpu = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     if (tuning.target_dispatch_ms <= 0.0)
         tuning.target_dispatch_ms = cpu ? Tuning::kCpuTargetMs : Tuning::kGpuTargetMs;
+    if (tuning.texel_reads == Tuning::TexelReads::kAuto)
+        tuning.texel_reads = cpu ? Tuning::TexelReads::kOn : Tuning::TexelReads::kOff;
     if (tuning.presplit_on_llvmpipe && tuning.refinements_per_dispatch == 0 && driver_limits_loops(ctx))
         tuning.refinements_per_dispatch = Tuning::kLlvmpipeRefinements;
     return tuning;
@@ -117,12 +119,14 @@ RenderSetup::RenderSetup(const Context& context, const PreparedScene& prepared,
       method(make_shading_method(options, frame, prepared.tree, tuning,
                                  context.properties().limits.maxComputeSharedMemorySize)),
       resources(context, submitter, kernel_arrays(prepared, frame), *method,
-                std::uint64_t(frame.width) * frame.height, tuning.max_tile_pixels, tuning.split_bytes),
+                std::uint64_t(frame.width) * frame.height, tuning.max_tile_pixels, tuning.split_bytes,
+                tuning.texel_reads == Tuning::TexelReads::kOn),
       kernels(context, resources.pipeline_layout(), *method,
               {tuning.force_ggx || prepared.has_specular, tuning.force_shadows || prepared.has_occluders,
                tuning.force_oriented || prepared.has_oriented, tuning.force_textures || prepared.has_textures,
                tuning.force_disney || prepared.has_disney, tuning.force_sheen || prepared.has_sheen,
-               tuning.force_clearcoat || prepared.has_clearcoat, resources.chunks()}),
+               tuning.force_clearcoat || prepared.has_clearcoat, resources.texel_reads(),
+               resources.chunks()}),
       pass(context, resources, kernels, *method, timestamps) {}
 
 RenderSetup::~RenderSetup() { ctx.fn().vkDeviceWaitIdle(ctx.device().get()); }
@@ -148,6 +152,11 @@ Tuning Tuning::from_environment() {
         tuning.refinements_per_dispatch = std::uint32_t(std::strtoul(v, nullptr, 10));
     if (const char* v = std::getenv("LC_VK_SPLIT_BYTES"))
         tuning.split_bytes = std::strtoull(v, nullptr, 10);
+    if (const char* v = std::getenv("LC_VK_TEXEL_READS")) {
+        const std::string mode = v;
+        if (mode == "on") tuning.texel_reads = Tuning::TexelReads::kOn;
+        if (mode == "off") tuning.texel_reads = Tuning::TexelReads::kOff;
+    }
     if (const char* v = std::getenv("LC_VK_TARGET_MS")) {
         const double ms = std::strtod(v, nullptr);
         if (ms > 0.0) tuning.target_dispatch_ms = ms;

@@ -197,10 +197,11 @@ TEST_P(VulkanSampled, SampledAndStochasticMatchCpu) {
                     vulkan_test::kSampledDifferFraction * double(differs.size()));
         EXPECT_LE(double(differing), vulkan_test::kSampledDifferFraction * double(differs.size())) << label;
         EXPECT_LE(vulkan_test::max_relative_difference(g.image, cpu.image, label, tolerance, differs), tolerance);
-        if (std::count(froze.begin(), froze.end(), true) > 0)
+        if (std::count(froze.begin(), froze.end(), true) > 0) {
             EXPECT_LE(vulkan_test::max_relative_difference(g.image, cpu.image, label + ", frozen",
                                                            vulkan_test::kFrozenRelative, not_frozen),
                       vulkan_test::kFrozenRelative);
+        }
         EXPECT_NEAR(double(g.stats.shadow_rays), double(cpu.stats.shadow_rays),
                     1e-3 * double(cpu.stats.shadow_rays) + 1.0)
             << label;

@@ -194,6 +194,40 @@ TEST_F(Vulkan, SceneArraysSplitIntoChunksMatchTheCpu) {
     }
 }
 
+// The BVH nodes, triangles, lights and light-tree nodes can be read through
+// uniform texel buffers instead of storage buffers (Tuning::texel_reads;
+// the default on CPU devices). The same kernels read the same bits: the
+// images are identical for every method, and a split scene, which a texel
+// view cannot cover, falls back to the storage buffers.
+TEST_F(Vulkan, TexelReadsGiveTheImagesOfStorageBufferReads) {
+    const PreparedScene p = prepare_scene(random_scene(67, 60, 2, 12, 10), 1);
+    vk::Tuning texels, buffers, split;
+    texels.texel_reads = vk::Tuning::TexelReads::kOn;
+    buffers.texel_reads = vk::Tuning::TexelReads::kOff;
+    split.texel_reads = vk::Tuning::TexelReads::kOn;
+    split.split_bytes = 256;
+    {
+        VulkanOptions v;
+        v.validation = true;
+        vk::MessageLog log;
+        vk::Context ctx(v, &log);
+        const RenderOptions o = options("lightcuts", 12, 10);
+        const gpu::FrameParams frame = vk::frame_params(ctx, p, o);
+        EXPECT_TRUE(vk::RenderSetup(ctx, p, o, frame, texels).resources.texel_reads());
+        EXPECT_FALSE(vk::RenderSetup(ctx, p, o, frame, buffers).resources.texel_reads());
+        EXPECT_FALSE(vk::RenderSetup(ctx, p, o, frame, split).resources.texel_reads());
+        EXPECT_EQ(log.count(), 0u);
+    }
+    for (const char* method : {"brute", "lightcuts", "sampled", "stochastic"}) {
+        SCOPED_TRACE(method);
+        const RenderOptions o = options(method, 12, 10);
+        const RenderResult a = gpu(p, o, texels);
+        const RenderResult b = gpu(p, o, buffers);
+        EXPECT_EQ(max_relative_difference(a.image, b.image, std::string("texel reads ") + method, 0.0), 0.0);
+        EXPECT_EQ(a.stats.shadow_rays, b.stats.shadow_rays);
+    }
+}
+
 // Cuts refined at error 0 over 20000 lights: each refinement loops over
 // heap levels, the search for the smallest entry of a full heap (64 slots)
 // and a shadow ray's BVH nodes, through a grid of boxes; together past the
