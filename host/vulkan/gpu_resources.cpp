@@ -369,6 +369,14 @@ void GpuResources::create_descriptors() {
     VK_CHECK(vkd.vkAllocateDescriptorSets(device, &alloc_info, &descriptor_set_));
     ctx_.device().set_name(descriptor_set_, "kernel buffers");
 
+    const auto write = [&](std::uint32_t binding, VkDescriptorType type) {
+        auto w = vk_struct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
+        w.dstSet = descriptor_set_;
+        w.dstBinding = binding;
+        w.descriptorCount = 1;
+        w.descriptorType = type;
+        return w;
+    };
     VkDescriptorBufferInfo infos[gpu::kBindingCount];
     VkBufferView views[gpu::kTexelBindingCount];
     VkWriteDescriptorSet writes[kAllBindings];
@@ -377,22 +385,13 @@ void GpuResources::create_descriptors() {
                                : b == gpu::kBindingChunkTable ? chunk_table_
                                                               : tile_[b - gpu::kBindingGBuffer];
         infos[b] = {buffer.get(), 0, VK_WHOLE_SIZE};
-        writes[b] = vk_struct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
-        writes[b].dstSet = descriptor_set_;
-        writes[b].dstBinding = b;
-        writes[b].descriptorCount = 1;
-        writes[b].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        writes[b] = write(b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
         writes[b].pBufferInfo = &infos[b];
     }
     for (std::uint32_t t = 0; t < gpu::kTexelBindingCount; ++t) {
-        const std::uint32_t b = gpu::kBindingCount + t;
         views[t] = texel_views_[t].get();
-        writes[b] = vk_struct<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
-        writes[b].dstSet = descriptor_set_;
-        writes[b].dstBinding = b;
-        writes[b].descriptorCount = 1;
-        writes[b].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
-        writes[b].pTexelBufferView = &views[t];
+        writes[gpu::kBindingCount + t] = write(gpu::kBindingCount + t, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER);
+        writes[gpu::kBindingCount + t].pTexelBufferView = &views[t];
     }
     vkd.vkUpdateDescriptorSets(device, kAllBindings, writes, 0, nullptr);
 }
