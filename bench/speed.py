@@ -154,7 +154,7 @@ def main():
                     render(a.out, scene, f"vk_warm_k{k}", 8, "lightcuts", device="vulkan", cut_heap=k)
                     vimg, vs = render(a.out, scene, f"vk_k{k}", size, "lightcuts", device="vulkan", cut_heap=k)
                 except subprocess.CalledProcessError:
-                    lines.append(f"| {k} | {cs['seconds']['render']:.3f} | does not fit | | | |")
+                    lines.append(f"| {k} | {cs['seconds']['render']:.3f} | does not fit | | | | | |")
                     continue
                 c = compare(vimg, cimg)
                 tc, tv = cs["seconds"]["render"], vs["seconds"]["render"]

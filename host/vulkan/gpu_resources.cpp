@@ -389,9 +389,10 @@ void GpuResources::create_descriptors() {
         writes[b].pBufferInfo = &infos[b];
     }
     for (std::uint32_t t = 0; t < gpu::kTexelBindingCount; ++t) {
+        const std::uint32_t b = kTexelArrays[t].texel_binding;
         views[t] = texel_views_[t].get();
-        writes[gpu::kBindingCount + t] = write(gpu::kBindingCount + t, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER);
-        writes[gpu::kBindingCount + t].pTexelBufferView = &views[t];
+        writes[b] = write(b, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER);
+        writes[b].pTexelBufferView = &views[t];
     }
     vkd.vkUpdateDescriptorSets(device, kAllBindings, writes, 0, nullptr);
 }

@@ -30,6 +30,24 @@ std::uint64_t buffer_bytes(const RenderStats& stats, const std::string& name) {
     return 0;
 }
 
+// Runs `check` on the set-up (buffers, descriptors, kernels) of a 12x10
+// lightcuts render of `p` with each tuning, under the validation layer,
+// which must stay silent.
+template <typename Check>
+void check_setups(const PreparedScene& p, std::initializer_list<vk::Tuning> tunings, Check check) {
+    VulkanOptions v;
+    v.validation = true;
+    vk::MessageLog log;
+    vk::Context ctx(v, &log);
+    const RenderOptions o = options("lightcuts", 12, 10);
+    const gpu::FrameParams frame = vk::frame_params(ctx, p, o);
+    for (const vk::Tuning& tuning : tunings) {
+        const vk::RenderSetup setup(ctx, p, o, frame, tuning);
+        check(setup);
+    }
+    EXPECT_EQ(log.count(), 0u);
+}
+
 // The cut heap holds interior nodes of the tree, so it never gets more
 // slots than LightTree::cut_heap_capacity(max_cut), whatever max_cut and
 // cut_heap say: a max_cut of 4e9 over 8 lights takes 7 slots per pixel (it
@@ -164,14 +182,7 @@ TEST_F(Vulkan, SceneArraysSplitIntoChunksMatchTheCpu) {
     const PreparedScene p = prepare_scene(random_scene(66, 60, 2, 12, 10), 1);
     vk::Tuning split;
     split.split_bytes = 256;
-    {
-        VulkanOptions v;
-        v.validation = true;
-        vk::MessageLog log;
-        vk::Context ctx(v, &log);
-        const RenderOptions o = options("lightcuts", 12, 10);
-        const gpu::FrameParams frame = vk::frame_params(ctx, p, o);
-        vk::RenderSetup setup(ctx, p, o, frame, split);
+    check_setups(p, {split}, [](const vk::RenderSetup& setup) {
         EXPECT_TRUE(setup.resources.chunks().split);
         for (std::uint32_t b : {gpu::kBindingBvhNodes, gpu::kBindingTriangles, gpu::kBindingNormals,
                                 gpu::kBindingLights, gpu::kBindingLightNodes}) {
@@ -180,7 +191,7 @@ TEST_F(Vulkan, SceneArraysSplitIntoChunksMatchTheCpu) {
             EXPECT_LE(setup.resources.chunks().shift[b], 3u);  // at most 8 elements of >= 32 bytes
         }
         EXPECT_EQ(setup.resources.chunk_count(gpu::kBindingFrame), 1u);  // never split
-    }
+    });
     for (const char* method : {"brute", "lightcuts", "sampled"}) {
         SCOPED_TRACE(method);
         RenderOptions o = options(method, 12, 10);
@@ -206,18 +217,10 @@ TEST_F(Vulkan, TexelReadsGiveTheImagesOfStorageBufferReads) {
     buffers.texel_reads = vk::Tuning::TexelReads::kOff;
     split.texel_reads = vk::Tuning::TexelReads::kOn;
     split.split_bytes = 256;
-    {
-        VulkanOptions v;
-        v.validation = true;
-        vk::MessageLog log;
-        vk::Context ctx(v, &log);
-        const RenderOptions o = options("lightcuts", 12, 10);
-        const gpu::FrameParams frame = vk::frame_params(ctx, p, o);
-        EXPECT_TRUE(vk::RenderSetup(ctx, p, o, frame, texels).resources.texel_reads());
-        EXPECT_FALSE(vk::RenderSetup(ctx, p, o, frame, buffers).resources.texel_reads());
-        EXPECT_FALSE(vk::RenderSetup(ctx, p, o, frame, split).resources.texel_reads());
-        EXPECT_EQ(log.count(), 0u);
-    }
+    std::vector<bool> reads;
+    check_setups(p, {texels, buffers, split},
+                 [&](const vk::RenderSetup& setup) { reads.push_back(setup.resources.texel_reads()); });
+    EXPECT_EQ(reads, (std::vector<bool>{true, false, false}));
     for (const char* method : {"brute", "lightcuts", "sampled", "stochastic"}) {
         SCOPED_TRACE(method);
         const RenderOptions o = options(method, 12, 10);
