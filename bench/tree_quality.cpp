@@ -33,7 +33,7 @@ int main(int argc, char** argv) {
         std::uint32_t size = argc > 2 ? std::uint32_t(std::stoul(argv[2])) : 64;
         lc::PreparedScene prepared = lc::prepare_scene(scene, 1);
         // Every light the tree holds: the scene's, area samples, environment directions.
-        const std::vector<lc::gpu::Light> lights = prepared.tree.lights;
+        const std::vector<lc::gpu::Light> lights(prepared.tree.lights.begin(), prepared.tree.lights.end());
         lc::RenderOptions o;
         o.method = "lightcuts";
         o.width = o.height = size;

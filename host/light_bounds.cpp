@@ -46,10 +46,12 @@ glm::vec3 tree_point(const gpu::Light& l) {
     }
 }
 
-EmissionCone EmissionCone::everywhere() { return EmissionCone{}; }
+EmissionCone EmissionCone::everywhere() {
+    return EmissionCone{glm::vec3(0.0f, 0.0f, 1.0f), 3.14159265f, 1.57079633f, false, 1.0f};
+}
 
 EmissionCone EmissionCone::of_light(const gpu::Light& light) {
-    EmissionCone cone;
+    EmissionCone cone = everywhere();
     switch (light.type & gpu::kLightTypeMask) {
         case gpu::kLightSpot:
             cone.axis = glm::vec3(light.axis_x, light.axis_y, light.axis_z);
@@ -73,7 +75,7 @@ EmissionCone EmissionCone::of_light(const gpu::Light& light) {
 float EmissionCone::cos_beta() const { return std::cos(std::min(theta_o, kPi)); }
 
 EmissionCone cone_union(const EmissionCone& a, const EmissionCone& b) {
-    EmissionCone u;
+    EmissionCone u = EmissionCone::everywhere();
     u.theta_e = std::max(a.theta_e, b.theta_e);
     u.falloff_width = std::min(a.falloff_width, b.falloff_width);
     u.two_sided = a.two_sided || b.two_sided;

@@ -16,16 +16,20 @@
 
 namespace lc {
 
+// A plain struct, left unwritten by default construction (the tree
+// builder makes millions without zeroing them): start from everywhere() or
+// of_light().
 struct EmissionCone {
-    glm::vec3 axis{0.0f, 0.0f, 1.0f};  // as the kernels decode it (see quantized())
-    float theta_o = 3.14159265f;       // pi: the axes can point anywhere
-    float theta_e = 1.57079633f;
-    bool two_sided = false;
+    glm::vec3 axis;        // as the kernels decode it (see quantized())
+    float theta_o;         // pi: the axes can point anywhere
+    float theta_e;
+    bool two_sided;
     // Spots: the smallest max(1e-3, cos inner - cos outer) of the lights
     // (their outer angles are in theta_e). Others: 1.
-    float falloff_width = 1.0f;
+    float falloff_width;
 
-    // A light that emits everywhere (point and directional lights).
+    // A light that emits everywhere (point and directional lights): axis
+    // +z, theta_o pi, theta_e pi/2, one-sided, falloff width 1.
     static EmissionCone everywhere();
     // The cone of one light (spot: its axis and outer angle; oriented: its
     // normal and pi/2).

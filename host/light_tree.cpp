@@ -19,11 +19,13 @@
 #include "shared/color.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <numeric>
 #include <thread>
+#include <type_traits>
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -43,8 +45,9 @@ constexpr int kWindow = 16;
 // 10^7 lights touches 4 to 5 GB of fresh memory, and faulting it in by 4
 // KiB pages took a quarter of its build (docs/results/speed.md). Only an
 // advice: nothing else changes where it is not taken.
-template <typename T>
-void reserve_huge(std::vector<T>& v, std::size_t n) {
+template <typename Vector>
+void reserve_huge(Vector& v, std::size_t n) {
+    using T = typename Vector::value_type;
     v.reserve(n);
 #ifdef __linux__
     constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
@@ -55,6 +58,8 @@ void reserve_huge(std::vector<T>& v, std::size_t n) {
 #endif
 }
 
+// Left unwritten where made (Build::all does not zero its elements): the
+// leaves and merges write every field.
 struct Cluster {
     glm::vec3 lo, hi;
     // Summed in double: sums of many bright lights must neither overflow
@@ -62,16 +67,17 @@ struct Cluster {
     glm::dvec3 intensity;
     double weight;         // luminance of intensity, the metric's I_C
     EmissionCone cone;     // as stored: axis quantized, theta_o widened to match
-    std::uint32_t axis_packed = 0;
+    std::uint32_t axis_packed;
     std::uint32_t rep;     // index into the input light array
-    std::uint32_t left = gpu::kInvalidIndex, right = gpu::kInvalidIndex;  // build ids
-    bool rep_from_right = false;
+    std::uint32_t left, right;  // build ids; kInvalidIndex for leaves
+    bool rep_from_right;
 };
+static_assert(std::is_trivially_default_constructible_v<Cluster>);
 
 // One tree in the making: every cluster so far (leaves first) and what the
 // merges need.
 struct Build {
-    std::vector<Cluster> all;
+    UninitializedVector<Cluster> all;
     std::uint32_t seed = 0;
     // c^2 of the metric's cone term: 0 for lights that emit everywhere.
     double cone_weight = 0.0;
@@ -97,7 +103,7 @@ double merge_cost(const Build& b, const C& x, const C& y) {
 // proportional to their intensities from a hash of (seed, new id), so the
 // choice is the same whatever order or thread made it.
 void merge_into(Build& build, std::uint32_t a, std::uint32_t b, std::uint32_t id) {
-    std::vector<Cluster>& all = build.all;
+    UninitializedVector<Cluster>& all = build.all;
     const std::uint32_t seed = build.seed;
     Cluster& c = all[id];
     const Cluster& ca = all[a];
@@ -120,6 +126,19 @@ void merge(Build& build, std::uint32_t a, std::uint32_t b) {
     const auto id = static_cast<std::uint32_t>(build.all.size());
     build.all.emplace_back();
     merge_into(build, a, b, id);
+}
+
+// The leaf of light `index`.
+Cluster leaf_of(const gpu::Light& l, std::size_t index) {
+    Cluster c;
+    c.lo = c.hi = tree_point(l);
+    c.cone = quantized(EmissionCone::of_light(l), c.axis_packed);
+    c.intensity = glm::dvec3(l.r, l.g, l.b);
+    c.weight = gpu::lc_luminance(glm::vec3(l.r, l.g, l.b));
+    c.rep = std::uint32_t(index);
+    c.left = c.right = gpu::kInvalidIndex;
+    c.rep_from_right = false;
+    return c;
 }
 
 // The threads parallel_for uses for n items, and the range of thread t.
@@ -162,32 +181,21 @@ std::uint64_t morton_key(const std::uint32_t* q, int dims) {
     return key;
 }
 
-// Sorts cluster ids along a Morton curve of their box centres, in 3D, or
-// in 6D with the emission axis too where the metric has a cone term: the
-// window of partners then holds lights that are near and face alike.
-void sort_morton(const std::vector<Cluster>& all, std::vector<std::uint32_t>& active, bool with_axis) {
-    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-    for (auto id : active) {
-        lo = glm::min(lo, all[id].lo);
-        hi = glm::max(hi, all[id].hi);
-    }
-    glm::vec3 extent = glm::max(hi - lo, glm::vec3(1e-30f));
-    using Keyed = std::pair<std::uint64_t, std::uint32_t>;
-    std::vector<Keyed> keyed;
-    reserve_huge(keyed, active.size());
-    keyed.resize(active.size());
-    parallel_for(active.size(), [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) {
-            const Cluster& c = all[active[i]];
-            const glm::vec3 t = glm::clamp((0.5f * (c.lo + c.hi) - lo) / extent, 0.0f, 1.0f) * 1023.0f;
-            const glm::vec3 a = glm::clamp(0.5f * (c.cone.axis + 1.0f), 0.0f, 1.0f) * 1023.0f;
-            const std::uint32_t q[6] = {std::uint32_t(t.x), std::uint32_t(t.y), std::uint32_t(t.z),
-                                        std::uint32_t(a.x), std::uint32_t(a.y), std::uint32_t(a.z)};
-            keyed[i] = {morton_key(q, with_axis ? 6 : 3), active[i]};
-        }
-    });
-    // Each thread sorts its range, then the ranges merge: the order of one
-    // std::sort, as (key, id) pairs are all distinct.
+// The Morton key of a leaf: its point in the tree's box [lo, lo + extent],
+// in 3D, or in 6D with the emission axis too where the metric has a cone
+// term: the window of partners then holds lights that are near and face
+// alike.
+std::uint64_t leaf_key(const Cluster& c, glm::vec3 lo, glm::vec3 extent, bool with_axis) {
+    const glm::vec3 t = glm::clamp((0.5f * (c.lo + c.hi) - lo) / extent, 0.0f, 1.0f) * 1023.0f;
+    const glm::vec3 a = glm::clamp(0.5f * (c.cone.axis + 1.0f), 0.0f, 1.0f) * 1023.0f;
+    const std::uint32_t q[6] = {std::uint32_t(t.x), std::uint32_t(t.y), std::uint32_t(t.z),
+                                std::uint32_t(a.x), std::uint32_t(a.y), std::uint32_t(a.z)};
+    return morton_key(q, with_axis ? 6 : 3);
+}
+
+// Sorts (key, light) pairs: each thread sorts its range, then the ranges
+// merge. The order of one std::sort, as the pairs are all distinct.
+void parallel_sort(std::vector<std::pair<std::uint64_t, std::uint32_t>>& keyed) {
     const unsigned threads = thread_count(keyed.size());
     parallel_for_ranges(keyed.size(), [&](std::size_t b, std::size_t e, unsigned) {
         std::sort(keyed.begin() + std::ptrdiff_t(b), keyed.begin() + std::ptrdiff_t(e));
@@ -196,7 +204,6 @@ void sort_morton(const std::vector<Cluster>& all, std::vector<std::uint32_t>& ac
         auto [b, e] = thread_range(keyed.size(), threads, t);
         std::inplace_merge(keyed.begin(), keyed.begin() + std::ptrdiff_t(b), keyed.begin() + std::ptrdiff_t(e));
     }
-    for (std::size_t i = 0; i < keyed.size(); ++i) active[i] = keyed[i].second;
 }
 
 // What merge_cost reads of a cluster. The fast builder gathers these in
@@ -349,27 +356,10 @@ std::size_t best_partner_points(const PointKeys& k, std::size_t i) {
     return best_j;
 }
 
-// Puts the leaves (build ids [0, active.size())) in the order of `active`,
-// renumbering them 0, 1, ...: the windows of the first round, the merges
-// and flatten() then read neighbouring clusters from neighbouring memory
-// (the input order of a light file is arbitrary). Leaf ids only name
-// clusters; the lights (Cluster::rep) and every merge are as before.
-void renumber_leaves(Build& build, std::vector<std::uint32_t>& active) {
-    std::vector<Cluster> sorted;
-    reserve_huge(sorted, build.all.capacity());
-    sorted.resize(active.size());
-    parallel_for(active.size(), [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) sorted[i] = build.all[active[i]];
-    });
-    build.all.swap(sorted);
-    std::iota(active.begin(), active.end(), 0u);
-}
-
-// Locally-ordered clustering; returns the root's build id.
+// Locally-ordered clustering of leaves given in Morton order (leaf_key);
+// returns the root's build id.
 std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
     const bool points = !(build.cone_weight > 0.0);
-    sort_morton(build.all, active, !points);
-    if (active.size() == build.all.size()) renumber_leaves(build, active);
     std::vector<std::uint32_t> best(active.size());
     std::vector<CostKey> keys;
     PointKeys point_keys, next_point_keys;
@@ -466,7 +456,7 @@ std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
 }
 
 std::uint32_t cluster_exact(Build& build, std::vector<std::uint32_t> active) {
-    std::vector<Cluster>& all = build.all;
+    UninitializedVector<Cluster>& all = build.all;
     const double inf = std::numeric_limits<double>::infinity();
     std::vector<std::uint32_t> best(active.size());
     std::vector<double> best_cost(active.size(), inf);
@@ -516,19 +506,32 @@ std::uint32_t cluster_exact(Build& build, std::vector<std::uint32_t> active) {
     return active[0];
 }
 
-// Writes the subtree of build id `id` into node slot `slot`: children take
-// two adjacent slots, lights are numbered in depth-first leaf order.
-void flatten(const std::vector<Cluster>& all, std::span<const gpu::Light> input, std::uint32_t root,
-             std::uint32_t type, std::uint32_t base_slot, LightTree& tree) {
+// Writes the tree of build id `root` into nodes [base_slot, base_slot + 2n - 1)
+// and its lights from tree.lights.size() on (both already sized). The root
+// takes base_slot; the two children of each interior node take the next
+// two free slots when a depth-first walk, left before right, reaches it;
+// lights are numbered in the walk's leaf order, so each node's lights are
+// a contiguous range.
+//
+// The walk's numbering follows from subtree sizes: a subtree of L leaves
+// takes 2(L - 1) slots below its root and L lights, so its right child's
+// subtree starts 2 L_left slots and L_left lights after its left child's.
+// The top of the tree is cut into subtrees that way, and threads walk them.
+void flatten(const UninitializedVector<Cluster>& all, std::size_t leaf_count, std::span<const gpu::Light> input,
+             std::uint32_t root, std::uint32_t type, std::uint32_t base_slot, std::uint32_t base_light,
+             LightTree& tree) {
     const std::uint32_t type_bits = type << gpu::kNodeTypeShift;
-    struct Item { std::uint32_t id, slot; };
-    std::vector<Item> stack{{root, base_slot}};
-    std::uint32_t next_slot = base_slot + 1;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> leaf_slots;  // (slot, input light)
-    // Depth-first, left before right, so leaves come out in light order.
-    while (!stack.empty()) {
-        Item it = stack.back();
-        stack.pop_back();
+    // Leaves per cluster: children have smaller build ids than their parent.
+    std::vector<std::uint32_t> leaves(all.size(), 1u);
+    for (std::size_t id = leaf_count; id < all.size(); ++id) leaves[id] = leaves[all[id].left] + leaves[all[id].right];
+    // Input light index -> leaf-order index, for the representatives.
+    std::vector<std::uint32_t> remap(input.size(), gpu::kInvalidIndex);
+
+    // A subtree to write: its root's build id and slot, the first slot of
+    // the pairs below it and its first light.
+    struct Item { std::uint32_t id, slot, pairs, light; };
+    // Writes cluster it.id into its slot; returns whether it has children.
+    auto write = [&](const Item& it) {
         const Cluster& c = all[it.id];
         gpu::LightNode& n = tree.nodes[it.slot];
         n.min_x = c.lo.x; n.min_y = c.lo.y; n.min_z = c.lo.z;
@@ -545,22 +548,63 @@ void flatten(const std::vector<Cluster>& all, std::span<const gpu::Light> input,
         if (c.left == gpu::kInvalidIndex) {
             n.left = gpu::kInvalidIndex;
             n.flags = gpu::kNodeLeaf | node_bits;
-            leaf_slots.emplace_back(it.slot, c.rep);
-        } else {
-            n.left = next_slot;
-            n.flags = (c.rep_from_right ? gpu::kNodeRepFromRight : 0u) | node_bits;
-            next_slot += 2;
-            stack.push_back({c.right, n.left + 1});
-            stack.push_back({c.left, n.left});
+            tree.lights[it.light] = input[c.rep];
+            remap[c.rep] = it.light;
+            return false;
         }
+        n.left = it.pairs;
+        n.flags = (c.rep_from_right ? gpu::kNodeRepFromRight : 0u) | node_bits;
+        return true;
+    };
+    auto children = [&](const Item& it) {
+        const Cluster& c = all[it.id];
+        const std::uint32_t l = leaves[c.left];
+        return std::pair<Item, Item>{{c.left, it.pairs, it.pairs + 2, it.light},
+                                     {c.right, it.pairs + 1, it.pairs + 2 * l, it.light + l}};
+    };
+
+    // The top: split the largest subtree until there are enough for the
+    // threads to share evenly.
+    const unsigned threads = thread_count(leaf_count);
+    std::vector<Item> tasks{{root, base_slot, base_slot + 1, base_light}};
+    const std::size_t wanted = threads == 1 ? 1 : 16 * std::size_t(threads);
+    while (tasks.size() < wanted) {
+        auto largest = std::max_element(tasks.begin(), tasks.end(), [&](const Item& x, const Item& y) {
+            return leaves[x.id] < leaves[y.id];
+        });
+        if (leaves[largest->id] < 2) break;
+        const Item it = *largest;
+        write(it);
+        auto [left, right] = children(it);
+        *largest = left;
+        tasks.push_back(right);
     }
-    // Input light index -> leaf-order index.
-    std::vector<std::uint32_t> remap(input.size(), gpu::kInvalidIndex);
-    for (auto [slot, light] : leaf_slots) {
-        remap[light] = static_cast<std::uint32_t>(tree.lights.size());
-        tree.lights.push_back(input[light]);
-    }
-    for (std::uint32_t s = base_slot; s < next_slot; ++s) tree.nodes[s].rep_light = remap[tree.nodes[s].rep_light];
+    std::atomic<std::size_t> next{0};
+    auto walk = [&] {
+        std::vector<Item> stack;
+        for (std::size_t t; (t = next.fetch_add(1)) < tasks.size();) {
+            stack.assign(1, tasks[t]);
+            while (!stack.empty()) {
+                const Item it = stack.back();
+                stack.pop_back();
+                if (!write(it)) continue;
+                auto [left, right] = children(it);
+                stack.push_back(right);
+                stack.push_back(left);
+            }
+        }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(walk);
+    walk();
+    for (auto& th : pool) th.join();
+    const std::size_t slots = 2 * leaf_count - 1;
+    parallel_for(slots, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t s = begin; s < end; ++s) {
+            gpu::LightNode& n = tree.nodes[base_slot + s];
+            n.rep_light = remap[n.rep_light];
+        }
+    });
 }
 
 }  // namespace
@@ -588,83 +632,102 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
     LightTree tree;
     reserve_huge(tree.lights, lights.size());
     reserve_huge(tree.nodes, 2 * lights.size());
-    for (const gpu::Light& l : lights) tree_point(l);  // unknown types fail before any work
+    // Unknown types fail before any work.
+    std::array<bool, gpu::kLightTypeCount> present{};
+    for (const gpu::Light& l : lights) {
+        tree_point(l);
+        present[l.type & gpu::kLightTypeMask] = true;
+    }
     for (std::uint32_t type = 0; type < gpu::kLightTypeCount; ++type) {
+        if (!present[type]) continue;
         Build build;
         build.seed = seed ^ type;
-        std::vector<Cluster>& all = build.all;
-        // The leaves, in light order: each thread makes those of its range
-        // of lights, then they are packed in order (black lights left out).
+        UninitializedVector<Cluster>& all = build.all;
         const auto of_type = [type](const gpu::Light& l) { return (l.type & gpu::kLightTypeMask) == type; };
-        const std::size_t type_count = std::size_t(std::count_if(lights.begin(), lights.end(), of_type));
-        if (type_count == 0) continue;
-        reserve_huge(all, 2 * type_count);
-        all.resize(type_count);
+        // Pass 1, each thread over its range of lights: how many leaves
+        // the range makes (black lights make none), and their box.
         const unsigned threads = thread_count(lights.size());
         std::vector<std::size_t> made(threads + 1, 0);  // leaves before each thread's range
-        std::vector<glm::vec3> range_lo(threads, glm::vec3(std::numeric_limits<float>::max()));
-        std::vector<glm::vec3> range_hi(threads, glm::vec3(-std::numeric_limits<float>::max()));
+        std::vector<glm::vec3> range_lo(threads), range_hi(threads);
         std::vector<std::size_t> range_black(threads, 0);
-        // Pass 1: lights of this type before each range, so each range
-        // writes where one pass in order would.
+        std::vector<char> range_cones(threads, 0);
         parallel_for_ranges(lights.size(), [&](std::size_t begin, std::size_t end, unsigned t) {
-            made[t + 1] = std::size_t(std::count_if(lights.begin() + std::ptrdiff_t(begin),
-                                                     lights.begin() + std::ptrdiff_t(end), of_type));
-        });
-        for (unsigned t = 0; t < threads; ++t) made[t + 1] += made[t];
-        std::vector<std::size_t> range_end(threads, 0);  // one past each range's last leaf
-        parallel_for_ranges(lights.size(), [&](std::size_t begin, std::size_t end, unsigned t) {
-            std::size_t out = made[t];
+            glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+            std::size_t count = 0, black = 0;
+            bool cones = false;
             for (std::size_t i = begin; i < end; ++i) {
-                const gpu::Light& l = lights[i];
-                if (!of_type(l)) continue;
-                Cluster& c = all[out];
-                c = Cluster{};
-                c.lo = c.hi = tree_point(l);
-                c.cone = quantized(EmissionCone::of_light(l), c.axis_packed);
-                c.intensity = glm::dvec3(l.r, l.g, l.b);
-                c.weight = gpu::lc_luminance(glm::vec3(l.r, l.g, l.b));
+                if (!of_type(lights[i])) continue;
+                const Cluster c = leaf_of(lights[i], i);
                 if (!(c.weight > 0.0)) {
-                    range_black[t] += 1;
+                    ++black;
                     continue;
                 }
-                c.rep = std::uint32_t(i);
-                range_lo[t] = glm::min(range_lo[t], c.lo);
-                range_hi[t] = glm::max(range_hi[t], c.hi);
-                ++out;
+                ++count;
+                lo = glm::min(lo, c.lo);
+                hi = glm::max(hi, c.hi);
+                cones = cones || !c.cone.emits_everywhere();
             }
-            range_end[t] = out;
+            made[t + 1] = count;
+            range_black[t] = black;
+            range_lo[t] = lo;
+            range_hi[t] = hi;
+            range_cones[t] = cones ? 1 : 0;
         });
-        // Pack the ranges together where black lights left gaps.
         glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-        std::size_t packed = 0;
+        bool has_cones = false;
         for (unsigned t = 0; t < threads; ++t) {
+            made[t + 1] += made[t];
             tree.black_lights += range_black[t];
             lo = glm::min(lo, range_lo[t]);
             hi = glm::max(hi, range_hi[t]);
-            if (packed != made[t])
-                std::copy(all.begin() + std::ptrdiff_t(made[t]), all.begin() + std::ptrdiff_t(range_end[t]),
-                          all.begin() + std::ptrdiff_t(packed));
-            packed += range_end[t] - made[t];
+            has_cones = has_cones || range_cones[t] != 0;
         }
-        all.resize(packed);
-        std::vector<std::uint32_t> leaves(packed);
-        std::iota(leaves.begin(), leaves.end(), 0u);
-        if (leaves.empty()) continue;
+        const std::size_t leaf_count = made[threads];
+        if (leaf_count == 0) continue;
         // Walter 2005 §4.1 sets c, which weighs directional against spatial
         // similarity, to the scene's diagonal; here the diagonal of this
         // tree's lights. Lights that emit everywhere have no cone term.
-        const bool has_cones = std::any_of(leaves.begin(), leaves.end(),
-                                           [&](std::uint32_t id) { return !all[id].cone.emits_everywhere(); });
         if (has_cones)
             build.cone_weight = cone_scale * cone_scale * glm::dot(glm::dvec3(hi - lo), glm::dvec3(hi - lo));
-        std::uint32_t root = builder == TreeBuilder::kExact ? cluster_exact(build, leaves) : cluster_fast(build, leaves);
-        auto base = static_cast<std::uint32_t>(tree.nodes.size());
-        tree.nodes.resize(tree.nodes.size() + 2 * leaves.size() - 1);
+        // Pass 2: the leaves' lights in light order, each with its Morton
+        // key where the fast builder will sort them.
+        const bool sorted = builder == TreeBuilder::kFast;
+        const bool with_axis = build.cone_weight > 0.0;
+        const glm::vec3 extent = glm::max(hi - lo, glm::vec3(1e-30f));
+        std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
+        reserve_huge(keyed, leaf_count);
+        keyed.resize(leaf_count);
+        parallel_for_ranges(lights.size(), [&](std::size_t begin, std::size_t end, unsigned t) {
+            std::size_t out = made[t];
+            for (std::size_t i = begin; i < end; ++i) {
+                if (!of_type(lights[i])) continue;
+                const Cluster c = leaf_of(lights[i], i);
+                if (!(c.weight > 0.0)) continue;
+                keyed[out++] = {sorted ? leaf_key(c, lo, extent, with_axis) : 0u, std::uint32_t(i)};
+            }
+        });
+        // Pass 3: the leaves, build ids 0, 1, ... in that order. Sorted, the
+        // windows of the first round, the merges and flatten() read
+        // neighbouring clusters from neighbouring memory (the input order of
+        // a light file is arbitrary).
+        if (sorted) parallel_sort(keyed);
+        reserve_huge(all, 2 * leaf_count);
+        all.resize(leaf_count);
+        parallel_for(leaf_count, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t k = begin; k < end; ++k) all[k] = leaf_of(lights[keyed[k].second], keyed[k].second);
+        });
+        keyed = {};
+        std::vector<std::uint32_t> leaves(leaf_count);
+        std::iota(leaves.begin(), leaves.end(), 0u);
+        std::uint32_t root = builder == TreeBuilder::kExact ? cluster_exact(build, std::move(leaves))
+                                                                : cluster_fast(build, std::move(leaves));
+        const auto base = static_cast<std::uint32_t>(tree.nodes.size());
+        const auto base_light = static_cast<std::uint32_t>(tree.lights.size());
+        tree.nodes.resize(tree.nodes.size() + 2 * leaf_count - 1);
+        tree.lights.resize(tree.lights.size() + leaf_count);
         tree.roots[type] = base;
-        // flatten() numbers lights from tree.lights.size() on, so the light
-        // indices of each tree follow those of the one before.
-        flatten(all, lights, root, type, base, tree);
+        // The light indices of each tree follow those of the one before.
+        flatten(all, leaf_count, lights, root, type, base, base_light, tree);
     }
     tree.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return tree;

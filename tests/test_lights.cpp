@@ -152,7 +152,7 @@ TEST(EmissionBound, ConeUnionAndPackingHoldTheirInputs) {
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     auto angle = [](glm::vec3 a, glm::vec3 b) { return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b)); };
     for (int trial = 0; trial < 100000; ++trial) {
-        EmissionCone a, b;
+        EmissionCone a = EmissionCone::everywhere(), b = EmissionCone::everywhere();
         a.axis = random_unit(rng);
         b.axis = random_unit(rng);
         a.theta_o = u(rng) < 0.3f ? 0.0f : kPi * u(rng) * u(rng);

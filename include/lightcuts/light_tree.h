@@ -5,20 +5,52 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <new>
 #include <span>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "shared/types.h"
 
 namespace lc {
 
+// std::allocator, except that an element made without a value is
+// default-initialized: resize() of a vector of plain structs leaves the new
+// elements unwritten. The tree builder's threads then write them, and fault
+// their pages in, side by side, instead of one thread zeroing gigabytes first.
+template <typename T>
+struct DefaultInitAllocator : std::allocator<T> {
+    template <typename U>
+    struct rebind {
+        using other = DefaultInitAllocator<U>;
+    };
+    DefaultInitAllocator() noexcept = default;
+    template <typename U>
+    DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+
+    template <typename U>
+    void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <typename U, typename... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+
+// A vector whose resize() does not zero plain structs (DefaultInitAllocator).
+template <typename T>
+using UninitializedVector = std::vector<T, DefaultInitAllocator<T>>;
+
 struct LightTree {
     // One tree per light type that has lights, one after the other in type
     // order (2n-1 nodes each); roots[type] is where each starts. Lights are
     // in leaf order, so a node's lights are a contiguous range; nodes'
     // rep_light index into `lights`.
-    std::vector<gpu::LightNode> nodes;
-    std::vector<gpu::Light> lights;
+    UninitializedVector<gpu::LightNode> nodes;
+    UninitializedVector<gpu::Light> lights;
     std::array<std::uint32_t, gpu::kLightTypeCount> roots;
     // Lights with zero intensity: left out of the tree (they would only
     // widen the boxes of bright clusters) and out of `lights`.
