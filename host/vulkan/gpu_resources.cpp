@@ -102,8 +102,8 @@ std::string mib(VkDeviceSize bytes) {
 GpuResources::GpuResources(const Context& ctx, Submitter& submitter,
                            const std::vector<SceneArray>& scene, const ShadingMethod& method,
                            std::uint64_t image_pixels, std::uint32_t max_tile_pixels,
-                           std::uint64_t split_bytes, bool texel_reads)
-    : ctx_(ctx), submitter_(submitter), split_bytes_(split_bytes) {
+                           std::uint64_t split_bytes, bool texel_reads, bool chunk_buffers)
+    : ctx_(ctx), submitter_(submitter), split_bytes_(split_bytes), chunk_buffers_(chunk_buffers) {
     const VkPhysicalDeviceLimits& limits = ctx.properties().limits;
     max_buffer_ = std::min<VkDeviceSize>(limits.maxStorageBufferRange, ctx.max_allocation_size());
     upload_scene(scene);
@@ -169,9 +169,11 @@ void GpuResources::upload(const std::string& name, const void* data, VkDeviceSiz
 
 // The array in one device-local buffer if it fits one (maxStorageBufferRange,
 // maxMemoryAllocationSize and the forced split size), else in chunks of the
-// largest power of two of elements that does, each its own buffer, read by
-// the kernels through its device address. An empty array gets one zeroed
-// element so that every binding has a buffer.
+// largest power of two of elements that does, read by the kernels through
+// their device addresses. The chunks are windows of one buffer where the
+// whole array fits one allocation (a texel view can then still cover it),
+// else each its own buffer (and always with `chunk_buffers_`). An empty
+// array gets one zeroed element so that every binding has a buffer.
 std::vector<Buffer> GpuResources::upload_chunks(const SceneArray& array, std::uint32_t binding) {
     const std::vector<unsigned char> zero_element(array.count == 0 ? array.element_bytes : 0);
     const auto* source = static_cast<const unsigned char*>(array.count == 0 ? zero_element.data() : array.data);
@@ -189,27 +191,35 @@ std::vector<Buffer> GpuResources::upload_chunks(const SceneArray& array, std::ui
         while (shift < 30 && (VkDeviceSize(2) << shift) * element <= limit) ++shift;
     }
     const std::uint64_t per_chunk = std::uint64_t(1) << shift;
+    const std::uint64_t chunk_count = (count + per_chunk - 1) / per_chunk;
     if (binding < gpu::kSceneArrayCount) chunks_.shift[binding] = shift;
+    if (chunk_count > 1) chunks_.split = true;
+    chunk_counts_.push_back(chunk_count);
+    first_chunk_bytes_.push_back(std::min(per_chunk, count) * element);
+    buffer_bytes_.emplace_back(name, bytes);
 
     const VkBufferUsageFlags usage =
         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
         VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
         (has_texel_view(binding) ? VkBufferUsageFlags(VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT) : VkBufferUsageFlags(0));
-    std::vector<Buffer> chunks;
+    std::vector<Buffer> buffers;
+    if (chunk_count > 1 && !chunk_buffers_ && bytes <= ctx_.max_allocation_size()) {
+        Buffer buffer(ctx_.device(), ctx_.memory(), bytes, usage, MemoryUse::kDevice, name);
+        upload(name, source, bytes, buffer);
+        buffers.push_back(std::move(buffer));
+        return buffers;
+    }
     for (std::uint64_t first = 0; first < count; first += per_chunk) {
         const VkDeviceSize chunk_bytes = std::min(per_chunk, count - first) * element;
-        const std::string chunk_name =
-            per_chunk >= count ? name : name + " chunk " + std::to_string(chunks.size());
+        const std::string chunk_name = chunk_count == 1 ? name : name + " chunk " + std::to_string(buffers.size());
         // Still refuses an array that cannot be split (the frame constants)
         // or whose single element is larger than a buffer may be.
         check_fits(chunk_name, chunk_bytes);
         Buffer buffer(ctx_.device(), ctx_.memory(), chunk_bytes, usage, MemoryUse::kDevice, chunk_name);
         upload(chunk_name, source + first * element, chunk_bytes, buffer);
-        chunks.push_back(std::move(buffer));
+        buffers.push_back(std::move(buffer));
     }
-    if (chunks.size() > 1) chunks_.split = true;
-    buffer_bytes_.emplace_back(name, bytes);
-    return chunks;
+    return buffers;
 }
 
 void GpuResources::upload_scene(const std::vector<SceneArray>& scene) {
@@ -222,12 +232,18 @@ void GpuResources::upload_scene(const std::vector<SceneArray>& scene) {
 // chunk 0 in the address list, then the device address of every chunk.
 void GpuResources::create_chunk_table() {
     std::vector<std::uint32_t> words(gpu::kSceneArrayCount);
+    const auto address_of = [&](const Buffer& buffer) {
+        auto info = vk_struct<VkBufferDeviceAddressInfo>(VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO);
+        info.buffer = buffer.get();
+        return ctx_.fn().vkGetBufferDeviceAddress(ctx_.device().get(), &info);
+    };
     for (std::uint32_t b = 0; b < gpu::kSceneArrayCount; ++b) {
         words[b] = std::uint32_t((words.size() - gpu::kSceneArrayCount) / 2);
-        for (const Buffer& chunk : scene_[b]) {
-            auto info = vk_struct<VkBufferDeviceAddressInfo>(VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO);
-            info.buffer = chunk.get();
-            const VkDeviceAddress address = ctx_.fn().vkGetBufferDeviceAddress(ctx_.device().get(), &info);
+        for (std::uint64_t c = 0; c < chunk_counts_[b]; ++c) {
+            // Chunk c: buffer c, or the window c of the array's one buffer.
+            const bool windows = scene_[b].size() == 1;
+            const VkDeviceAddress address =
+                windows ? address_of(scene_[b][0]) + c * first_chunk_bytes_[b] : address_of(scene_[b][c]);
             words.push_back(std::uint32_t(address));
             words.push_back(std::uint32_t(address >> 32));
         }
@@ -238,11 +254,13 @@ void GpuResources::create_chunk_table() {
     upload("chunk addresses", words.data(), bytes, chunk_table_);
 }
 
-// Texel views can cover the four arrays: none is split (a view sees one
-// buffer), each is within maxTexelBufferElements, and the format can be a
-// uniform texel buffer (the spec makes RGBA32UI's support mandatory).
+// Texel views can cover the four arrays: each is in one buffer (a view sees
+// one buffer; chunks that are windows of one buffer are fine), each is
+// within maxTexelBufferElements, and the format can be a uniform texel
+// buffer (the spec makes RGBA32UI's support mandatory).
 bool GpuResources::texel_views_fit() const {
-    if (chunks_.split) return false;
+    for (const TexelArray& a : kTexelArrays)
+        if (scene_[a.binding].size() > 1) return false;
     VkFormatProperties format{};
     vkGetPhysicalDeviceFormatProperties(ctx_.physical(), kTexelFormat, &format);
     if (!(format.bufferFeatures & VK_FORMAT_FEATURE_UNIFORM_TEXEL_BUFFER_BIT)) return false;
@@ -384,7 +402,8 @@ void GpuResources::create_descriptors() {
         const Buffer& buffer = b < gpu::kBindingGBuffer    ? scene_[b][0]
                                : b == gpu::kBindingChunkTable ? chunk_table_
                                                               : tile_[b - gpu::kBindingGBuffer];
-        infos[b] = {buffer.get(), 0, VK_WHOLE_SIZE};
+        // A scene array's binding sees its chunk 0 (within maxStorageBufferRange).
+        infos[b] = {buffer.get(), 0, b < gpu::kSceneArrayCount ? first_chunk_bytes_[b] : VK_WHOLE_SIZE};
         writes[b] = write(b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
         writes[b].pBufferInfo = &infos[b];
     }

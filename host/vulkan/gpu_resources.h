@@ -32,14 +32,16 @@ public:
     // `max_tile_pixels`, 0: no cap), and binds everything. Throws naming
     // the buffer, its size and the device limit when something cannot fit.
     // A scene array larger than one buffer may be (or than `split_bytes`, if
-    // not 0) is split into chunks of 2^k elements, each its own buffer.
+    // not 0) is split into chunks of 2^k elements: windows of one buffer
+    // where the array fits one allocation and not `chunk_buffers`, else
+    // each its own buffer.
     // `texel_reads`: let the kernels read the BVH nodes, triangles, lights
     // and light-tree nodes through texel views, where the device allows
     // (texel_reads() says whether it did).
     GpuResources(const Context& ctx, Submitter& submitter, const std::vector<SceneArray>& scene,
                  const ShadingMethod& method, std::uint64_t image_pixels,
                  std::uint32_t max_tile_pixels, std::uint64_t split_bytes = 0,
-                 bool texel_reads = false);
+                 bool texel_reads = false, bool chunk_buffers = false);
 
     const TileLayout& tiles() const { return tiles_; }
     // How the scene arrays were split, for the kernels' specialization.
@@ -47,8 +49,10 @@ public:
     // The texel views cover the four arrays (kBindingBvhNodeTexels ..): the
     // kernels may read them there.
     bool texel_reads() const { return texel_reads_; }
-    // Chunks of the scene array at `binding` (1 where it fits one buffer).
-    std::size_t chunk_count(std::uint32_t binding) const { return scene_[binding].size(); }
+    // Chunks of the scene array at `binding` (1 where it fits one buffer),
+    // and the buffers that hold them (1, or one per chunk).
+    std::size_t chunk_count(std::uint32_t binding) const { return chunk_counts_[binding]; }
+    std::size_t chunk_buffer_count(std::uint32_t binding) const { return scene_[binding].size(); }
     VkDescriptorSet descriptor_set() const { return descriptor_set_; }
     VkPipelineLayout pipeline_layout() const { return pipeline_layout_.get(); }
 
@@ -93,6 +97,7 @@ private:
     Submitter& submitter_;
     VkDeviceSize max_buffer_ = 0;  // min(maxStorageBufferRange, maxMemoryAllocationSize)
     VkDeviceSize split_bytes_ = 0;  // a smaller chunk size forced by Tuning (0: none)
+    bool chunk_buffers_ = false;    // every chunk its own buffer (Tuning::chunk_buffers)
     SceneChunks chunks_;
     bool texel_reads_ = false;
     TileLayout tiles_;
@@ -102,6 +107,10 @@ private:
     // Bindings kBindingBvhNodes .. kBindingFrame, each one or more chunks
     // (chunk 0 is what the binding holds).
     std::vector<std::vector<Buffer>> scene_;
+    // Per binding (scene arrays, then the frame constants): chunks, and the
+    // bytes of chunk 0 (the range the binding sees).
+    std::vector<std::uint64_t> chunk_counts_;
+    std::vector<VkDeviceSize> first_chunk_bytes_;
     Buffer chunk_table_;                        // binding kBindingChunkTable
     // Bindings kBindingBvhNodeTexels ..: over the whole array where
     // texel_reads_, else over its first texel (the kernels do not read them,

@@ -50,18 +50,24 @@ struct Tuning {
     // otherwise done only for arrays larger than one buffer may be (0: no
     // forced split), so that small scenes test the split.
     std::uint64_t split_bytes = 0;
+    // Keep each chunk of a split array in a buffer of its own even where
+    // the whole array fits one allocation (whose windows the chunks are
+    // otherwise, so that texel views can still cover it): the path of
+    // arrays larger than an allocation, for tests.
+    bool chunk_buffers = false;
 
     // Read the BVH nodes, triangles, lights and light-tree nodes through
     // uniform texel buffers instead of storage buffers. kAuto: on CPU
     // devices (lavapipe), where it measured faster (docs/results/lavapipe.md);
     // GPUs keep storage buffers until it is measured there. Either way only
-    // where no scene array is split and each fits maxTexelBufferElements.
+    // where each of the four arrays is in one buffer (split or not) and
+    // fits maxTexelBufferElements.
     enum class TexelReads { kAuto, kOn, kOff };
     TexelReads texel_reads = TexelReads::kAuto;
 
     // LC_VK_FORCE_FEATURES=ggx,shadows,oriented,textures,disney,sheen,clearcoat (or all), LC_VK_MAX_TILE_PIXELS=N, LC_VK_TARGET_MS=X,
     // LC_VK_LIGHTS_PER_DISPATCH=N, LC_VK_REFINEMENTS_PER_DISPATCH=N, LC_VK_SPLIT_BYTES=N,
-    // LC_VK_TEXEL_READS=on|off.
+    // LC_VK_CHUNK_BUFFERS=1, LC_VK_TEXEL_READS=on|off.
     static Tuning from_environment();
 };
 

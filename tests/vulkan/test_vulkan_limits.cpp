@@ -175,14 +175,20 @@ TEST_F(Vulkan, LoopLimitSplitsBruteForceAutomatically) {
 // Scene arrays larger than a buffer may be are split into chunks, read
 // through their device addresses (docs/vulkan.md). Forced here at 256
 // bytes, so every array of a small scene has several chunks (lights: 5
-// per chunk, light-tree nodes and BVH nodes a few each): the images are
-// those of the CPU reference within the usual tolerances, for every
-// method, as without a split.
+// per chunk, light-tree nodes and BVH nodes a few each), both as windows of
+// one buffer per array (where the array fits one allocation; storage-buffer
+// and texel reads) and as one buffer per chunk (the arrays larger than an
+// allocation): the images are those of the CPU reference within the usual
+// tolerances, for every method, as without a split.
 TEST_F(Vulkan, SceneArraysSplitIntoChunksMatchTheCpu) {
     const PreparedScene p = prepare_scene(random_scene(66, 60, 2, 12, 10), 1);
-    vk::Tuning split;
-    split.split_bytes = 256;
-    check_setups(p, {split}, [](const vk::RenderSetup& setup) {
+    vk::Tuning windows, windows_texels, buffers;
+    windows.split_bytes = windows_texels.split_bytes = buffers.split_bytes = 256;
+    windows.texel_reads = vk::Tuning::TexelReads::kOff;
+    windows_texels.texel_reads = vk::Tuning::TexelReads::kOn;
+    buffers.chunk_buffers = true;
+    std::vector<std::size_t> light_buffers;
+    check_setups(p, {windows, windows_texels, buffers}, [&](const vk::RenderSetup& setup) {
         EXPECT_TRUE(setup.resources.chunks().split);
         for (std::uint32_t b : {gpu::kBindingBvhNodes, gpu::kBindingTriangles, gpu::kBindingNormals,
                                 gpu::kBindingLights, gpu::kBindingLightNodes}) {
@@ -191,36 +197,46 @@ TEST_F(Vulkan, SceneArraysSplitIntoChunksMatchTheCpu) {
             EXPECT_LE(setup.resources.chunks().shift[b], 3u);  // at most 8 elements of >= 32 bytes
         }
         EXPECT_EQ(setup.resources.chunk_count(gpu::kBindingFrame), 1u);  // never split
+        light_buffers.push_back(setup.resources.chunk_buffer_count(gpu::kBindingLights));
     });
+    ASSERT_EQ(light_buffers.size(), 3u);
+    EXPECT_EQ(light_buffers[0], 1u);
+    EXPECT_EQ(light_buffers[1], 1u);
+    EXPECT_GT(light_buffers[2], 2u);
     for (const char* method : {"brute", "lightcuts", "sampled"}) {
         SCOPED_TRACE(method);
         RenderOptions o = options(method, 12, 10);
         const RenderResult whole = gpu(p, o);
-        const RenderResult chunked = gpu(p, o, split);
-        // The same kernels read the same values: the images are identical.
-        EXPECT_EQ(max_relative_difference(chunked.image, whole.image, std::string("split ") + method, 0.0),
-                  0.0);
-        if (std::string(method) == "brute") expect_brute_matches(p, o, chunked);
-        if (std::string(method) == "lightcuts") expect_lightcuts_matches(p, o, chunked);
+        for (const vk::Tuning* split : {&windows, &windows_texels, &buffers}) {
+            const RenderResult chunked = gpu(p, o, *split);
+            // The same kernels read the same values: the images are identical.
+            EXPECT_EQ(max_relative_difference(chunked.image, whole.image, std::string("split ") + method, 0.0),
+                      0.0);
+            if (std::string(method) == "brute") expect_brute_matches(p, o, chunked);
+            if (std::string(method) == "lightcuts") expect_lightcuts_matches(p, o, chunked);
+        }
     }
 }
 
 // The BVH nodes, triangles, lights and light-tree nodes can be read through
 // uniform texel buffers instead of storage buffers (Tuning::texel_reads;
 // the default on CPU devices). The same kernels read the same bits: the
-// images are identical for every method, and a split scene, which a texel
-// view cannot cover, falls back to the storage buffers.
+// images are identical for every method. A split scene keeps the texel
+// reads while each array's chunks are windows of one buffer, and falls
+// back to the storage buffers where they are buffers of their own, which a
+// texel view cannot cover.
 TEST_F(Vulkan, TexelReadsGiveTheImagesOfStorageBufferReads) {
     const PreparedScene p = prepare_scene(random_scene(67, 60, 2, 12, 10), 1);
-    vk::Tuning texels, buffers, split;
+    vk::Tuning texels, buffers, split, split_buffers;
     texels.texel_reads = vk::Tuning::TexelReads::kOn;
     buffers.texel_reads = vk::Tuning::TexelReads::kOff;
-    split.texel_reads = vk::Tuning::TexelReads::kOn;
-    split.split_bytes = 256;
+    split.texel_reads = split_buffers.texel_reads = vk::Tuning::TexelReads::kOn;
+    split.split_bytes = split_buffers.split_bytes = 256;
+    split_buffers.chunk_buffers = true;
     std::vector<bool> reads;
-    check_setups(p, {texels, buffers, split},
+    check_setups(p, {texels, buffers, split, split_buffers},
                  [&](const vk::RenderSetup& setup) { reads.push_back(setup.resources.texel_reads()); });
-    EXPECT_EQ(reads, (std::vector<bool>{true, false, false}));
+    EXPECT_EQ(reads, (std::vector<bool>{true, false, true, false}));
     for (const char* method : {"brute", "lightcuts", "sampled", "stochastic"}) {
         SCOPED_TRACE(method);
         const RenderOptions o = options(method, 12, 10);
