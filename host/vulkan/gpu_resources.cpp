@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
+#include <thread>
+#include <vector>
 
 #include "vk_check.h"
 
@@ -148,7 +150,20 @@ Buffer GpuResources::storage_buffer(const std::string& name, VkDeviceSize bytes,
 // GPUs), through a staging buffer and a copy otherwise.
 void GpuResources::upload(const std::string& name, const void* data, VkDeviceSize bytes, Buffer& buffer) {
     if (buffer.mapped()) {
-        std::memcpy(buffer.mapped(), data, bytes);
+        // Large arrays (the lights and nodes of millions of lights) are
+        // fresh memory to fault in as much as bytes to copy: every core
+        // takes a share.
+        const auto* from = static_cast<const unsigned char*>(data);
+        auto* to = static_cast<unsigned char*>(buffer.mapped());
+        const unsigned threads = bytes < (VkDeviceSize(64) << 20) ? 1u : std::max(1u, std::thread::hardware_concurrency());
+        const VkDeviceSize share = (bytes + threads - 1) / threads;
+        std::vector<std::thread> pool;
+        for (unsigned t = 1; t < threads; ++t) {
+            const VkDeviceSize begin = std::min(bytes, t * share), end = std::min(bytes, begin + share);
+            pool.emplace_back([=] { std::memcpy(to + begin, from + begin, end - begin); });
+        }
+        std::memcpy(to, from, std::min(bytes, share));
+        for (std::thread& th : pool) th.join();
         return;
     }
     Buffer staging(ctx_.device(), ctx_.memory(), bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
