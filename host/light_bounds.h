@@ -21,7 +21,7 @@ namespace lc {
 // of_light().
 struct EmissionCone {
     glm::vec3 axis;        // as the kernels decode it (see quantized())
-    float theta_o;         // pi: the axes can point anywhere
+    float theta_o;         // spread of the axes; pi: they can point anywhere
     float theta_e;
     bool two_sided;
     // Spots: the smallest max(1e-3, cos inner - cos outer) of the lights

@@ -507,7 +507,7 @@ std::uint32_t cluster_exact(Build& build, std::vector<std::uint32_t> active) {
 }
 
 // Writes the tree of build id `root` into nodes [base_slot, base_slot + 2n - 1)
-// and its lights from tree.lights.size() on (both already sized). The root
+// and its lights into [base_light, base_light + n) (both already sized). The root
 // takes base_slot; the two children of each interior node take the next
 // two free slots when a depth-first walk, left before right, reaches it;
 // lights are numbered in the walk's leaf order, so each node's lights are
@@ -648,7 +648,9 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
         // the range makes (black lights make none), and their box.
         const unsigned threads = thread_count(lights.size());
         std::vector<std::size_t> made(threads + 1, 0);  // leaves before each thread's range
-        std::vector<glm::vec3> range_lo(threads), range_hi(threads);
+        // A thread whose range is empty never runs: its box stays empty.
+        std::vector<glm::vec3> range_lo(threads, glm::vec3(std::numeric_limits<float>::max()));
+        std::vector<glm::vec3> range_hi(threads, glm::vec3(-std::numeric_limits<float>::max()));
         std::vector<std::size_t> range_black(threads, 0);
         std::vector<char> range_cones(threads, 0);
         parallel_for_ranges(lights.size(), [&](std::size_t begin, std::size_t end, unsigned t) {

@@ -148,13 +148,14 @@ Buffer GpuResources::storage_buffer(const std::string& name, VkDeviceSize bytes,
 // Fills a device-local buffer with `bytes` bytes from `data`: through the
 // mapping where the device memory is host-visible (lavapipe, integrated
 // GPUs), through a staging buffer and a copy otherwise.
-void GpuResources::upload(const std::string& name, const void* data, VkDeviceSize bytes, Buffer& buffer) {
+void GpuResources::upload(const std::string& name, const void* data, VkDeviceSize bytes, Buffer& buffer,
+                          VkDeviceSize offset) {
     if (buffer.mapped()) {
         // Large arrays (the lights and nodes of millions of lights) are
         // fresh memory to fault in as much as bytes to copy: every core
         // takes a share.
         const auto* from = static_cast<const unsigned char*>(data);
-        auto* to = static_cast<unsigned char*>(buffer.mapped());
+        auto* to = static_cast<unsigned char*>(buffer.mapped()) + offset;
         const unsigned threads = bytes < (VkDeviceSize(64) << 20) ? 1u : std::max(1u, std::thread::hardware_concurrency());
         const VkDeviceSize share = (bytes + threads - 1) / threads;
         std::vector<std::thread> pool;
@@ -170,7 +171,7 @@ void GpuResources::upload(const std::string& name, const void* data, VkDeviceSiz
                    MemoryUse::kUpload, name + " staging");
     std::memcpy(staging.mapped(), data, bytes);
     VkCommandBuffer cmd = submitter_.begin();
-    VkBufferCopy region{0, 0, bytes};
+    VkBufferCopy region{0, offset, bytes};
     ctx_.fn().vkCmdCopyBuffer(cmd, staging.get(), buffer.get(), 1, &region);
     // The kernels read what the copy wrote.
     auto barrier = vk_struct<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
@@ -218,9 +219,16 @@ std::vector<Buffer> GpuResources::upload_chunks(const SceneArray& array, std::ui
         VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
         (has_texel_view(binding) ? VkBufferUsageFlags(VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT) : VkBufferUsageFlags(0));
     std::vector<Buffer> buffers;
-    if (chunk_count > 1 && !chunk_buffers_ && bytes <= ctx_.max_allocation_size()) {
+    // The allocation may round the buffer's size up to its alignment: keep
+    // a margin below maxMemoryAllocationSize.
+    constexpr VkDeviceSize kAllocationMargin = VkDeviceSize(1) << 16;
+    if (chunk_count > 1 && !chunk_buffers_ && bytes + kAllocationMargin <= ctx_.max_allocation_size()) {
         Buffer buffer(ctx_.device(), ctx_.memory(), bytes, usage, MemoryUse::kDevice, name);
-        upload(name, source, bytes, buffer);
+        // Chunk by chunk, so that a staging buffer holds one chunk at a time.
+        for (std::uint64_t first = 0; first < count; first += per_chunk) {
+            const VkDeviceSize chunk_bytes = std::min(per_chunk, count - first) * element;
+            upload(name, source + first * element, chunk_bytes, buffer, first * element);
+        }
         buffers.push_back(std::move(buffer));
         return buffers;
     }

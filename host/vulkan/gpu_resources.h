@@ -80,7 +80,8 @@ private:
     Buffer storage_buffer(const std::string& name, VkDeviceSize bytes, MemoryUse use,
                           VkBufferUsageFlags extra_usage = 0);
     void check_fits(const std::string& name, VkDeviceSize bytes) const;
-    void upload(const std::string& name, const void* data, VkDeviceSize bytes, Buffer& buffer);
+    void upload(const std::string& name, const void* data, VkDeviceSize bytes, Buffer& buffer,
+                VkDeviceSize offset = 0);
     std::vector<Buffer> upload_chunks(const SceneArray& array, std::uint32_t binding);
     void upload_scene(const std::vector<SceneArray>& scene);
     void create_chunk_table();
@@ -104,8 +105,9 @@ private:
     std::vector<std::pair<std::string, std::uint64_t>> buffer_bytes_;
 
     // Destroyed in reverse: layouts and descriptors before the buffers.
-    // Bindings kBindingBvhNodes .. kBindingFrame, each one or more chunks
-    // (chunk 0 is what the binding holds).
+    // Bindings kBindingBvhNodes .. kBindingFrame, each one buffer (whose
+    // windows the chunks of a split array are) or one buffer per chunk;
+    // the binding holds chunk 0.
     std::vector<std::vector<Buffer>> scene_;
     // Per binding (scene arrays, then the frame constants): chunks, and the
     // bytes of chunk 0 (the range the binding sees).
