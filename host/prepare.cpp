@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include <chrono>
 
@@ -133,7 +134,13 @@ gpu::FrameParams make_frame_params(const PreparedScene& prepared, const RenderOp
 
 std::vector<SceneArray> scene_arrays(const PreparedScene& p) {
     auto array = [](const char* name, const auto& v) {
-        return SceneArray{name, v.data(), sizeof(v[0]), v.size()};
+        using Vector = std::decay_t<decltype(v)>;
+        using Allocator = typename Vector::allocator_type;
+        SceneArray a{name, v.data(), sizeof(v[0]), v.size()};
+        if constexpr (std::is_same_v<Allocator, DefaultInitAllocator<typename Vector::value_type>>) {
+            if (v.capacity() * sizeof(v[0]) >= Allocator::kPagedFrom) a.page_bytes = Allocator::allocation_bytes(v.capacity());
+        }
+        return a;
     };
     return {
         array("bvh_nodes", p.bvh.nodes),

@@ -1,6 +1,7 @@
 #include "gpu_resources.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
@@ -104,8 +105,13 @@ std::string mib(VkDeviceSize bytes) {
 GpuResources::GpuResources(const Context& ctx, Submitter& submitter,
                            const std::vector<SceneArray>& scene, const ShadingMethod& method,
                            std::uint64_t image_pixels, std::uint32_t max_tile_pixels,
-                           std::uint64_t split_bytes, bool texel_reads, bool chunk_buffers)
-    : ctx_(ctx), submitter_(submitter), split_bytes_(split_bytes), chunk_buffers_(chunk_buffers) {
+                           std::uint64_t split_bytes, bool texel_reads, bool chunk_buffers,
+                           bool host_import)
+    : ctx_(ctx),
+      submitter_(submitter),
+      split_bytes_(split_bytes),
+      chunk_buffers_(chunk_buffers),
+      host_import_(host_import) {
     const VkPhysicalDeviceLimits& limits = ctx.properties().limits;
     max_buffer_ = std::min<VkDeviceSize>(limits.maxStorageBufferRange, ctx.max_allocation_size());
     upload_scene(scene);
@@ -222,6 +228,18 @@ std::vector<Buffer> GpuResources::upload_chunks(const SceneArray& array, std::ui
     // The allocation may round the buffer's size up to its alignment: keep
     // a margin below maxMemoryAllocationSize.
     constexpr VkDeviceSize kAllocationMargin = VkDeviceSize(1) << 16;
+    // Where the device can use the array's host memory in place (a CPU
+    // device; an array that owns whole pages), it does: no copy.
+    const VkDeviceSize align = host_import_ ? ctx_.host_import_alignment() : 0;
+    imported_.push_back(align > 0 && array.count > 0 && array.page_bytes > 0 &&
+                        reinterpret_cast<std::uintptr_t>(array.data) % align == 0 &&
+                        (bytes + align - 1) / align * align <= array.page_bytes &&
+                        bytes + kAllocationMargin <= ctx_.max_allocation_size() &&
+                        !(chunk_count > 1 && chunk_buffers_));
+    if (imported_.back()) {
+        buffers.emplace_back(ctx_.device(), ctx_.memory(), array.data, bytes, array.page_bytes, align, usage, name);
+        return buffers;
+    }
     if (chunk_count > 1 && !chunk_buffers_ && bytes + kAllocationMargin <= ctx_.max_allocation_size()) {
         Buffer buffer(ctx_.device(), ctx_.memory(), bytes, usage, MemoryUse::kDevice, name);
         // Chunk by chunk, so that a staging buffer holds one chunk at a time.

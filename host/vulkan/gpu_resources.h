@@ -31,6 +31,8 @@ public:
     // `method` and an image of `image_pixels` (tiles of at most
     // `max_tile_pixels`, 0: no cap), and binds everything. Throws naming
     // the buffer, its size and the device limit when something cannot fit.
+    // Large scene arrays that own whole pages of host memory are used in
+    // place on a CPU device that can import host memory (`host_import`).
     // A scene array larger than one buffer may be (or than `split_bytes`, if
     // not 0) is split into chunks of 2^k elements: windows of one buffer
     // where the array fits one allocation and not `chunk_buffers`, else
@@ -41,7 +43,7 @@ public:
     GpuResources(const Context& ctx, Submitter& submitter, const std::vector<SceneArray>& scene,
                  const ShadingMethod& method, std::uint64_t image_pixels,
                  std::uint32_t max_tile_pixels, std::uint64_t split_bytes = 0,
-                 bool texel_reads = false, bool chunk_buffers = false);
+                 bool texel_reads = false, bool chunk_buffers = false, bool host_import = true);
 
     const TileLayout& tiles() const { return tiles_; }
     // How the scene arrays were split, for the kernels' specialization.
@@ -53,6 +55,8 @@ public:
     // and the buffers that hold them (1, or one per chunk).
     std::size_t chunk_count(std::uint32_t binding) const { return chunk_counts_[binding]; }
     std::size_t chunk_buffer_count(std::uint32_t binding) const { return scene_[binding].size(); }
+    // The scene array at `binding` is read where it is in host memory.
+    bool imported(std::uint32_t binding) const { return imported_[binding]; }
     VkDescriptorSet descriptor_set() const { return descriptor_set_; }
     VkPipelineLayout pipeline_layout() const { return pipeline_layout_.get(); }
 
@@ -99,6 +103,7 @@ private:
     VkDeviceSize max_buffer_ = 0;  // min(maxStorageBufferRange, maxMemoryAllocationSize)
     VkDeviceSize split_bytes_ = 0;  // a smaller chunk size forced by Tuning (0: none)
     bool chunk_buffers_ = false;    // every chunk its own buffer (Tuning::chunk_buffers)
+    bool host_import_ = true;       // Tuning::host_import
     SceneChunks chunks_;
     bool texel_reads_ = false;
     TileLayout tiles_;
@@ -113,6 +118,7 @@ private:
     // bytes of chunk 0 (the range the binding sees).
     std::vector<std::uint64_t> chunk_counts_;
     std::vector<VkDeviceSize> first_chunk_bytes_;
+    std::vector<bool> imported_;
     Buffer chunk_table_;                        // binding kBindingChunkTable
     // Bindings kBindingBvhNodeTexels ..: over the whole array where
     // texel_reads_, else over its first texel (the kernels do not read them,

@@ -276,13 +276,29 @@ Context::Context(const VulkanOptions& options, MessageLog* log) {
 
     physical_ = choose_device(physical_devices(instance_.get()), options.gpu);
 
+    // A CPU device (lavapipe) reads host memory as fast as its own: where
+    // it can import it, the large scene arrays need no copy.
+    std::uint32_t extension_count = 0;
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(physical_.handle, nullptr, &extension_count, nullptr));
+    std::vector<VkExtensionProperties> extensions(extension_count);
+    VK_CHECK(vkEnumerateDeviceExtensionProperties(physical_.handle, nullptr, &extension_count, extensions.data()));
+    const bool host_import =
+        physical_.properties.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU &&
+        std::any_of(extensions.begin(), extensions.end(), [](const VkExtensionProperties& e) {
+            return std::strcmp(e.extensionName, VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME) == 0;
+        });
+
     auto maintenance3 = vk_struct<VkPhysicalDeviceMaintenance3Properties>(
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MAINTENANCE_3_PROPERTIES);
+    auto host_memory = vk_struct<VkPhysicalDeviceExternalMemoryHostPropertiesEXT>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_EXTERNAL_MEMORY_HOST_PROPERTIES_EXT);
+    if (host_import) maintenance3.pNext = &host_memory;
     auto properties2 =
         vk_struct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
     properties2.pNext = &maintenance3;
     vkGetPhysicalDeviceProperties2(physical_.handle, &properties2);
     max_allocation_size_ = maintenance3.maxMemoryAllocationSize;
+    if (host_import) host_import_alignment_ = host_memory.minImportedHostPointerAlignment;
     vkGetPhysicalDeviceMemoryProperties(physical_.handle, &memory_);
 
     std::uint32_t family_count = 0;
@@ -291,8 +307,9 @@ Context::Context(const VulkanOptions& options, MessageLog* log) {
     vkGetPhysicalDeviceQueueFamilyProperties(physical_.handle, &family_count, families.data());
     timestamp_valid_bits_ = families[physical_.compute_family].timestampValidBits;
 
-    // One compute queue and one feature, Vulkan 1.2's bufferDeviceAddress
-    // (scene arrays split over several buffers); no extension.
+    // One compute queue, one feature, Vulkan 1.2's bufferDeviceAddress
+    // (scene arrays split into chunks), and on CPU devices that have it
+    // VK_EXT_external_memory_host.
     const float priority = 1.0f;
     auto queue_info = vk_struct<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
     queue_info.queueFamilyIndex = physical_.compute_family;
@@ -304,6 +321,11 @@ Context::Context(const VulkanOptions& options, MessageLog* log) {
     auto v12 = vk_struct<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
     v12.bufferDeviceAddress = VK_TRUE;
     device_info.pNext = &v12;
+    const char* host_memory_extension = VK_EXT_EXTERNAL_MEMORY_HOST_EXTENSION_NAME;
+    if (host_import) {
+        device_info.enabledExtensionCount = 1;
+        device_info.ppEnabledExtensionNames = &host_memory_extension;
+    }
     VkDevice device = VK_NULL_HANDLE;
     VK_CHECK(vkCreateDevice(physical_.handle, &device_info, nullptr, &device));
     device_ = Device(device, debug_utils);

@@ -51,6 +51,9 @@ public:
     const VkPhysicalDeviceProperties& properties() const { return physical_.properties; }
     const VkPhysicalDeviceMemoryProperties& memory() const { return memory_; }
     VkDeviceSize max_allocation_size() const { return max_allocation_size_; }
+    // Alignment of host memory the device can use in place
+    // (VK_EXT_external_memory_host, enabled on CPU devices); 0: none.
+    VkDeviceSize host_import_alignment() const { return host_import_alignment_; }
     VkQueue queue() const { return queue_; }
     std::uint32_t queue_family() const { return physical_.compute_family; }
     // Nanoseconds per timestamp tick, and the valid bits (0: no timestamps).
@@ -66,6 +69,7 @@ private:
     PhysicalDeviceInfo physical_;
     VkPhysicalDeviceMemoryProperties memory_{};
     VkDeviceSize max_allocation_size_ = 0;
+    VkDeviceSize host_import_alignment_ = 0;
     VkQueue queue_ = VK_NULL_HANDLE;
     std::uint32_t timestamp_valid_bits_ = 0;
 };

@@ -1,5 +1,6 @@
 #include "vk_objects.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "vk_check.h"
@@ -107,6 +108,50 @@ Buffer::Buffer(const Device& device, const VkPhysicalDeviceMemoryProperties& mem
         VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
     if ((memory.memoryTypes[type].propertyFlags & kMappable) == kMappable)
         VK_CHECK(vkd.vkMapMemory(device.get(), allocation, 0, VK_WHOLE_SIZE, 0, &mapped_));
+}
+
+Buffer::Buffer(const Device& device, const VkPhysicalDeviceMemoryProperties& memory, const void* host,
+               VkDeviceSize size, VkDeviceSize host_bytes, VkDeviceSize alignment, VkBufferUsageFlags usage,
+               const std::string& name)
+    : size_(size), name_(name) {
+    const VolkDeviceTable& vkd = device.fn();
+    constexpr auto kHandle = VK_EXTERNAL_MEMORY_HANDLE_TYPE_HOST_ALLOCATION_BIT_EXT;
+    auto external = vk_struct<VkExternalMemoryBufferCreateInfo>(VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_BUFFER_CREATE_INFO);
+    external.handleTypes = kHandle;
+    auto buffer_info = vk_struct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
+    buffer_info.pNext = &external;
+    buffer_info.size = size;
+    buffer_info.usage = usage;
+    buffer_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VK_CHECK(vkd.vkCreateBuffer(device.get(), &buffer_info, nullptr, &buffer));
+    buffer_ = own<VkBufferHandle>(device, buffer, name);
+
+    VkMemoryRequirements requirements;
+    vkd.vkGetBufferMemoryRequirements(device.get(), buffer, &requirements);
+    auto host_properties =
+        vk_struct<VkMemoryHostPointerPropertiesEXT>(VK_STRUCTURE_TYPE_MEMORY_HOST_POINTER_PROPERTIES_EXT);
+    VK_CHECK(vkd.vkGetMemoryHostPointerPropertiesEXT(device.get(), kHandle, host, &host_properties));
+    const std::uint32_t type =
+        find_memory_type(memory, requirements.memoryTypeBits & host_properties.memoryTypeBits, 0, 0);
+    const VkDeviceSize bytes = (std::max(size, requirements.size) + alignment - 1) / alignment * alignment;
+    if (type == UINT32_MAX || bytes > host_bytes)
+        throw std::runtime_error("host memory of '" + name + "' cannot back a Vulkan buffer");
+
+    auto import = vk_struct<VkImportMemoryHostPointerInfoEXT>(VK_STRUCTURE_TYPE_IMPORT_MEMORY_HOST_POINTER_INFO_EXT);
+    import.handleType = kHandle;
+    import.pHostPointer = const_cast<void*>(host);  // read only: the kernels never write scene arrays
+    auto flags_info = vk_struct<VkMemoryAllocateFlagsInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO);
+    flags_info.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+    if ((usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0) import.pNext = &flags_info;
+    auto alloc_info = vk_struct<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
+    alloc_info.pNext = &import;
+    alloc_info.allocationSize = bytes;
+    alloc_info.memoryTypeIndex = type;
+    VkDeviceMemory allocation = VK_NULL_HANDLE;
+    VK_CHECK(vkd.vkAllocateMemory(device.get(), &alloc_info, nullptr, &allocation));
+    memory_ = own<DeviceMemory>(device, allocation, name + " memory");
+    VK_CHECK(vkd.vkBindBufferMemory(device.get(), buffer, allocation, 0));
 }
 
 }  // namespace lc::vk

@@ -148,6 +148,13 @@ public:
     Buffer() = default;
     Buffer(const Device& device, const VkPhysicalDeviceMemoryProperties& memory,
            VkDeviceSize size, VkBufferUsageFlags usage, MemoryUse use, const std::string& name);
+    // A buffer over `size` bytes of host memory at `host`, used in place
+    // (VK_EXT_external_memory_host): `host` is aligned to `alignment`, and
+    // the caller owns `host_bytes` (at least size rounded up to alignment)
+    // there, which must outlive the buffer.
+    Buffer(const Device& device, const VkPhysicalDeviceMemoryProperties& memory, const void* host,
+           VkDeviceSize size, VkDeviceSize host_bytes, VkDeviceSize alignment, VkBufferUsageFlags usage,
+           const std::string& name);
 
     VkBuffer get() const { return buffer_.get(); }
     VkDeviceSize size() const { return size_; }

@@ -120,7 +120,7 @@ RenderSetup::RenderSetup(const Context& context, const PreparedScene& prepared,
                                  context.properties().limits.maxComputeSharedMemorySize)),
       resources(context, submitter, kernel_arrays(prepared, frame), *method,
                 std::uint64_t(frame.width) * frame.height, tuning.max_tile_pixels, tuning.split_bytes,
-                tuning.texel_reads == Tuning::TexelReads::kOn, tuning.chunk_buffers),
+                tuning.texel_reads == Tuning::TexelReads::kOn, tuning.chunk_buffers, tuning.host_import),
       kernels(context, resources.pipeline_layout(), *method,
               {tuning.force_ggx || prepared.has_specular, tuning.force_shadows || prepared.has_occluders,
                tuning.force_oriented || prepared.has_oriented, tuning.force_textures || prepared.has_textures,
@@ -153,6 +153,7 @@ Tuning Tuning::from_environment() {
     if (const char* v = std::getenv("LC_VK_SPLIT_BYTES"))
         tuning.split_bytes = std::strtoull(v, nullptr, 10);
     if (const char* v = std::getenv("LC_VK_CHUNK_BUFFERS")) tuning.chunk_buffers = std::string(v) == "1";
+    if (const char* v = std::getenv("LC_VK_HOST_IMPORT")) tuning.host_import = std::string(v) != "0";
     if (const char* v = std::getenv("LC_VK_TEXEL_READS")) {
         const std::string mode = v;
         if (mode == "on") tuning.texel_reads = Tuning::TexelReads::kOn;

@@ -56,6 +56,11 @@ struct Tuning {
     // arrays larger than an allocation, for tests.
     bool chunk_buffers = false;
 
+    // On a CPU device with VK_EXT_external_memory_host, let the kernels read
+    // the large scene arrays (the lights and light-tree nodes, which own
+    // whole pages) in host memory, without copying them.
+    bool host_import = true;
+
     // Read the BVH nodes, triangles, lights and light-tree nodes through
     // uniform texel buffers instead of storage buffers. kAuto: on CPU
     // devices (lavapipe), where it measured faster (docs/results/lavapipe.md);
@@ -67,7 +72,7 @@ struct Tuning {
 
     // LC_VK_FORCE_FEATURES=ggx,shadows,oriented,textures,disney,sheen,clearcoat (or all), LC_VK_MAX_TILE_PIXELS=N, LC_VK_TARGET_MS=X,
     // LC_VK_LIGHTS_PER_DISPATCH=N, LC_VK_REFINEMENTS_PER_DISPATCH=N, LC_VK_SPLIT_BYTES=N,
-    // LC_VK_CHUNK_BUFFERS=1, LC_VK_TEXEL_READS=on|off.
+    // LC_VK_CHUNK_BUFFERS=1, LC_VK_HOST_IMPORT=0, LC_VK_TEXEL_READS=on|off.
     static Tuning from_environment();
 };
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <new>
@@ -29,6 +30,24 @@ struct DefaultInitAllocator : std::allocator<T> {
     DefaultInitAllocator() noexcept = default;
     template <typename U>
     DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+
+    // Arrays of 1 MiB and more start on a page and own whole pages, so that
+    // a CPU Vulkan device can read them where they are
+    // (VK_EXT_external_memory_host) instead of a copy.
+    static constexpr std::size_t kPage = 4096;
+    static constexpr std::size_t kPagedFrom = std::size_t(1) << 20;
+    // The bytes an allocation of n elements owns from its start.
+    static constexpr std::size_t allocation_bytes(std::size_t n) {
+        return n * sizeof(T) < kPagedFrom ? n * sizeof(T) : (n * sizeof(T) + kPage - 1) / kPage * kPage;
+    }
+    T* allocate(std::size_t n) {
+        if (n * sizeof(T) < kPagedFrom) return std::allocator<T>::allocate(n);
+        return static_cast<T*>(::operator new(allocation_bytes(n), std::align_val_t(kPage)));
+    }
+    void deallocate(T* p, std::size_t n) noexcept {
+        if (n * sizeof(T) < kPagedFrom) return std::allocator<T>::deallocate(p, n);
+        ::operator delete(p, allocation_bytes(n), std::align_val_t(kPage));
+    }
 
     template <typename U>
     void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {

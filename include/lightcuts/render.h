@@ -55,6 +55,9 @@ struct SceneArray {
     const void* data;
     std::size_t element_bytes;
     std::size_t count;
+    // The bytes from `data` on that the array's allocation owns, where they
+    // are whole pages (UninitializedVector's large arrays); 0 otherwise.
+    std::uint64_t page_bytes = 0;
     std::uint64_t bytes() const { return std::uint64_t(element_bytes) * count; }
 };
 std::vector<SceneArray> scene_arrays(const PreparedScene& prepared);

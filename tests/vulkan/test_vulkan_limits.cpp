@@ -218,6 +218,46 @@ TEST_F(Vulkan, SceneArraysSplitIntoChunksMatchTheCpu) {
     }
 }
 
+// On a CPU device that can import host memory (lavapipe), the large scene
+// arrays, the lights and light-tree nodes (1 MiB and more, which own whole
+// pages), are read in place instead of copied (Tuning::host_import), also
+// when split into chunks; the images are those of the copies exactly.
+TEST_F(Vulkan, LargeArraysAreReadInPlaceOnCpuDevices) {
+    const PreparedScene p = prepare_scene(random_scene(68, 25000, 0, 8, 8), 1);
+    ASSERT_GE(p.tree.lights.size() * sizeof(gpu::Light), std::size_t(1) << 20);
+    vk::Tuning in_place, copied, split;
+    copied.host_import = false;
+    split.split_bytes = 1 << 18;
+    std::vector<bool> imported, splits;
+    bool can_import = false, llvmpipe = false;
+    check_setups(p, {in_place, copied, split}, [&](const vk::RenderSetup& setup) {
+        can_import = setup.ctx.host_import_alignment() > 0;
+        llvmpipe = setup.ctx.device_name().find("llvmpipe") != std::string::npos;
+        for (std::uint32_t b : {gpu::kBindingLights, gpu::kBindingLightNodes})
+            imported.push_back(setup.resources.imported(b));
+        EXPECT_FALSE(setup.resources.imported(gpu::kBindingFrame));
+        splits.push_back(setup.resources.chunk_count(gpu::kBindingLightNodes) > 1);
+    });
+    EXPECT_EQ(splits, (std::vector<bool>{false, false, true}));
+    // lavapipe has VK_EXT_external_memory_host; a GPU copies.
+    if (llvmpipe) {
+        EXPECT_TRUE(can_import);
+    }
+    const bool c = can_import;
+    EXPECT_EQ(imported, (std::vector<bool>{c, c, false, false, c, c}));
+    for (const char* method : {"brute", "lightcuts"}) {
+        SCOPED_TRACE(method);
+        const RenderOptions o = options(method, 8, 8);
+        const RenderResult copy = gpu(p, o, copied);
+        for (const vk::Tuning* t : {&in_place, &split}) {
+            const RenderResult read_in_place = gpu(p, o, *t);
+            EXPECT_EQ(max_relative_difference(read_in_place.image, copy.image, std::string("in place ") + method, 0.0),
+                      0.0);
+        }
+        if (std::string(method) == "lightcuts") expect_lightcuts_matches(p, o, copy);
+    }
+}
+
 // The BVH nodes, triangles, lights and light-tree nodes can be read through
 // uniform texel buffers instead of storage buffers (Tuning::texel_reads;
 // the default on CPU devices). The same kernels read the same bits: the
