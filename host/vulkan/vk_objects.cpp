@@ -59,22 +59,31 @@ std::uint32_t find_memory_type(const VkPhysicalDeviceMemoryProperties& memory,
     return fallback;
 }
 
+// A buffer of `size` bytes (`next`: the create info's chain), and what
+// memory it needs.
+VkBufferHandle create_buffer(const Device& device, VkDeviceSize size, VkBufferUsageFlags usage, const void* next,
+                             const std::string& name, VkMemoryRequirements& requirements) {
+    auto buffer_info = vk_struct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
+    buffer_info.pNext = next;
+    buffer_info.size = size;
+    buffer_info.usage = usage;
+    buffer_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VK_CHECK(device.fn().vkCreateBuffer(device.get(), &buffer_info, nullptr, &buffer));
+    VkBufferHandle handle = own<VkBufferHandle>(device, buffer, name);
+    device.fn().vkGetBufferMemoryRequirements(device.get(), buffer, &requirements);
+    return handle;
+}
+
 }  // namespace
 
 Buffer::Buffer(const Device& device, const VkPhysicalDeviceMemoryProperties& memory,
                VkDeviceSize size, VkBufferUsageFlags usage, MemoryUse use, const std::string& name)
     : size_(size), name_(name) {
     const VolkDeviceTable& vkd = device.fn();
-    auto buffer_info = vk_struct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
-    buffer_info.size = size;
-    buffer_info.usage = usage;
-    buffer_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    VkBuffer buffer = VK_NULL_HANDLE;
-    VK_CHECK(vkd.vkCreateBuffer(device.get(), &buffer_info, nullptr, &buffer));
-    buffer_ = own<VkBufferHandle>(device, buffer, name);
-
     VkMemoryRequirements requirements;
-    vkd.vkGetBufferMemoryRequirements(device.get(), buffer, &requirements);
+    buffer_ = create_buffer(device, size, usage, nullptr, name, requirements);
+    const VkBuffer buffer = buffer_.get();
     VkMemoryPropertyFlags required = 0, preferred = 0;
     switch (use) {
         case MemoryUse::kDevice:
@@ -118,17 +127,9 @@ Buffer::Buffer(const Device& device, const VkPhysicalDeviceMemoryProperties& mem
     constexpr auto kHandle = VK_EXTERNAL_MEMORY_HANDLE_TYPE_HOST_ALLOCATION_BIT_EXT;
     auto external = vk_struct<VkExternalMemoryBufferCreateInfo>(VK_STRUCTURE_TYPE_EXTERNAL_MEMORY_BUFFER_CREATE_INFO);
     external.handleTypes = kHandle;
-    auto buffer_info = vk_struct<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
-    buffer_info.pNext = &external;
-    buffer_info.size = size;
-    buffer_info.usage = usage;
-    buffer_info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    VkBuffer buffer = VK_NULL_HANDLE;
-    VK_CHECK(vkd.vkCreateBuffer(device.get(), &buffer_info, nullptr, &buffer));
-    buffer_ = own<VkBufferHandle>(device, buffer, name);
-
     VkMemoryRequirements requirements;
-    vkd.vkGetBufferMemoryRequirements(device.get(), buffer, &requirements);
+    buffer_ = create_buffer(device, size, usage, &external, name, requirements);
+    const VkBuffer buffer = buffer_.get();
     auto host_properties =
         vk_struct<VkMemoryHostPointerPropertiesEXT>(VK_STRUCTURE_TYPE_MEMORY_HOST_POINTER_PROPERTIES_EXT);
     VK_CHECK(vkd.vkGetMemoryHostPointerPropertiesEXT(device.get(), kHandle, host, &host_properties));

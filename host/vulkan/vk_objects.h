@@ -142,7 +142,8 @@ enum class MemoryUse {
 };
 
 // A buffer with its own memory allocation, persistently mapped when the
-// memory is host-visible and coherent (mapped() == nullptr otherwise).
+// memory is host-visible and coherent (mapped() == nullptr otherwise), or
+// over host memory that the device uses in place (never mapped).
 class Buffer {
 public:
     Buffer() = default;
