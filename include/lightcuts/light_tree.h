@@ -46,7 +46,7 @@ struct DefaultInitAllocator : std::allocator<T> {
     }
     void deallocate(T* p, std::size_t n) noexcept {
         if (n * sizeof(T) < kPagedFrom) return std::allocator<T>::deallocate(p, n);
-        ::operator delete(p, allocation_bytes(n), std::align_val_t(kPage));
+        ::operator delete(p, std::align_val_t(kPage));
     }
 
     template <typename U>
