@@ -141,9 +141,14 @@ Cluster leaf_of(const gpu::Light& l, std::size_t index) {
     return c;
 }
 
+// The threads of the build running on this thread: build_light_tree's
+// `threads`, or 0 for one per hardware thread.
+thread_local unsigned build_threads = 0;
+
 // The threads parallel_for uses for n items, and the range of thread t.
 unsigned thread_count(std::size_t n) {
-    return n < 4096 ? 1u : std::max(1u, std::thread::hardware_concurrency());
+    if (n < 4096) return 1u;
+    return build_threads > 0 ? build_threads : std::max(1u, std::thread::hardware_concurrency());
 }
 std::pair<std::size_t, std::size_t> thread_range(std::size_t n, unsigned threads, unsigned t) {
     const std::size_t chunk = (n + threads - 1) / threads;
@@ -627,8 +632,13 @@ std::uint32_t LightTree::cut_heap_slots(std::uint32_t max_cut, std::uint32_t cut
 }
 
 LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t seed, TreeBuilder builder,
-                           double cone_scale) {
+                           double cone_scale, unsigned threads) {
     auto start = std::chrono::steady_clock::now();
+    struct ThreadsOfThisBuild {
+        unsigned before = build_threads;
+        explicit ThreadsOfThisBuild(unsigned t) { build_threads = t; }
+        ~ThreadsOfThisBuild() { build_threads = before; }
+    } threads_of_this_build(threads);
     LightTree tree;
     reserve_huge(tree.lights, lights.size());
     reserve_huge(tree.nodes, 2 * lights.size());

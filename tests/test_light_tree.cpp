@@ -187,6 +187,30 @@ TEST(LightTree, SameSeedSameTree) {
     EXPECT_GT(differ, 0);
 }
 
+// The same tree whatever the thread count: each thread of the build writes
+// where one pass in order would. 4100 lights on 128 threads leave the last
+// threads' ranges empty (a thread with no lights once put the origin into
+// the tree's box); a third of the lights are black, a seventh directional.
+TEST(LightTree, SameTreeWhateverTheThreadCount) {
+    for (std::size_t n : {4100u, 30000u}) {
+        SCOPED_TRACE(n);
+        std::vector<gpu::Light> lights = random_mixed(n, std::uint32_t(n) + 1);
+        for (std::size_t i = 0; i < n; i += 3) lights[i].r = lights[i].g = lights[i].b = 0.0f;
+        const LightTree one = build_light_tree(lights, 3, TreeBuilder::kFast, 1.0, 1);
+        check_tree(one, lights);
+        for (unsigned threads : {2u, 3u, 7u, 128u}) {
+            SCOPED_TRACE(threads);
+            const LightTree t = build_light_tree(lights, 3, TreeBuilder::kFast, 1.0, threads);
+            ASSERT_EQ(t.nodes.size(), one.nodes.size());
+            ASSERT_EQ(t.lights.size(), one.lights.size());
+            EXPECT_EQ(t.roots, one.roots);
+            EXPECT_EQ(t.black_lights, one.black_lights);
+            EXPECT_EQ(std::memcmp(t.nodes.data(), one.nodes.data(), one.nodes.size() * sizeof(gpu::LightNode)), 0);
+            EXPECT_EQ(std::memcmp(t.lights.data(), one.lights.data(), one.lights.size() * sizeof(gpu::Light)), 0);
+        }
+    }
+}
+
 TEST(LightTree, EmptyInputGivesNoTree) {
     LightTree t = build_light_tree({}, 1);
     EXPECT_TRUE(t.nodes.empty());

@@ -100,7 +100,10 @@ enum class TreeBuilder {
 // `cone_scale` multiplies c, the weight of the metric's cone term (the
 // diagonal of the tree's lights by default, light_tree.cpp); 0 leaves the
 // term out, to measure what it buys (bench/tree_quality).
+// `threads`: how many threads the build's parallel parts use (0: one per
+// hardware thread); the tree is the same for any count.
 LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t seed,
-                           TreeBuilder builder = TreeBuilder::kFast, double cone_scale = 1.0);
+                           TreeBuilder builder = TreeBuilder::kFast, double cone_scale = 1.0,
+                           unsigned threads = 0);
 
 }  // namespace lc
