@@ -228,19 +228,19 @@ std::vector<Buffer> GpuResources::upload_chunks(const SceneArray& array, std::ui
     // The allocation may round the buffer's size up to its alignment: keep
     // a margin below maxMemoryAllocationSize.
     constexpr VkDeviceSize kAllocationMargin = VkDeviceSize(1) << 16;
+    const bool one_allocation = bytes + kAllocationMargin <= ctx_.max_allocation_size();
     // Where the device can use the array's host memory in place (a CPU
     // device; an array that owns whole pages), it does: no copy.
     const VkDeviceSize align = host_import_ ? ctx_.host_import_alignment() : 0;
     imported_.push_back(align > 0 && array.count > 0 && array.page_bytes > 0 &&
                         reinterpret_cast<std::uintptr_t>(array.data) % align == 0 &&
                         (bytes + align - 1) / align * align <= array.page_bytes &&
-                        bytes + kAllocationMargin <= ctx_.max_allocation_size() &&
-                        !(chunk_count > 1 && chunk_buffers_));
+                        one_allocation && !(chunk_count > 1 && chunk_buffers_));
     if (imported_.back()) {
         buffers.emplace_back(ctx_.device(), ctx_.memory(), array.data, bytes, array.page_bytes, align, usage, name);
         return buffers;
     }
-    if (chunk_count > 1 && !chunk_buffers_ && bytes + kAllocationMargin <= ctx_.max_allocation_size()) {
+    if (chunk_count > 1 && !chunk_buffers_ && one_allocation) {
         Buffer buffer(ctx_.device(), ctx_.memory(), bytes, usage, MemoryUse::kDevice, name);
         // Chunk by chunk, so that a staging buffer holds one chunk at a time.
         for (std::uint64_t first = 0; first < count; first += per_chunk) {
