@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "cpu_kernel.h"
+#include "wide_trace.h"
 #include "lightcuts/scene.h"
 
 namespace {
@@ -176,6 +177,16 @@ int run(int argc, char** argv) {
         });
         const std::size_t reference = total();
         report("software BVH, single rays", r.size(), s, reference, reference);
+
+        std::fill(hits.begin(), hits.end(), 0);
+        s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+            lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
+            std::size_t h = 0;
+            for (std::size_t i = b; i < e; ++i)
+                h += lc::cpu::trace_any_wide(tk, p.bvh.wide_nodes.data(), r[i].org, r[i].dir, r[i].t_max) ? 1 : 0;
+            hits[t] = h;
+        });
+        report("software 4-wide BVH, single rays", r.size(), s, total(), reference);
 
         std::fill(hits.begin(), hits.end(), 0);
         s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {

@@ -207,7 +207,77 @@ private:
     std::vector<BvhNode>& nodes_;
 };
 
+// Half the surface area of a binary node's box.
+float half_area(const BvhNode& n) {
+    const float dx = n.max_x - n.min_x, dy = n.max_y - n.min_y, dz = n.max_z - n.min_z;
+    return dx * dy + dy * dz + dz * dx;
+}
+
+// Writes the wide node for the children of binary node `inner` at
+// wide[index], and its inner children's wide nodes after it (depth first).
+void collapse(const std::vector<BvhNode>& nodes, std::uint32_t inner, std::uint32_t index,
+              std::vector<WideBvhNode>& wide) {
+    std::array<std::uint32_t, 4> slots{nodes[inner].first_or_left, nodes[inner].first_or_left + 1u, 0u, 0u};
+    std::uint32_t used = 2;
+    while (used < 4) {
+        int widest = -1;
+        for (std::uint32_t s = 0; s < used; ++s)
+            if (nodes[slots[s]].tri_count == 0 &&
+                (widest < 0 || half_area(nodes[slots[s]]) > half_area(nodes[slots[std::size_t(widest)]])))
+                widest = int(s);
+        if (widest < 0) break;
+        const std::uint32_t left = nodes[slots[std::size_t(widest)]].first_or_left;
+        slots[std::size_t(widest)] = left;
+        slots[used++] = left + 1u;
+    }
+    WideBvhNode w{};
+    for (std::uint32_t s = 0; s < 4; ++s) {
+        w.count[s] = -1;
+        w.child[s] = 0;
+        // An empty slot's box is never tested (count -1 masks it out).
+        w.lo_x[s] = w.lo_y[s] = w.lo_z[s] = w.hi_x[s] = w.hi_y[s] = w.hi_z[s] = 0.0f;
+    }
+    for (std::uint32_t s = 0; s < used; ++s) {
+        const BvhNode& c = nodes[slots[s]];
+        w.lo_x[s] = c.min_x, w.lo_y[s] = c.min_y, w.lo_z[s] = c.min_z;
+        w.hi_x[s] = c.max_x, w.hi_y[s] = c.max_y, w.hi_z[s] = c.max_z;
+        w.count[s] = std::int32_t(c.tri_count);
+        w.child[s] = c.first_or_left;
+    }
+    wide[index] = w;
+    for (std::uint32_t s = 0; s < used; ++s) {
+        if (w.count[s] != 0) continue;
+        const auto child = std::uint32_t(wide.size());
+        wide.emplace_back();
+        wide[index].child[s] = child;
+        collapse(nodes, slots[s], child, wide);
+    }
+}
+
 }  // namespace
+
+std::vector<WideBvhNode> collapse_bvh(const std::vector<BvhNode>& nodes) {
+    std::vector<WideBvhNode> wide(1);
+    WideBvhNode& root = wide[0];
+    for (std::uint32_t s = 0; s < 4; ++s) {
+        root.count[s] = -1;
+        root.child[s] = 0;
+        root.lo_x[s] = root.lo_y[s] = root.lo_z[s] = root.hi_x[s] = root.hi_y[s] = root.hi_z[s] = 0.0f;
+    }
+    if (nodes.empty()) return wide;
+    const BvhNode& r = nodes[0];
+    if (r.tri_count == 0 && r.first_or_left == 0) return wide;  // no triangles (build_bvh's far root)
+    if (r.tri_count > 0) {
+        // A root leaf: one slot holding it.
+        root.lo_x[0] = r.min_x, root.lo_y[0] = r.min_y, root.lo_z[0] = r.min_z;
+        root.hi_x[0] = r.max_x, root.hi_y[0] = r.max_y, root.hi_z[0] = r.max_z;
+        root.count[0] = std::int32_t(r.tri_count);
+        root.child[0] = r.first_or_left;
+        return wide;
+    }
+    collapse(nodes, 0, 0, wide);
+    return wide;
+}
 
 Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNormals>& normals,
               std::vector<gpu::TriangleUvs>* uvs) {
@@ -231,6 +301,7 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
         // axis and sees a box around the origin.
         constexpr float far = std::numeric_limits<float>::max();
         bvh.nodes.push_back(BvhNode{far, far, far, 0u, far, far, far, 0u});
+        bvh.wide_nodes = collapse_bvh(bvh.nodes);
         bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return bvh;
     }
@@ -269,6 +340,7 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
         uvs->swap(sorted_uvs);
     }
 
+    bvh.wide_nodes = collapse_bvh(bvh.nodes);
     bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;
 }

@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 
 #include "lightcuts/render.h"
+#include "wide_trace.h"
 #include "shared/types.h"
 #include "shared/color.h"
 #include "shared/octahedral.h"
@@ -74,6 +75,7 @@ struct ShadowRayRecord {
 template <bool kRecordRays>
 struct BasicShadeKernel {
     const BvhNode* bvh_nodes = nullptr;
+    const WideBvhNode* wide_nodes = nullptr;  // the same tree 4 wide, for shadow rays (none: bvh_nodes)
     const Triangle* triangles = nullptr;
     const TriangleNormals* normals = nullptr;
     const TriangleUvs* uvs = nullptr;
@@ -125,6 +127,7 @@ struct BasicShadeKernel {
 #define LC_ON_SHADOW_RAY(o, d, t) \
     if constexpr (kRecordRays) ray_log->push_back({o, d, t})
 #define LC_SEED_LOBE_BOUND seed_lobe_bound
+#define LC_TRACE_ANY(o, d, t) lc_trace_shadow(o, d, t)
 #include "shared/trace.h"
 #include "shared/textures.h"
 #include "shared/shading.h"
@@ -149,6 +152,15 @@ struct BasicShadeKernel {
 #undef LC_PREFETCH_LIGHT_NODES
 #undef LC_ON_SHADOW_RAY
 #undef LC_SEED_LOBE_BOUND
+#undef LC_TRACE_ANY
+
+    // The shadow rays' any-hit query: lc_trace_any's answer, from the 4-wide
+    // tree where one is bound (1.3 to 1.8 times the rays per second on the
+    // shipped room, bench/embree_rays).
+    bool lc_trace_shadow(vec3 org, vec3 dir, float t_max) {
+        return wide_nodes != nullptr ? trace_any_wide(*this, wide_nodes, org, dir, t_max)
+                                     : lc_trace_any(org, dir, t_max);
+    }
 };
 
 using ShadeKernel = BasicShadeKernel<false>;
@@ -159,6 +171,7 @@ template <bool kRecordRays = false>
 BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, HeapEntry* heap = nullptr, uint heap_slots = 0u) {
     BasicShadeKernel<kRecordRays> k;
     k.bvh_nodes = p.bvh.nodes.data();
+    k.wide_nodes = p.bvh.wide_nodes.empty() ? nullptr : p.bvh.wide_nodes.data();
     k.triangles = p.scene.triangles.data();
     k.normals = p.scene.normals.data();
     k.uvs = p.scene.uvs.data();

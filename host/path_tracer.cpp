@@ -272,7 +272,7 @@ glm::vec3 PathTracer::light_sample(Kernel& k, const SurfacePoint& sp, std::uint3
     const glm::vec3 unit = k.lc_light_unit(sp, l, frame_.min_distance2, wi, t_max);
     if (black(unit)) return glm::vec3(0.0f);
     ++shadow_rays;
-    if (k.lc_trace_any(sp.p, wi, t_max)) return glm::vec3(0.0f);
+    if (k.lc_trace_shadow(sp.p, wi, t_max)) return glm::vec3(0.0f);
     return unit * k.lc_light_intensity(l) / pmf;
 }
 
@@ -299,7 +299,7 @@ glm::vec3 PathTracer::triangle_sample(Kernel& k, const SurfacePoint& sp, const L
     const gpu::Material& m = sp.mat;
     const float weight = power_heuristic(light_pdf, bsdf_pdf(k, m, lobes, sp.n, sp.wo, wi));
     ++shadow_rays;
-    if (k.lc_trace_any(sp.p, wi, d * (1.0f - Kernel::kShadowEndRelative))) return glm::vec3(0.0f);
+    if (k.lc_trace_shadow(sp.p, wi, d * (1.0f - Kernel::kShadowEndRelative))) return glm::vec3(0.0f);
     return k.lc_brdf_cos(m, sp.n, wi, sp.wo, cos_i) * emitted * (weight / light_pdf);
 }
 
@@ -328,7 +328,7 @@ glm::vec3 PathTracer::environment_sample(Kernel& k, const SurfacePoint& sp, cons
     const gpu::Material& m = sp.mat;
     const float weight = power_heuristic(light_pdf, bsdf_pdf(k, m, lobes, sp.n, sp.wo, wi));
     ++shadow_rays;
-    if (k.lc_trace_any(sp.p, wi, Kernel::kRayInfinity)) return glm::vec3(0.0f);
+    if (k.lc_trace_shadow(sp.p, wi, Kernel::kRayInfinity)) return glm::vec3(0.0f);
     return k.lc_brdf_cos(m, sp.n, wi, sp.wo, cos_i) * sky * (weight / light_pdf);
 }
 

@@ -16,6 +16,7 @@
 
 #include "cpu_kernel.h"
 #include "lightcuts/bvh.h"
+#include "wide_trace.h"
 #include "test_util.h"
 
 namespace {
@@ -117,8 +118,11 @@ std::string check_ray(const Scene& s, vec3 org, vec3 dir, float t_max) {
                 return "closest picked a triangle that is not a tie for " + describe(org, dir, t_max);
         }
     }
-    if (k.lc_trace_any(org, dir, t_max) != brute_any(s, org, dir, t_max))
+    const bool any = brute_any(s, org, dir, t_max);
+    if (k.lc_trace_any(org, dir, t_max) != any)
         return "any-hit disagrees with brute force for " + describe(org, dir, t_max);
+    if (lc::cpu::trace_any_wide(k, s.bvh.wide_nodes.data(), org, dir, t_max) != any)
+        return "4-wide any-hit disagrees with brute force for " + describe(org, dir, t_max);
     return {};
 }
 
@@ -136,6 +140,56 @@ bool contains(const BvhNode& outer, const BvhNode& inner) {
 bool contains(const BvhNode& box, vec3 p) {
     return box.min_x <= p.x && box.min_y <= p.y && box.min_z <= p.z && box.max_x >= p.x && box.max_y >= p.y &&
            box.max_z >= p.z;
+}
+
+// The 4-wide tree: every wide node reached once, its slots filled from the
+// first, each child's box one of the binary tree's, leaves exactly the
+// binary tree's leaves (every triangle once, inside its box), no deeper
+// than the binary tree.
+void check_wide_invariants(const Scene& s) {
+    const auto& wide = s.bvh.wide_nodes;
+    ASSERT_FALSE(wide.empty());
+    std::map<std::array<float, 6>, int> binary_boxes;
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> binary_leaves;
+    for (const BvhNode& n : s.bvh.nodes) {
+        ++binary_boxes[{n.min_x, n.min_y, n.min_z, n.max_x, n.max_y, n.max_z}];
+        if (n.tri_count > 0) ++binary_leaves[{n.first_or_left, n.tri_count}];
+    }
+    std::vector<int> seen(wide.size(), 0), tri_seen(s.triangles.size(), 0);
+    std::size_t leaves = 0;
+    std::vector<std::pair<std::uint32_t, int>> stack = {{0u, 0}};
+    int max_depth = 0;
+    while (!stack.empty()) {
+        const auto [index, depth] = stack.back();
+        stack.pop_back();
+        ASSERT_LT(index, wide.size());
+        ++seen[index];
+        max_depth = std::max(max_depth, depth);
+        const lc::WideBvhNode& w = wide[index];
+        for (int slot = 0; slot < 4; ++slot) {
+            if (w.count[slot] < 0) {
+                for (int later = slot; later < 4; ++later) ASSERT_LT(w.count[later], 0) << "slots not filled first";
+                break;
+            }
+            EXPECT_EQ(binary_boxes.count({w.lo_x[slot], w.lo_y[slot], w.lo_z[slot], w.hi_x[slot], w.hi_y[slot],
+                                          w.hi_z[slot]}),
+                      1u);
+            if (w.count[slot] == 0) {
+                stack.push_back({w.child[slot], depth + 1});
+                continue;
+            }
+            ++leaves;
+            EXPECT_EQ(binary_leaves.count({w.child[slot], std::uint32_t(w.count[slot])}), 1u);
+            for (std::uint32_t i = w.child[slot]; i < w.child[slot] + std::uint32_t(w.count[slot]); ++i) {
+                ASSERT_LT(i, s.triangles.size());
+                ++tri_seen[i];
+            }
+        }
+    }
+    EXPECT_EQ(leaves, binary_leaves.size());
+    EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int c) { return c == 1; }));
+    EXPECT_TRUE(std::all_of(tri_seen.begin(), tri_seen.end(), [](int c) { return c == 1; }));
+    EXPECT_LE(max_depth, max_leaf_depth(s.bvh.nodes, 0, 0));
 }
 
 // Structural invariants: every node reached once, children inside parents,
@@ -182,6 +236,7 @@ void check_invariants(const Scene& s) {
         ASSERT_EQ(s.normals[i].pad0, s.triangles[i].material) << "normals not permuted with triangles";
     }
     EXPECT_TRUE(std::all_of(input_seen.begin(), input_seen.end(), [](int c) { return c == 1; }));
+    check_wide_invariants(s);
 }
 
 using lc::test::random_unit;
@@ -352,7 +407,10 @@ TEST(Bvh, EmptySceneMissesEverything) {
         float t, b1, b2;
         EXPECT_EQ(k.lc_trace_closest(org, dir, kRayInfinity, t, b1, b2), kInvalidIndex);
         EXPECT_FALSE(k.lc_trace_any(org, dir, kRayInfinity));
+        EXPECT_FALSE(lc::cpu::trace_any_wide(k, bvh.wide_nodes.data(), org, dir, kRayInfinity));
     }
+    ASSERT_EQ(bvh.wide_nodes.size(), 1u);
+    for (int slot = 0; slot < 4; ++slot) EXPECT_EQ(bvh.wide_nodes[0].count[slot], -1);
 }
 
 TEST(Bvh, DegenerateInputsKeepInvariants) {
@@ -391,6 +449,12 @@ TEST(Bvh, DegenerateInputsKeepInvariants) {
     const Scene single(one);
     check_invariants(single);
     EXPECT_EQ(single.bvh.nodes.size(), 1u);
+    ASSERT_EQ(single.bvh.wide_nodes.size(), 1u);  // the root leaf in slot 0
+    EXPECT_EQ(single.bvh.wide_nodes[0].count[0], 1);
+    EXPECT_TRUE(check_ray(single, vec3(0.2f, 0.2f, 1.0f), vec3(0, 0, -1), kRayInfinity).empty());
+    lc::cpu::TraceKernel single_kernel = single.kernel();
+    EXPECT_TRUE(lc::cpu::trace_any_wide(single_kernel, single.bvh.wide_nodes.data(), vec3(0.2f, 0.2f, 1.0f),
+                                        vec3(0, 0, -1), kRayInfinity));
 }
 
 TEST(Bvh, BuildsLargeRandomSceneWithValidTree) {

@@ -85,14 +85,12 @@ void lc_heap_pop(LC_INOUT(uint) size) {
     while (true) {
         uint child = 2u * i + 1u;
         if (child >= size) break;
+        // The larger child by its error alone; the entry is read once
+        // chosen (on the CPU, copying whole entries to compare them made
+        // the compiler write one field and read the entry back, a stalled
+        // store-to-load forward per level).
+        if (child + 1u < size && LC_HEAP_LOAD(child + 1u).error > LC_HEAP_LOAD(child).error) child += 1u;
         HeapEntry c = LC_HEAP_LOAD(child);
-        if (child + 1u < size) {
-            HeapEntry r = LC_HEAP_LOAD(child + 1u);
-            if (r.error > c.error) {
-                child += 1u;
-                c = r;
-            }
-        }
         if (c.error <= last.error) break;
         LC_HEAP_STORE(i, c);
         i = child;

@@ -54,6 +54,15 @@ vec3 lc_camera_ray_dir(LC_IN(FrameParams) f, vec2 pixel) {
     return normalize(d);
 }
 
+// Orthonormal basis around n (Duff et al., JCGT 2017).
+void lc_basis(vec3 n, LC_OUT(vec3) t, LC_OUT(vec3) b) {
+    float s = n.z >= 0.0f ? 1.0f : -1.0f;
+    float a = -1.0f / (s + n.z);
+    float c = n.x * n.y * a;
+    t = vec3(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
+    b = vec3(c, s + n.y * n.y * a, -n.y);
+}
+
 // A shaded point: position offset off the surface, shading normal and view
 // direction both on the camera's side, and its material with the textures
 // at its texture coordinates applied (lc_material_at), looked up once
@@ -61,6 +70,7 @@ vec3 lc_camera_ray_dir(LC_IN(FrameParams) f, vec2 pixel) {
 struct SurfacePoint {
     vec3 p;
     vec3 n;
+    vec3 t, b;      // lc_basis(n): the frame the cosine bound works in, made once
     vec3 wo;
     uint material;  // index of the material record
     vec2 uv;
@@ -72,6 +82,7 @@ SurfacePoint lc_make_surface(vec3 p, vec3 n, vec3 wo, uint material, vec2 uv) {
     SurfacePoint sp;
     sp.p = p;
     sp.n = n;
+    lc_basis(n, sp.t, sp.b);
     sp.wo = wo;
     sp.material = material;
     sp.uv = uv;
@@ -102,6 +113,7 @@ SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) 
     SurfacePoint sp;
     sp.p = lc_offset_hit_point(p, ng, tri);
     sp.n = ns;
+    lc_basis(ns, sp.t, sp.b);
     sp.wo = -ray_dir;
     sp.material = tri.material;
     sp.uv = uv;
@@ -365,7 +377,12 @@ bool lc_visible(LC_IN(SurfacePoint) sp, vec3 wi, float t_max) {
 #ifdef LC_ON_SHADOW_RAY
     LC_ON_SHADOW_RAY(sp.p, wi, t_max);  // the CPU's ray recorder (host/cpu_kernel.h)
 #endif
+#ifdef LC_TRACE_ANY
+    // The includer's own any-hit query (the CPU's 4-wide BVH).
+    return !kEnableShadows || !LC_TRACE_ANY(sp.p, wi, t_max);
+#else
     return !kEnableShadows || !lc_trace_any(sp.p, wi, t_max);
+#endif
 }
 
 // lc_light_unit times visibility: one shadow ray, counted in stats, where
@@ -390,15 +407,6 @@ vec3 lc_node_intensity(LC_IN(LightNode) node) {
 // --- Walter et al. 2005, section 4.1: upper bounds on a cluster's
 // contribution per unit intensity at a shaded point.
 
-// Orthonormal basis around n (Duff et al., JCGT 2017).
-void lc_basis(vec3 n, LC_OUT(vec3) t, LC_OUT(vec3) b) {
-    float s = n.z >= 0.0f ? 1.0f : -1.0f;
-    float a = -1.0f / (s + n.z);
-    float c = n.x * n.y * a;
-    t = vec3(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
-    b = vec3(c, s + n.y * n.y * a, -n.y);
-}
-
 float lc_min_abs_on_interval(float centre, float half_width) {
     return max(abs(centre) - half_width, 0.0f);
 }
@@ -409,8 +417,8 @@ float lc_min_abs_on_interval(float centre, float half_width) {
 // bound z_max / sqrt(min x^2 + min y^2 + z_max^2) over that box is then an
 // upper bound over the original box. Zero when the box lies below the
 // surface. (The seed report rotated a world-space box by a single angle,
-// which is not conservative.)
-float lc_cosine_bound(vec3 box_min, vec3 box_max, vec3 x, vec3 n) {
+// which is not conservative.) t and b complete n to a frame (lc_basis).
+float lc_cosine_bound(vec3 box_min, vec3 box_max, vec3 x, vec3 n, vec3 t, vec3 b) {
     // The box relative to x first: the centre 0.5 * (box_min + box_max)
     // rounds at the box's magnitude (0.008 at 1e5), which shifted the box by
     // far more than the slack below and broke the bound by 0.3% far from
@@ -424,8 +432,6 @@ float lc_cosine_bound(vec3 box_min, vec3 box_max, vec3 x, vec3 n) {
     // it was computed from.
     float z_max = dot(n, c) + dot(abs(n), e) + kCosineAbsSlack * (dot(abs(n), abs(c)) + dot(abs(n), e));
     if (z_max <= 0.0f) return 0.0f;
-    vec3 t, b;
-    lc_basis(n, t, b);
     float min_x = lc_min_abs_on_interval(dot(t, c), dot(abs(t), e));
     float min_y = lc_min_abs_on_interval(dot(b, c), dot(abs(b), e));
     float bound = z_max * inversesqrt(min_x * min_x + min_y * min_y + z_max * z_max);
@@ -584,7 +590,7 @@ vec3 lc_cluster_bound(LC_IN(SurfacePoint) sp, LC_IN(Material) m, LC_IN(LightNode
     vec3 box_max = vec3(node.max_x, node.max_y, node.max_z);
     bool positional = lc_node_type(node) != kLightDirectional;
     vec3 x = positional ? sp.p : vec3(0.0f);
-    float cos_bound = lc_cosine_bound(box_min, box_max, x, sp.n);
+    float cos_bound = lc_cosine_bound(box_min, box_max, x, sp.n, sp.t, sp.b);
     if (cos_bound <= 0.0f) return vec3(0.0f);
     float factor = 1.0f;
     if (positional) {
