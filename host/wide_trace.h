@@ -1,7 +1,7 @@
 // The CPU path's shadow rays through the 4-wide copy of the BVH
 // (lc::WideBvhNode, collapse_bvh): one SSE slab test checks a node's four
 // children at once. The triangle test is the kernels' own
-// (lc_intersect_triangle), so the answer is the binary traversal's: a
+// (lc_intersect_sheared), so the answer is the binary traversal's: a
 // triangle is tested here whenever it is there (each of its boxes passes
 // the same test, lanes computed with the same operations), and both return
 // true exactly when one of those tests hits.
@@ -24,11 +24,12 @@ namespace lc::cpu {
 inline constexpr std::uint32_t kWideStackSize = 3u * gpu::kBvhStackSize + 4u;
 
 // Any hit with t in (0, t_max) among `kernel`'s triangles (a kernel struct
-// of host/cpu_kernel.h: its lc_safe_inverse, lc_intersect_triangle and
-// triangles), the same test as lc_trace_any.
+// of host/cpu_kernel.h: its lc_safe_inverse, lc_shear_ray,
+// lc_intersect_sheared and triangles), the same test as lc_trace_any.
 template <class Kernel>
 bool trace_any_wide(Kernel& kernel, const WideBvhNode* nodes, glm::vec3 org, glm::vec3 dir, float t_max) {
     const glm::vec3 inv = kernel.lc_safe_inverse(dir);
+    const auto sheared = kernel.lc_shear_ray(dir);
     std::uint32_t stack[kWideStackSize];
     std::uint32_t sp = 0;
     stack[sp++] = 0u;
@@ -80,7 +81,7 @@ bool trace_any_wide(Kernel& kernel, const WideBvhNode* nodes, glm::vec3 org, glm
             const std::uint32_t first = node.child[s];
             for (std::uint32_t i = first; i < first + std::uint32_t(count); ++i) {
                 float b1, b2;
-                if (kernel.lc_intersect_triangle(org, dir, kernel.triangles[i], t_max, b1, b2) > 0.0f) return true;
+                if (kernel.lc_intersect_sheared(org, sheared, kernel.triangles[i], t_max, b1, b2) > 0.0f) return true;
             }
         }
     }

@@ -18,34 +18,45 @@ vec3 lc_tri_v2(Triangle t) { return vec3(t.v2_x, t.v2_y, t.v2_z); }
 
 // Watertight ray/triangle test (Woop, Benthin, Wald, JCGT 2013): rays through
 // a shared edge or vertex hit at least one of the triangles, so nothing leaks
-// between neighbours. Returns t in (0, t_max), or -1 for a miss; b1 and b2
-// are the barycentric weights of v1 and v2.
-float lc_intersect_triangle(vec3 org, vec3 dir, LC_IN(Triangle) tri, float t_max,
-                            LC_OUT(float) b1, LC_OUT(float) b2) {
+// between neighbours. In two parts: the ray's axis permutation and shear,
+// made once per ray (lc_shear_ray), and the test of one triangle with them.
+struct ShearedRay {
+    int kx, ky, kz;  // the permuted axes: kz where |dir| is largest
+    float sx, sy, sz;
+};
+
+ShearedRay lc_shear_ray(vec3 dir) {
+    vec3 ad = abs(dir);
+    ShearedRay r;
+    r.kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
+    r.kx = r.kz == 2 ? 0 : r.kz + 1;
+    r.ky = r.kx == 2 ? 0 : r.kx + 1;
+    if (dir[r.kz] < 0.0f) {
+        int tmp = r.kx;
+        r.kx = r.ky;
+        r.ky = tmp;
+    }
+    r.sz = 1.0f / dir[r.kz];
+    r.sx = dir[r.kx] * r.sz;
+    r.sy = dir[r.ky] * r.sz;
+    return r;
+}
+
+// Returns t in (0, t_max), or -1 for a miss; b1 and b2 are the barycentric
+// weights of v1 and v2.
+float lc_intersect_sheared(vec3 org, LC_IN(ShearedRay) r, LC_IN(Triangle) tri, float t_max, LC_OUT(float) b1,
+                           LC_OUT(float) b2) {
     b1 = 0.0f;
     b2 = 0.0f;
-    vec3 ad = abs(dir);
-    int kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);
-    int kx = kz == 2 ? 0 : kz + 1;
-    int ky = kx == 2 ? 0 : kx + 1;
-    if (dir[kz] < 0.0f) {
-        int tmp = kx;
-        kx = ky;
-        ky = tmp;
-    }
-    float sz = 1.0f / dir[kz];
-    float sx = dir[kx] * sz;
-    float sy = dir[ky] * sz;
-
     vec3 a = lc_tri_v0(tri) - org;
     vec3 b = lc_tri_v1(tri) - org;
     vec3 c = lc_tri_v2(tri) - org;
-    float ax = a[kx] - sx * a[kz];
-    float ay = a[ky] - sy * a[kz];
-    float bx = b[kx] - sx * b[kz];
-    float by = b[ky] - sy * b[kz];
-    float cx = c[kx] - sx * c[kz];
-    float cy = c[ky] - sy * c[kz];
+    float ax = a[r.kx] - r.sx * a[r.kz];
+    float ay = a[r.ky] - r.sy * a[r.kz];
+    float bx = b[r.kx] - r.sx * b[r.kz];
+    float by = b[r.ky] - r.sy * b[r.kz];
+    float cx = c[r.kx] - r.sx * c[r.kz];
+    float cy = c[r.ky] - r.sy * c[r.kz];
 
     float u = cx * by - cy * bx;
     float v = ax * cy - ay * cx;
@@ -54,12 +65,18 @@ float lc_intersect_triangle(vec3 org, vec3 dir, LC_IN(Triangle) tri, float t_max
     float det = u + v + w;
     if (det == 0.0f) return -1.0f;
 
-    float t_scaled = (u * a[kz] + v * b[kz] + w * c[kz]) * sz;
+    float t_scaled = (u * a[r.kz] + v * b[r.kz] + w * c[r.kz]) * r.sz;
     float t = t_scaled / det;
     if (!(t > 0.0f && t < t_max)) return -1.0f;
     b1 = v / det;
     b2 = w / det;
     return t;
+}
+
+// The test of one ray against one triangle.
+float lc_intersect_triangle(vec3 org, vec3 dir, LC_IN(Triangle) tri, float t_max, LC_OUT(float) b1,
+                            LC_OUT(float) b2) {
+    return lc_intersect_sheared(org, lc_shear_ray(dir), tri, t_max, b1, b2);
 }
 
 // Slab test. The far distance is widened by 2*gamma(3) (Ize, "Robust BVH Ray
@@ -88,6 +105,7 @@ vec3 lc_safe_inverse(vec3 d) {
 uint lc_trace_closest(vec3 org, vec3 dir, float t_max, LC_OUT(float) t_hit, LC_OUT(float) b1,
                       LC_OUT(float) b2) {
     vec3 inv_dir = lc_safe_inverse(dir);
+    ShearedRay sheared = lc_shear_ray(dir);
     uint hit = kInvalidIndex;
     t_hit = t_max;
     b1 = 0.0f;
@@ -102,7 +120,7 @@ uint lc_trace_closest(vec3 org, vec3 dir, float t_max, LC_OUT(float) t_hit, LC_O
         if (node.tri_count > 0u) {
             for (uint i = node.first_or_left; i < node.first_or_left + node.tri_count; ++i) {
                 float u, v;
-                float t = lc_intersect_triangle(org, dir, LC_TRIANGLE(i), t_hit, u, v);
+                float t = lc_intersect_sheared(org, sheared, LC_TRIANGLE(i), t_hit, u, v);
                 if (t > 0.0f) {
                     t_hit = t;
                     b1 = u;
@@ -142,6 +160,7 @@ uint lc_trace_closest(vec3 org, vec3 dir, float t_max, LC_OUT(float) t_hit, LC_O
 // Any hit with t in (0, t_max): true if something blocks the segment.
 bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
     vec3 inv_dir = lc_safe_inverse(dir);
+    ShearedRay sheared = lc_shear_ray(dir);
     uint stack[kBvhStackSize];
     uint sp = 0u;
     stack[sp++] = 0u;
@@ -153,7 +172,7 @@ bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
         if (node.tri_count > 0u) {
             for (uint i = node.first_or_left; i < node.first_or_left + node.tri_count; ++i) {
                 float u, v;
-                if (lc_intersect_triangle(org, dir, LC_TRIANGLE(i), t_max, u, v) > 0.0f) return true;
+                if (lc_intersect_sheared(org, sheared, LC_TRIANGLE(i), t_max, u, v) > 0.0f) return true;
             }
         } else {
             stack[sp++] = node.first_or_left + 1u;
