@@ -85,11 +85,13 @@ void lc_heap_pop(LC_INOUT(uint) size) {
     while (true) {
         uint child = 2u * i + 1u;
         if (child >= size) break;
-        // The larger child by its error alone; the entry is read once
-        // chosen (on the CPU, copying whole entries to compare them made
-        // the compiler write one field and read the entry back, a stalled
+        // The larger child by its error alone, as arithmetic rather than a
+        // branch (which way it goes is a coin toss, so a branch would be
+        // mispredicted at every other level); the entry is read once chosen
+        // (on the CPU, copying whole entries to compare them made the
+        // compiler write one field and read the entry back, a stalled
         // store-to-load forward per level).
-        if (child + 1u < size && LC_HEAP_LOAD(child + 1u).error > LC_HEAP_LOAD(child).error) child += 1u;
+        if (child + 1u < size) child += uint(LC_HEAP_LOAD(child + 1u).error > LC_HEAP_LOAD(child).error);
         HeapEntry c = LC_HEAP_LOAD(child);
         if (c.error <= last.error) break;
         LC_HEAP_STORE(i, c);
