@@ -183,7 +183,7 @@ int run(int argc, char** argv) {
             lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
             std::size_t h = 0;
             for (std::size_t i = b; i < e; ++i)
-                h += lc::cpu::trace_any_wide(tk, p.bvh.wide_nodes.data(), r[i].org, r[i].dir, r[i].t_max) ? 1 : 0;
+                h += lc::cpu::trace_any_wide(tk, p.bvh.wide_nodes.data(), p.bvh.wide_leaves.data(), r[i].org, r[i].dir, r[i].t_max) ? 1 : 0;
             hits[t] = h;
         });
         report("software 4-wide BVH, single rays", r.size(), s, total(), reference);

@@ -213,10 +213,37 @@ float half_area(const BvhNode& n) {
     return dx * dy + dy * dz + dz * dx;
 }
 
+// The wide leaf of binary leaf `leaf`.
+WideLeaf wide_leaf(const BvhNode& leaf, const std::vector<gpu::Triangle>& triangles) {
+    WideLeaf w{};
+    w.first = leaf.first_or_left;
+    w.count = leaf.tri_count;
+    for (std::uint32_t lane = 0; lane < leaf.tri_count; ++lane) {
+        const gpu::Triangle& t = triangles[leaf.first_or_left + lane];
+        const float v0[3] = {t.v0_x, t.v0_y, t.v0_z}, v1[3] = {t.v1_x, t.v1_y, t.v1_z},
+                    v2[3] = {t.v2_x, t.v2_y, t.v2_z};
+        for (int axis = 0; axis < 3; ++axis) {
+            w.v0[axis][lane] = v0[axis];
+            w.v1[axis][lane] = v1[axis];
+            w.v2[axis][lane] = v2[axis];
+        }
+    }
+    return w;
+}
+
+// An empty wide node: every slot masked out (count -1); an empty slot's box
+// is never tested.
+WideBvhNode empty_wide_node() {
+    WideBvhNode w{};
+    for (std::uint32_t s = 0; s < 4; ++s) w.count[s] = -1;
+    return w;
+}
+
 // Writes the wide node for the children of binary node `inner` at
 // wide[index], and its inner children's wide nodes after it (depth first).
-void collapse(const std::vector<BvhNode>& nodes, std::uint32_t inner, std::uint32_t index,
-              std::vector<WideBvhNode>& wide) {
+void collapse(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
+              std::uint32_t inner, std::uint32_t index, std::vector<WideBvhNode>& wide,
+              std::vector<WideLeaf>& leaves) {
     std::array<std::uint32_t, 4> slots{nodes[inner].first_or_left, nodes[inner].first_or_left + 1u, 0u, 0u};
     std::uint32_t used = 2;
     while (used < 4) {
@@ -230,19 +257,16 @@ void collapse(const std::vector<BvhNode>& nodes, std::uint32_t inner, std::uint3
         slots[std::size_t(widest)] = left;
         slots[used++] = left + 1u;
     }
-    WideBvhNode w{};
-    for (std::uint32_t s = 0; s < 4; ++s) {
-        w.count[s] = -1;
-        w.child[s] = 0;
-        // An empty slot's box is never tested (count -1 masks it out).
-        w.lo_x[s] = w.lo_y[s] = w.lo_z[s] = w.hi_x[s] = w.hi_y[s] = w.hi_z[s] = 0.0f;
-    }
+    WideBvhNode w = empty_wide_node();
     for (std::uint32_t s = 0; s < used; ++s) {
         const BvhNode& c = nodes[slots[s]];
         w.lo_x[s] = c.min_x, w.lo_y[s] = c.min_y, w.lo_z[s] = c.min_z;
         w.hi_x[s] = c.max_x, w.hi_y[s] = c.max_y, w.hi_z[s] = c.max_z;
         w.count[s] = std::int32_t(c.tri_count);
-        w.child[s] = c.first_or_left;
+        if (c.tri_count > 0) {
+            w.child[s] = std::uint32_t(leaves.size());
+            leaves.push_back(wide_leaf(c, triangles));
+        }
     }
     wide[index] = w;
     for (std::uint32_t s = 0; s < used; ++s) {
@@ -250,33 +274,30 @@ void collapse(const std::vector<BvhNode>& nodes, std::uint32_t inner, std::uint3
         const auto child = std::uint32_t(wide.size());
         wide.emplace_back();
         wide[index].child[s] = child;
-        collapse(nodes, slots[s], child, wide);
+        collapse(nodes, triangles, slots[s], child, wide, leaves);
     }
 }
 
 }  // namespace
 
-std::vector<WideBvhNode> collapse_bvh(const std::vector<BvhNode>& nodes) {
-    std::vector<WideBvhNode> wide(1);
-    WideBvhNode& root = wide[0];
-    for (std::uint32_t s = 0; s < 4; ++s) {
-        root.count[s] = -1;
-        root.child[s] = 0;
-        root.lo_x[s] = root.lo_y[s] = root.lo_z[s] = root.hi_x[s] = root.hi_y[s] = root.hi_z[s] = 0.0f;
-    }
-    if (nodes.empty()) return wide;
+void collapse_bvh(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
+                  std::vector<WideBvhNode>& wide_nodes, std::vector<WideLeaf>& wide_leaves) {
+    wide_nodes.assign(1, empty_wide_node());
+    wide_leaves.clear();
+    if (nodes.empty()) return;
     const BvhNode& r = nodes[0];
-    if (r.tri_count == 0 && r.first_or_left == 0) return wide;  // no triangles (build_bvh's far root)
+    if (r.tri_count == 0 && r.first_or_left == 0) return;  // no triangles (build_bvh's far root)
     if (r.tri_count > 0) {
         // A root leaf: one slot holding it.
+        WideBvhNode& root = wide_nodes[0];
         root.lo_x[0] = r.min_x, root.lo_y[0] = r.min_y, root.lo_z[0] = r.min_z;
         root.hi_x[0] = r.max_x, root.hi_y[0] = r.max_y, root.hi_z[0] = r.max_z;
         root.count[0] = std::int32_t(r.tri_count);
-        root.child[0] = r.first_or_left;
-        return wide;
+        root.child[0] = 0;
+        wide_leaves.push_back(wide_leaf(r, triangles));
+        return;
     }
-    collapse(nodes, 0, 0, wide);
-    return wide;
+    collapse(nodes, triangles, 0, 0, wide_nodes, wide_leaves);
 }
 
 Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNormals>& normals,
@@ -301,7 +322,7 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
         // axis and sees a box around the origin.
         constexpr float far = std::numeric_limits<float>::max();
         bvh.nodes.push_back(BvhNode{far, far, far, 0u, far, far, far, 0u});
-        bvh.wide_nodes = collapse_bvh(bvh.nodes);
+        collapse_bvh(bvh.nodes, triangles, bvh.wide_nodes, bvh.wide_leaves);
         bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return bvh;
     }
@@ -340,7 +361,7 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
         uvs->swap(sorted_uvs);
     }
 
-    bvh.wide_nodes = collapse_bvh(bvh.nodes);
+    collapse_bvh(bvh.nodes, triangles, bvh.wide_nodes, bvh.wide_leaves);
     bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;
 }

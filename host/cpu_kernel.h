@@ -87,6 +87,7 @@ template <bool kRecordRays>
 struct BasicShadeKernel {
     const BvhNode* bvh_nodes = nullptr;
     const WideBvhNode* wide_nodes = nullptr;  // the same tree 4 wide, for shadow rays (none: bvh_nodes)
+    const WideLeaf* wide_leaves = nullptr;    // its leaves' triangles
     const Triangle* triangles = nullptr;
     const TriangleNormals* normals = nullptr;
     const TriangleUvs* uvs = nullptr;
@@ -169,7 +170,7 @@ struct BasicShadeKernel {
     // tree where one is bound (1.3 to 1.8 times the rays per second on the
     // shipped room, bench/embree_rays).
     bool lc_trace_shadow(vec3 org, vec3 dir, float t_max) {
-        return wide_nodes != nullptr ? trace_any_wide(*this, wide_nodes, org, dir, t_max)
+        return wide_nodes != nullptr ? trace_any_wide(*this, wide_nodes, wide_leaves, org, dir, t_max)
                                      : lc_trace_any(org, dir, t_max);
     }
 };
@@ -183,6 +184,7 @@ BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, HeapEntr
     BasicShadeKernel<kRecordRays> k;
     k.bvh_nodes = p.bvh.nodes.data();
     k.wide_nodes = p.bvh.wide_nodes.empty() ? nullptr : p.bvh.wide_nodes.data();
+    k.wide_leaves = p.bvh.wide_leaves.data();
     k.triangles = p.scene.triangles.data();
     k.normals = p.scene.normals.data();
     k.uvs = p.scene.uvs.data();

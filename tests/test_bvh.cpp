@@ -121,7 +121,7 @@ std::string check_ray(const Scene& s, vec3 org, vec3 dir, float t_max) {
     const bool any = brute_any(s, org, dir, t_max);
     if (k.lc_trace_any(org, dir, t_max) != any)
         return "any-hit disagrees with brute force for " + describe(org, dir, t_max);
-    if (lc::cpu::trace_any_wide(k, s.bvh.wide_nodes.data(), org, dir, t_max) != any)
+    if (lc::cpu::trace_any_wide(k, s.bvh.wide_nodes.data(), s.bvh.wide_leaves.data(), org, dir, t_max) != any)
         return "4-wide any-hit disagrees with brute force for " + describe(org, dir, t_max);
     return {};
 }
@@ -179,14 +179,26 @@ void check_wide_invariants(const Scene& s) {
                 continue;
             }
             ++leaves;
-            EXPECT_EQ(binary_leaves.count({w.child[slot], std::uint32_t(w.count[slot])}), 1u);
-            for (std::uint32_t i = w.child[slot]; i < w.child[slot] + std::uint32_t(w.count[slot]); ++i) {
-                ASSERT_LT(i, s.triangles.size());
-                ++tri_seen[i];
+            ASSERT_LT(w.child[slot], s.bvh.wide_leaves.size());
+            const lc::WideLeaf& leaf = s.bvh.wide_leaves[w.child[slot]];
+            EXPECT_EQ(leaf.count, std::uint32_t(w.count[slot]));
+            EXPECT_EQ(binary_leaves.count({leaf.first, leaf.count}), 1u);
+            for (std::uint32_t lane = 0; lane < 4; ++lane) {
+                if (lane >= leaf.count) {
+                    EXPECT_EQ(leaf.v0[0][lane], 0.0f);  // unused lanes stay zero
+                    continue;
+                }
+                ASSERT_LT(leaf.first + lane, s.triangles.size());
+                ++tri_seen[leaf.first + lane];
+                const Triangle& t = s.triangles[leaf.first + lane];
+                EXPECT_EQ(vec3(leaf.v0[0][lane], leaf.v0[1][lane], leaf.v0[2][lane]), v0(t));
+                EXPECT_EQ(vec3(leaf.v1[0][lane], leaf.v1[1][lane], leaf.v1[2][lane]), v1(t));
+                EXPECT_EQ(vec3(leaf.v2[0][lane], leaf.v2[1][lane], leaf.v2[2][lane]), v2(t));
             }
         }
     }
     EXPECT_EQ(leaves, binary_leaves.size());
+    EXPECT_EQ(s.bvh.wide_leaves.size(), binary_leaves.size());
     EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int c) { return c == 1; }));
     EXPECT_TRUE(std::all_of(tri_seen.begin(), tri_seen.end(), [](int c) { return c == 1; }));
     EXPECT_LE(max_depth, max_leaf_depth(s.bvh.nodes, 0, 0));
@@ -407,7 +419,7 @@ TEST(Bvh, EmptySceneMissesEverything) {
         float t, b1, b2;
         EXPECT_EQ(k.lc_trace_closest(org, dir, kRayInfinity, t, b1, b2), kInvalidIndex);
         EXPECT_FALSE(k.lc_trace_any(org, dir, kRayInfinity));
-        EXPECT_FALSE(lc::cpu::trace_any_wide(k, bvh.wide_nodes.data(), org, dir, kRayInfinity));
+        EXPECT_FALSE(lc::cpu::trace_any_wide(k, bvh.wide_nodes.data(), bvh.wide_leaves.data(), org, dir, kRayInfinity));
     }
     ASSERT_EQ(bvh.wide_nodes.size(), 1u);
     for (int slot = 0; slot < 4; ++slot) EXPECT_EQ(bvh.wide_nodes[0].count[slot], -1);
@@ -453,7 +465,7 @@ TEST(Bvh, DegenerateInputsKeepInvariants) {
     EXPECT_EQ(single.bvh.wide_nodes[0].count[0], 1);
     EXPECT_TRUE(check_ray(single, vec3(0.2f, 0.2f, 1.0f), vec3(0, 0, -1), kRayInfinity).empty());
     lc::cpu::TraceKernel single_kernel = single.kernel();
-    EXPECT_TRUE(lc::cpu::trace_any_wide(single_kernel, single.bvh.wide_nodes.data(), vec3(0.2f, 0.2f, 1.0f),
+    EXPECT_TRUE(lc::cpu::trace_any_wide(single_kernel, single.bvh.wide_nodes.data(), single.bvh.wide_leaves.data(), vec3(0.2f, 0.2f, 1.0f),
                                         vec3(0, 0, -1), kRayInfinity));
 }
 

@@ -10,28 +10,39 @@
 namespace lc {
 
 // A node of the 4-wide copy of the tree that the CPU path's shadow rays
-// traverse (host/cpu_kernel.h, lc_trace_any_wide): the boxes of up to four
-// children side by side, so that one SIMD slab test checks them all. Made
-// from the binary tree by pulling grandchildren up (collapse_bvh), so it has
-// the same leaves and the same triangle tests; the GPU kernels keep the
-// binary tree.
+// traverse (host/wide_trace.h): the boxes of up to four children side by
+// side, so that one SIMD slab test checks them all. Made from the binary
+// tree by pulling grandchildren up (collapse_bvh), so it has the same
+// leaves; the GPU kernels keep the binary tree.
 struct alignas(16) WideBvhNode {
     float lo_x[4], lo_y[4], lo_z[4];
     float hi_x[4], hi_y[4], hi_z[4];
-    std::uint32_t child[4];  // a leaf's first triangle, or an inner child's WideBvhNode index
+    std::uint32_t child[4];  // a leaf's WideLeaf index, or an inner child's WideBvhNode index
     std::int32_t count[4];   // a leaf's triangles (> 0); 0: an inner child; -1: no child
 };
 
+// The triangles of one leaf (at most gpu::kBvhMaxLeafTriangles = 4), lane by
+// lane, so that one SIMD test checks them all: v0[axis][lane] and so on,
+// unused lanes zero. `first` is the leaf's first triangle in the binary
+// tree's order.
+struct alignas(16) WideLeaf {
+    float v0[3][4], v1[3][4], v2[3][4];
+    std::uint32_t first, count, pad0, pad1;
+};
+
 struct Bvh {
-    std::vector<gpu::BvhNode> nodes;   // root at 0 (a single empty leaf if no triangles)
+    std::vector<gpu::BvhNode> nodes;      // root at 0 (a single empty leaf if no triangles)
     std::vector<WideBvhNode> wide_nodes;  // root at 0 (all slots empty if no triangles)
+    std::vector<WideLeaf> wide_leaves;    // one per leaf of wide_nodes
     double build_seconds = 0.0;
 };
 
-// The 4-wide tree of a binary one (build_bvh calls it): each wide node takes
-// the children of a binary node and keeps replacing its largest inner child
-// by that child's two children while it has fewer than four.
-std::vector<WideBvhNode> collapse_bvh(const std::vector<gpu::BvhNode>& nodes);
+// The 4-wide tree of a binary one and its triangles (build_bvh calls it):
+// each wide node takes the children of a binary node and keeps replacing its
+// largest inner child by that child's two children while it has fewer than
+// four.
+void collapse_bvh(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
+                  std::vector<WideBvhNode>& wide_nodes, std::vector<WideLeaf>& wide_leaves);
 
 // Builds the BVH and reorders `triangles`, `normals` and `uvs` when given
 // (same permutation) so that each leaf references a contiguous range. Depth
