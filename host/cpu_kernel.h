@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "lightcuts/render.h"
+#include "pair_bound.h"
 #include "wide_trace.h"
 #include "shared/types.h"
 #include "shared/color.h"
@@ -140,6 +141,7 @@ struct BasicShadeKernel {
     if constexpr (kRecordRays) ray_log->push_back({o, d, t})
 #define LC_SEED_LOBE_BOUND seed_lobe_bound
 #define LC_TRACE_ANY(o, d, t) lc_trace_shadow(o, d, t)
+#define LC_CHILD_ERRORS(sp, m, left, right, d2) lc_child_errors(sp, m, left, right, d2)
 #include "shared/trace.h"
 #include "shared/textures.h"
 #include "shared/shading.h"
@@ -165,6 +167,17 @@ struct BasicShadeKernel {
 #undef LC_ON_SHADOW_RAY
 #undef LC_SEED_LOBE_BOUND
 #undef LC_TRACE_ANY
+#undef LC_CHILD_ERRORS
+
+    // A refinement's two children's lc_cluster_error: both at once in SSE
+    // lanes where pair_errors covers them (host/pair_bound.h), the same
+    // values bit for bit.
+    vec2 lc_child_errors(const SurfacePoint& sp, const Material& m, const LightNode& left, const LightNode& right,
+                         float min_distance2) {
+        vec2 errors;
+        if (pair_errors(*this, sp, m, left, right, min_distance2, errors)) return errors;
+        return vec2(lc_cluster_error(sp, m, left, min_distance2), lc_cluster_error(sp, m, right, min_distance2));
+    }
 
     // The shadow rays' any-hit query: lc_trace_any's answer, from the 4-wide
     // tree where one is bound (1.3 to 1.8 times the rays per second on the

@@ -99,6 +99,71 @@ TEST(LightcutsBounds, EveryBoundIsConservative) {
     EXPECT_GT(zero_bounds, 1000);  // clusters fully below the surface do occur
 }
 
+// The CPU evaluates a refinement's two children's bounds together in SSE
+// lanes (host/pair_bound.h): over random pairs of clusters (points, VPLs,
+// oriented and directional ones, leaves), points (far, near, inside a box,
+// on its face) and materials (Lambert, GGX, Disney), its errors are the
+// scalar lc_cluster_error's bit for bit, and the pair path is taken for
+// most of them.
+TEST(LightcutsBounds, PairOfChildErrorsIsTheScalarOneBitForBit) {
+    std::mt19937 rng(777);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::vector<gpu::Material> materials(1);
+    Kernel k;
+    k.materials = materials.data();
+    k.vpl_min_distance2 = 0.01f;
+    int paired = 0, trials = 0, nonzero = 0;
+    for (int trial = 0; trial < 100000; ++trial) {
+        gpu::Material& m = materials[0];
+        const glm::vec3 kd(u(rng), u(rng), u(rng));
+        const int kind = trial % 7;
+        m = kind < 3 ? test::lambert(kd)
+                     : test::glossy(kd, glm::vec3(u(rng), u(rng), u(rng)), std::pow(10.0f, -3.0f * u(rng)));
+        if (kind == 6) m.flags |= gpu::kMaterialDisney;
+        gpu::LightNode nodes[2];
+        for (gpu::LightNode& node : nodes) {
+            const glm::vec3 centre = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 4.0f;
+            const glm::vec3 half = glm::vec3(u(rng), u(rng), u(rng)) * (u(rng) < 0.2f ? 0.0f : 0.7f);
+            const float pick = u(rng);
+            const std::uint32_t type = pick < 0.7f ? gpu::kLightPoint
+                                       : pick < 0.8f ? gpu::kLightVpl
+                                       : pick < 0.9f ? gpu::kLightOriented
+                                                     : gpu::kLightDirectional;
+            node = test::node_with_box(centre - half, centre + half, type);
+            if (type == gpu::kLightOriented) node.cos_theta_o = 0.5f;
+            if (u(rng) < 0.05f) node.flags |= gpu::kNodeLeaf;
+            node.intensity_r = 10.0f * u(rng), node.intensity_g = 10.0f * u(rng), node.intensity_b = 10.0f * u(rng);
+        }
+        glm::vec3 x = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 6.0f;
+        if (u(rng) < 0.2f) x = glm::vec3(nodes[0].min_x, nodes[0].min_y + 0.5f * (nodes[0].max_y - nodes[0].min_y),
+                                         nodes[0].max_z);  // on a face
+        glm::vec3 n = random_unit(rng);
+        glm::vec3 wo = random_unit(rng);
+        if (glm::dot(wo, n) < 0.0f) wo = -wo;
+        const Kernel::SurfacePoint sp = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f));
+        const float min_distance2 = u(rng) < 0.5f ? 1e-8f : 0.05f;
+        glm::vec2 pair(-1.0f);
+        const bool took = cpu::pair_errors(k, sp, m, nodes[0], nodes[1], min_distance2, pair);
+        const glm::vec2 scalar(k.lc_cluster_error(sp, m, nodes[0], min_distance2),
+                               k.lc_cluster_error(sp, m, nodes[1], min_distance2));
+        const glm::vec2 used = k.lc_child_errors(sp, m, nodes[0], nodes[1], min_distance2);
+        ++trials;
+        paired += took ? 1 : 0;
+        nonzero += scalar.x > 0.0f ? 1 : 0;
+        // Bit for bit: the same float, not merely close.
+        ASSERT_EQ(used.x, scalar.x) << "trial " << trial;
+        ASSERT_EQ(used.y, scalar.y) << "trial " << trial;
+        if (took) {
+            ASSERT_EQ(pair.x, scalar.x) << "trial " << trial;
+            ASSERT_EQ(pair.y, scalar.y) << "trial " << trial;
+        }
+    }
+#if defined(__SSE2__)
+    EXPECT_GT(paired, trials / 4);
+#endif
+    EXPECT_GT(nonzero, trials / 4);
+}
+
 // The GGX bound is tighter than a constant: for a small cluster far from the
 // mirror direction it is far below the lobe's peak D(1) * G1(wo) / (4 cos_o).
 TEST(LightcutsBounds, GgxBoundIsTighterThanThePeak) {

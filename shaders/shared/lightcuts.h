@@ -136,24 +136,26 @@ void lc_heap_push(LC_IN(SurfacePoint) sp, float min_distance2, LC_INOUT(uint) si
     lc_heap_sift_up(smallest, e);
 }
 
-// Adds one cluster to the cut: its bound decides whether it needs a ray at
-// all; leaves are final (exact, zero error) and go to fixed_sum, refinable
-// interior nodes go to the heap. `inherited` is true when the caller already
-// knows the representative's unit contribution (shared with the parent) and
-// the visibility behind it.
-void lc_add_cluster(LC_IN(SurfacePoint) sp, LC_IN(Material) m, uint node_index, bool inherited, vec3 inherited_unit,
-                    bool inherited_visible, float min_distance2, LC_INOUT(uint) heap_size,
+// A cluster's error bound at the point: the luminance of its bound on
+// material * geometry * emission times its intensity; zero for a leaf,
+// which is exact.
+float lc_cluster_error(LC_IN(SurfacePoint) sp, LC_IN(Material) m, LC_IN(LightNode) node, float min_distance2) {
+    if ((node.flags & kNodeLeaf) != 0u) return 0.0f;
+    return lc_luminance(lc_cluster_bound(sp, m, node, min_distance2) * lc_node_intensity(node));
+}
+
+// Adds one cluster (`node`, at node_index, with its lc_cluster_error) to
+// the cut: a zero bound means no ray at all; leaves are final (exact, zero
+// error) and go to fixed_sum, refinable interior nodes go to the heap.
+// `inherited` is true when the caller already knows the representative's
+// unit contribution (shared with the parent) and the visibility behind it.
+void lc_add_cluster(LC_IN(SurfacePoint) sp, uint node_index, LC_IN(LightNode) node, float error, bool inherited,
+                    vec3 inherited_unit, bool inherited_visible, float min_distance2, LC_INOUT(uint) heap_size,
                     LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
-    LightNode node = LC_LIGHT_NODE(node_index);
     vec3 intensity = lc_node_intensity(node);
     bool leaf = (node.flags & kNodeLeaf) != 0u;
-    float error = 0.0f;
-    if (!leaf) {
-        vec3 bound = lc_cluster_bound(sp, m, node, min_distance2);
-        error = lc_luminance(bound * intensity);
-        // A cluster whose bound is zero contributes exactly zero: no ray.
-        if (!(error > 0.0f)) return;
-    }
+    // A cluster whose bound is zero contributes exactly zero: no ray.
+    if (!leaf && !(error > 0.0f)) return;
     bool visible = inherited_visible;
     vec3 unit = inherited ? inherited_unit : lc_rep_unit(sp, node.rep_light, min_distance2, visible, stats);
     if (leaf) {
@@ -192,8 +194,9 @@ void lc_cut_start(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_
     uint root_count = 0u;
     for (uint type = 0u; type < kLightTypeCount; ++type) {
         if (f.roots[type] == kInvalidIndex) continue;
-        lc_add_cluster(sp, m, f.roots[type], false, vec3(0.0f), false, f.min_distance2, heap_size, fixed_sum,
-                       heap_sum, stats);
+        LightNode root = LC_LIGHT_NODE(f.roots[type]);
+        lc_add_cluster(sp, f.roots[type], root, lc_cluster_error(sp, m, root, f.min_distance2), false, vec3(0.0f),
+                       false, f.min_distance2, heap_size, fixed_sum, heap_sum, stats);
         root_count += 1u;
     }
     stats.cut_size = root_count;
@@ -220,10 +223,18 @@ bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) he
     vec3 unit = lc_entry_unit(sp, top, node, f.min_distance2);
     heap_sum -= unit * lc_node_intensity(node);
     bool right_shares = (node.flags & kNodeRepFromRight) != 0u;
-    lc_add_cluster(sp, m, node.left, !right_shares, unit, visible, f.min_distance2, heap_size, fixed_sum,
-                   heap_sum, stats);
-    lc_add_cluster(sp, m, node.left + 1u, right_shares, unit, visible, f.min_distance2, heap_size, fixed_sum,
-                   heap_sum, stats);
+    LightNode left = LC_LIGHT_NODE(node.left);
+    LightNode right = LC_LIGHT_NODE(node.left + 1u);
+#ifdef LC_CHILD_ERRORS
+    // The includer's evaluation of both bounds at once (the CPU's SSE one).
+    vec2 errors = LC_CHILD_ERRORS(sp, m, left, right, f.min_distance2);
+#else
+    vec2 errors = vec2(lc_cluster_error(sp, m, left, f.min_distance2), lc_cluster_error(sp, m, right, f.min_distance2));
+#endif
+    lc_add_cluster(sp, node.left, left, errors.x, !right_shares, unit, visible, f.min_distance2, heap_size,
+                   fixed_sum, heap_sum, stats);
+    lc_add_cluster(sp, node.left + 1u, right, errors.y, right_shares, unit, visible, f.min_distance2, heap_size,
+                   fixed_sum, heap_sum, stats);
     stats.cut_size += 1u;
     if (lc_node_type(node) == kLightVpl) stats.cut_indirect += 1u;
     return true;
