@@ -7,6 +7,9 @@
 // for bit (tests/test_lightcuts.cpp checks it); the GGX lobe's bound stays
 // scalar. Every other case (leaves, directional or oriented clusters, the
 // Disney BRDF) returns false and the caller evaluates one child at a time.
+// A change to lc_cluster_bound, lc_cosine_bound, lc_box_distance2 or
+// lc_luminance (shaders/shared) must be made here too; the test fails until
+// it is.
 #pragma once
 
 #include <glm/glm.hpp>

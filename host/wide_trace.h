@@ -6,6 +6,8 @@
 // by lane with the same operations in the same order, so the answer is the
 // binary traversal's: a triangle is tested here whenever it is there (each
 // of its boxes passes the same test), and each test gives the same result.
+// A change to lc_hit_box or lc_intersect_sheared (shaders/shared/trace.h)
+// must be made here too; the Bvh tests compare the two traversals.
 #pragma once
 
 #include <cstdint>

@@ -585,6 +585,8 @@ vec3 lc_disney_bound(LC_IN(Material) m, vec3 box_min, vec3 box_max, vec3 x, vec3
 // holds positions, G <= 1/d_min^2 with the same clamp as the exact term.
 // Directional lights: the box holds unit directions, so x is the origin and
 // G = 1.
+// The CPU evaluates the common case for two clusters at once with the same
+// arithmetic (host/pair_bound.h): a change here must be made there too.
 vec3 lc_cluster_bound(LC_IN(SurfacePoint) sp, LC_IN(Material) m, LC_IN(LightNode) node, float min_distance2) {
     vec3 box_min = vec3(node.min_x, node.min_y, node.min_z);
     vec3 box_max = vec3(node.max_x, node.max_y, node.max_z);

@@ -79,6 +79,10 @@ float lc_intersect_triangle(vec3 org, vec3 dir, LC_IN(Triangle) tri, float t_max
     return lc_intersect_sheared(org, lc_shear_ray(dir), tri, t_max, b1, b2);
 }
 
+// The CPU's 4-wide traversal (host/wide_trace.h) runs this slab test and
+// lc_intersect_sheared four lanes at a time: a change here must be made
+// there too.
+//
 // Slab test. The far distance is widened by 2*gamma(3) (Ize, "Robust BVH Ray
 // Traversal", JCGT 2013) so rounding never culls a box the ray touches.
 bool lc_hit_box(LC_IN(BvhNode) node, vec3 org, vec3 inv_dir, float t_max, LC_OUT(float) t_entry) {
