@@ -12,6 +12,9 @@
 // it is.
 #pragma once
 
+#include <cmath>
+#include <cstdint>
+
 #include <glm/glm.hpp>
 
 #include "shared/types.h"
