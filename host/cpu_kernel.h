@@ -180,7 +180,7 @@ struct BasicShadeKernel {
     }
 
     // The shadow rays' any-hit query: lc_trace_any's answer, from the 4-wide
-    // tree where one is bound (1.3 to 1.8 times the rays per second on the
+    // tree where one is bound (1.4 to 2.4 times the rays per second on the
     // shipped room, bench/embree_rays).
     bool lc_trace_shadow(vec3 org, vec3 dir, float t_max) {
         return wide_nodes != nullptr ? trace_any_wide(*this, wide_nodes, wide_leaves, org, dir, t_max)
