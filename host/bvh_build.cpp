@@ -217,7 +217,6 @@ float half_area(const BvhNode& n) {
 WideLeaf wide_leaf(const BvhNode& leaf, const std::vector<gpu::Triangle>& triangles) {
     WideLeaf w{};
     w.first = leaf.first_or_left;
-    w.count = leaf.tri_count;
     for (std::uint32_t lane = 0; lane < leaf.tri_count; ++lane) {
         const gpu::Triangle& t = triangles[leaf.first_or_left + lane];
         const float v0[3] = {t.v0_x, t.v0_y, t.v0_z}, v1[3] = {t.v1_x, t.v1_y, t.v1_z},
@@ -239,6 +238,19 @@ WideBvhNode empty_wide_node() {
     return w;
 }
 
+// Puts binary node `c` in slot s of w: its box and count, and for a leaf
+// its triangles as a new wide leaf (an inner child's index comes later).
+void fill_slot(WideBvhNode& w, std::uint32_t s, const BvhNode& c, const std::vector<gpu::Triangle>& triangles,
+               std::vector<WideLeaf>& leaves) {
+    w.lo_x[s] = c.min_x, w.lo_y[s] = c.min_y, w.lo_z[s] = c.min_z;
+    w.hi_x[s] = c.max_x, w.hi_y[s] = c.max_y, w.hi_z[s] = c.max_z;
+    w.count[s] = std::int32_t(c.tri_count);
+    if (c.tri_count > 0) {
+        w.child[s] = std::uint32_t(leaves.size());
+        leaves.push_back(wide_leaf(c, triangles));
+    }
+}
+
 // Writes the wide node for the children of binary node `inner` at
 // wide[index], and its inner children's wide nodes after it (depth first).
 void collapse(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
@@ -258,16 +270,7 @@ void collapse(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle
         slots[used++] = left + 1u;
     }
     WideBvhNode w = empty_wide_node();
-    for (std::uint32_t s = 0; s < used; ++s) {
-        const BvhNode& c = nodes[slots[s]];
-        w.lo_x[s] = c.min_x, w.lo_y[s] = c.min_y, w.lo_z[s] = c.min_z;
-        w.hi_x[s] = c.max_x, w.hi_y[s] = c.max_y, w.hi_z[s] = c.max_z;
-        w.count[s] = std::int32_t(c.tri_count);
-        if (c.tri_count > 0) {
-            w.child[s] = std::uint32_t(leaves.size());
-            leaves.push_back(wide_leaf(c, triangles));
-        }
-    }
+    for (std::uint32_t s = 0; s < used; ++s) fill_slot(w, s, nodes[slots[s]], triangles, leaves);
     wide[index] = w;
     for (std::uint32_t s = 0; s < used; ++s) {
         if (w.count[s] != 0) continue;
@@ -288,13 +291,7 @@ void collapse_bvh(const std::vector<BvhNode>& nodes, const std::vector<gpu::Tria
     const BvhNode& r = nodes[0];
     if (r.tri_count == 0 && r.first_or_left == 0) return;  // no triangles (build_bvh's far root)
     if (r.tri_count > 0) {
-        // A root leaf: one slot holding it.
-        WideBvhNode& root = wide_nodes[0];
-        root.lo_x[0] = r.min_x, root.lo_y[0] = r.min_y, root.lo_z[0] = r.min_z;
-        root.hi_x[0] = r.max_x, root.hi_y[0] = r.max_y, root.hi_z[0] = r.max_z;
-        root.count[0] = std::int32_t(r.tri_count);
-        root.child[0] = 0;
-        wide_leaves.push_back(wide_leaf(r, triangles));
+        fill_slot(wide_nodes[0], 0, r, triangles, wide_leaves);  // a root leaf: one slot holding it
         return;
     }
     collapse(nodes, triangles, 0, 0, wide_nodes, wide_leaves);

@@ -31,8 +31,8 @@ inline constexpr std::uint32_t kWideStackSize = 3u * gpu::kBvhStackSize + 4u;
 // Any hit with t in (0, t_max) among the triangles of the wide tree
 // (nodes, leaves), the same answer as lc_trace_any. `kernel` is a kernel
 // struct of host/cpu_kernel.h: its lc_safe_inverse and lc_shear_ray set the
-// ray up, and without SSE its lc_intersect_sheared and triangles test the
-// leaves.
+// ray up, and without SSE its lc_hit_box, lc_intersect_sheared and
+// triangles do the tests one at a time.
 template <class Kernel>
 bool trace_any_wide(Kernel& kernel, const WideBvhNode* nodes, const WideLeaf* leaves, glm::vec3 org,
                     glm::vec3 dir, float t_max) {
@@ -75,18 +75,17 @@ bool trace_any_wide(Kernel& kernel, const WideBvhNode* nodes, const WideLeaf* le
 #else
         for (unsigned s = 0; s < 4u; ++s) {
             if (node.count[s] < 0) continue;
-            const glm::vec3 t0 = (glm::vec3(node.lo_x[s], node.lo_y[s], node.lo_z[s]) - org) * inv;
-            const glm::vec3 t1 = (glm::vec3(node.hi_x[s], node.hi_y[s], node.hi_z[s]) - org) * inv;
-            const glm::vec3 tn = glm::min(t0, t1), tf = glm::max(t0, t1);
-            const float t_near = glm::max(glm::max(tn.x, tn.y), glm::max(tn.z, 0.0f));
-            const float t_far = glm::min(glm::min(tf.x, tf.y), glm::min(tf.z, t_max)) * 1.0000004f;
-            if (t_near <= t_far) mask |= 1u << s;
+            const gpu::BvhNode box{node.lo_x[s], node.lo_y[s], node.lo_z[s], 0u,
+                                   node.hi_x[s], node.hi_y[s], node.hi_z[s], 0u};
+            float t_entry;
+            if (kernel.lc_hit_box(box, org, inv, t_max, t_entry)) mask |= 1u << s;
         }
 #endif
         while (mask != 0u) {
             const unsigned s = unsigned(__builtin_ctz(mask));
             mask &= mask - 1u;
-            if (node.count[s] == 0) {
+            const std::int32_t count = node.count[s];
+            if (count == 0) {
                 stack[sp++] = node.child[s];
                 continue;
             }
@@ -115,10 +114,10 @@ bool trace_any_wide(Kernel& kernel, const WideBvhNode* nodes, const WideLeaf* le
             const __m128 t = _mm_div_ps(t_scaled, det);
             const __m128 outside = _mm_or_ps(_mm_and_ps(negative, positive), _mm_cmpeq_ps(det, zero));
             const __m128 in_range = _mm_and_ps(_mm_cmpgt_ps(t, zero), _mm_cmplt_ps(t, far_limit));
-            const __m128 used = _mm_castsi128_ps(_mm_cmplt_epi32(lane, _mm_set1_epi32(std::int32_t(leaf.count))));
+            const __m128 used = _mm_castsi128_ps(_mm_cmplt_epi32(lane, _mm_set1_epi32(count)));
             if (_mm_movemask_ps(_mm_and_ps(_mm_andnot_ps(outside, in_range), used)) != 0) return true;
 #else
-            for (std::uint32_t i = leaf.first; i < leaf.first + leaf.count; ++i) {
+            for (std::uint32_t i = leaf.first; i < leaf.first + std::uint32_t(count); ++i) {
                 float b1, b2;
                 if (kernel.lc_intersect_sheared(org, sheared, kernel.triangles[i], t_max, b1, b2) > 0.0f) return true;
             }

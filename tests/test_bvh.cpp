@@ -181,10 +181,10 @@ void check_wide_invariants(const Scene& s) {
             ++leaves;
             ASSERT_LT(w.child[slot], s.bvh.wide_leaves.size());
             const lc::WideLeaf& leaf = s.bvh.wide_leaves[w.child[slot]];
-            EXPECT_EQ(leaf.count, std::uint32_t(w.count[slot]));
-            EXPECT_EQ(binary_leaves.count({leaf.first, leaf.count}), 1u);
+            const auto count = std::uint32_t(w.count[slot]);
+            EXPECT_EQ(binary_leaves.count({leaf.first, count}), 1u);
             for (std::uint32_t lane = 0; lane < 4; ++lane) {
-                if (lane >= leaf.count) {
+                if (lane >= count) {
                     EXPECT_EQ(leaf.v0[0][lane], 0.0f);  // unused lanes stay zero
                     continue;
                 }

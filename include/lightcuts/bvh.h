@@ -21,13 +21,13 @@ struct alignas(16) WideBvhNode {
     std::int32_t count[4];   // a leaf's triangles (> 0); 0: an inner child; -1: no child
 };
 
-// The triangles of one leaf (at most gpu::kBvhMaxLeafTriangles = 4), lane by
-// lane, so that one SIMD test checks them all: v0[axis][lane] and so on,
-// unused lanes zero. `first` is the leaf's first triangle in the binary
-// tree's order.
+// The triangles of one leaf (at most gpu::kBvhMaxLeafTriangles = 4; how many
+// is its slot's count), lane by lane, so that one SIMD test checks them all:
+// v0[axis][lane] and so on, unused lanes zero. `first` is the leaf's first
+// triangle in the binary tree's order.
 struct alignas(16) WideLeaf {
     float v0[3][4], v1[3][4], v2[3][4];
-    std::uint32_t first, count, pad0, pad1;
+    std::uint32_t first, pad0, pad1, pad2;
 };
 
 struct Bvh {
