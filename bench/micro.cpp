@@ -90,15 +90,17 @@ BENCHMARK(BM_ClusterBound);
 void BM_CutSelection(benchmark::State& state) {
     Fixture f(std::size_t(state.range(0)));
     std::size_t i = 0;
-    std::uint64_t rays = 0, cut = 0;
+    std::uint64_t rays = 0, cut = 0, frozen = 0;
     for (auto _ : state) {
         ShadeKernel::ShadeStats ss{};
         benchmark::DoNotOptimize(f.k.lc_shade_lightcuts(f.points[i++ % f.points.size()], f.frame, ss));
         rays += ss.shadow_rays;
         cut += ss.cut_size;
+        frozen += ss.frozen;
     }
     state.counters["cut_size"] = benchmark::Counter(double(cut), benchmark::Counter::kAvgIterations);
     state.counters["shadow_rays"] = benchmark::Counter(double(rays), benchmark::Counter::kAvgIterations);
+    state.counters["frozen"] = benchmark::Counter(double(frozen), benchmark::Counter::kAvgIterations);
 }
 BENCHMARK(BM_CutSelection)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMicrosecond);
 

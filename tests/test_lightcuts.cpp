@@ -248,6 +248,12 @@ TEST(LightcutsHeap, PopsInDecreasingOrder) {
             pushed.erase(it);
             k.lc_heap_pop(size);
         }
+        if (i % 7 == 5) {  // and replacements of the top (a refinement's larger child)
+            auto it = std::max_element(pushed.begin(), pushed.end());
+            ASSERT_EQ(storage[0].error, *it);
+            *it = u(rng);
+            k.lc_heap_replace_top(size, cpu::HeapEntry{std::uint32_t(i), *it, glm::vec3(0.0f)});
+        }
     }
     ASSERT_EQ(size, pushed.size());
     std::sort(pushed.rbegin(), pushed.rend());
@@ -257,6 +263,36 @@ TEST(LightcutsHeap, PopsInDecreasingOrder) {
     }
     EXPECT_EQ(size, 0u);
     EXPECT_EQ(ss.frozen, 0u);
+}
+
+// The CPU's search of a full heap's leaves for the entry to freeze
+// (cpu::heap_smallest, eight slots at a time in SSE lanes) gives the shared
+// scalar loop's answer: the first slot of the smallest error below the
+// bound, none if no error is below it; on ranges of every length and
+// offset, with ties.
+TEST(LightcutsHeap, SmallestSearchIsTheScalarLoop) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    std::vector<cpu::HeapEntry> heap(80);
+    int found = 0, none = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        for (auto& e : heap) e.error = float(int(u(rng) * 16.0f) + 1) / 16.0f;  // ties in every range
+        const auto from = std::uint32_t(u(rng) * 40.0f);
+        const auto to = from + std::uint32_t(u(rng) * 40.0f);
+        const float bound = float(int(u(rng) * 20.0f)) / 16.0f;
+        std::uint32_t expected = gpu::kInvalidIndex;
+        float smallest = bound;
+        for (std::uint32_t i = from; i < to; ++i)
+            if (heap[i].error < smallest) {
+                smallest = heap[i].error;
+                expected = i;
+            }
+        ASSERT_EQ(cpu::heap_smallest(heap.data(), from, to, bound), expected)
+            << "trial " << trial << " slots [" << from << ", " << to << ") bound " << bound;
+        (expected == gpu::kInvalidIndex ? none : found) += 1;
+    }
+    EXPECT_GT(found, 5000);
+    EXPECT_GT(none, 2000);
 }
 
 // A full heap of K entries freezes the smallest bound of the K + 1 it would

@@ -10,6 +10,10 @@
 //   LC_HEAP_STORE(i, e)     stores HeapEntry e in slot i
 //   LC_HEAP_CAPACITY        K, the heap's capacity (see lc_heap_push)
 //   LC_PREFETCH_LIGHT_NODES(i) (optional) starts loading nodes i and i + 1
+//   LC_HEAP_SMALLEST(from, to, bound) (optional) lc_heap_smallest's answer,
+//                           found the includer's way
+//   LC_CHILD_ERRORS(sp, m, left, right, min_distance2) (optional) -> vec2,
+//                           both children's lc_cluster_error at once
 // On the GPU the K slots live in workgroup shared memory; on the CPU they
 // are a per-thread array.
 // No include guard: each kernel context (a GLSL shader, a C++ kernel
@@ -76,11 +80,9 @@ void lc_heap_sift_up(uint i, HeapEntry e) {
     LC_HEAP_STORE(i, e);
 }
 
-// Removes the largest entry (slot 0).
-void lc_heap_pop(LC_INOUT(uint) size) {
-    size -= 1u;
-    if (size == 0u) return;
-    HeapEntry last = LC_HEAP_LOAD(size);
+// Puts e in place of the largest entry (slot 0) of a heap of `size`
+// entries and lets it sink to its place: a pop and a push in one pass.
+void lc_heap_replace_top(uint size, HeapEntry e) {
     uint i = 0u;
     while (true) {
         uint child = 2u * i + 1u;
@@ -93,11 +95,37 @@ void lc_heap_pop(LC_INOUT(uint) size) {
         // store-to-load forward per level).
         if (child + 1u < size) child += uint(LC_HEAP_LOAD(child + 1u).error > LC_HEAP_LOAD(child).error);
         HeapEntry c = LC_HEAP_LOAD(child);
-        if (c.error <= last.error) break;
+        if (c.error <= e.error) break;
         LC_HEAP_STORE(i, c);
         i = child;
     }
-    LC_HEAP_STORE(i, last);
+    LC_HEAP_STORE(i, e);
+}
+
+// Removes the largest entry (slot 0).
+void lc_heap_pop(LC_INOUT(uint) size) {
+    size -= 1u;
+    if (size > 0u) lc_heap_replace_top(size, LC_HEAP_LOAD(size));
+}
+
+// The slot in [from, to) with the smallest error, the first of equals,
+// if that error is below `bound`; kInvalidIndex if none is.
+uint lc_heap_smallest(uint from, uint to, float bound) {
+#ifdef LC_HEAP_SMALLEST
+    // The includer's own search (the CPU's SSE one), the same answer.
+    return LC_HEAP_SMALLEST(from, to, bound);
+#else
+    uint smallest = kInvalidIndex;
+    float smallest_error = bound;
+    for (uint i = from; i < to; ++i) {
+        float error = LC_HEAP_LOAD(i).error;
+        if (error < smallest_error) {
+            smallest_error = error;
+            smallest = i;
+        }
+    }
+    return smallest;
+#endif
 }
 
 // The bounded heap: at most LC_HEAP_CAPACITY entries. A push into a full
@@ -115,22 +143,15 @@ void lc_heap_push(LC_IN(SurfacePoint) sp, float min_distance2, LC_INOUT(uint) si
         return;
     }
     stats.frozen += 1u;
-    uint smallest = kInvalidIndex;
-    float smallest_error = e.error;
-    for (uint i = size / 2u; i < size; ++i) {
-        float error = LC_HEAP_LOAD(i).error;
-        if (error < smallest_error) {
-            smallest_error = error;
-            smallest = i;
-        }
-    }
+    uint smallest = lc_heap_smallest(size / 2u, size, e.error);
     if (smallest == kInvalidIndex) {
         stats.frozen_error += e.error;
         fixed_sum += estimate;
         return;
     }
-    stats.frozen_error += smallest_error;
-    vec3 frozen = lc_entry_estimate(sp, LC_HEAP_LOAD(smallest), min_distance2);
+    HeapEntry leaving = LC_HEAP_LOAD(smallest);
+    stats.frozen_error += leaving.error;
+    vec3 frozen = lc_entry_estimate(sp, leaving, min_distance2);
     fixed_sum += frozen;
     heap_sum += estimate - frozen;
     lc_heap_sift_up(smallest, e);
@@ -144,25 +165,33 @@ float lc_cluster_error(LC_IN(SurfacePoint) sp, LC_IN(Material) m, LC_IN(LightNod
     return lc_luminance(lc_cluster_bound(sp, m, node, min_distance2) * lc_node_intensity(node));
 }
 
-// Adds one cluster (`node`, at node_index, with its lc_cluster_error) to
-// the cut: a zero bound means no ray at all; leaves are final (exact, zero
-// error) and go to fixed_sum, refinable interior nodes go to the heap.
+// One cluster (`node`, at node_index, with its lc_cluster_error) entering
+// the cut: a zero bound means no ray at all; a leaf is final (exact, zero
+// error) and goes to fixed_sum. True for a refinable interior node, whose
+// heap entry and estimate are then in `e` and `estimate` for the caller to
+// place in the heap.
 // `inherited` is true when the caller already knows the representative's
 // unit contribution (shared with the parent) and the visibility behind it.
-void lc_add_cluster(LC_IN(SurfacePoint) sp, uint node_index, LC_IN(LightNode) node, float error, bool inherited,
-                    vec3 inherited_unit, bool inherited_visible, float min_distance2, LC_INOUT(uint) heap_size,
-                    LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
+bool lc_cluster_entry(LC_IN(SurfacePoint) sp, uint node_index, LC_IN(LightNode) node, float error, bool inherited,
+                      vec3 inherited_unit, bool inherited_visible, float min_distance2, LC_OUT(HeapEntry) e,
+                      LC_OUT(vec3) estimate, LC_INOUT(vec3) fixed_sum, LC_INOUT(ShadeStats) stats) {
+    // Defined on every path (the caller reads them only after a true).
+    e.node = kInvalidIndex;
+    e.error = 0.0f;
+#ifdef LC_HEAP_KEEPS_UNITS
+    e.unit = vec3(0.0f);
+#endif
+    estimate = vec3(0.0f);
     vec3 intensity = lc_node_intensity(node);
     bool leaf = (node.flags & kNodeLeaf) != 0u;
     // A cluster whose bound is zero contributes exactly zero: no ray.
-    if (!leaf && !(error > 0.0f)) return;
+    if (!leaf && !(error > 0.0f)) return false;
     bool visible = inherited_visible;
     vec3 unit = inherited ? inherited_unit : lc_rep_unit(sp, node.rep_light, min_distance2, visible, stats);
     if (leaf) {
         fixed_sum += unit * intensity;
-        return;
+        return false;
     }
-    HeapEntry e;
     e.node = node_index | (visible ? kCutEntryVisible : 0u);
     e.error = error;
 #ifdef LC_HEAP_KEEPS_UNITS
@@ -173,7 +202,20 @@ void lc_add_cluster(LC_IN(SurfacePoint) sp, uint node_index, LC_IN(LightNode) no
     // loading them now (the CPU; the GLSL kernels have no prefetch).
     LC_PREFETCH_LIGHT_NODES(node.left);
 #endif
-    lc_heap_push(sp, min_distance2, heap_size, e, unit * intensity, fixed_sum, heap_sum, stats);
+    estimate = unit * intensity;
+    return true;
+}
+
+// Adds one cluster to the cut (lc_cluster_entry), into the heap if it can
+// be refined.
+void lc_add_cluster(LC_IN(SurfacePoint) sp, uint node_index, LC_IN(LightNode) node, float error, float min_distance2,
+                    LC_INOUT(uint) heap_size, LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum,
+                    LC_INOUT(ShadeStats) stats) {
+    HeapEntry e;
+    vec3 estimate;
+    if (lc_cluster_entry(sp, node_index, node, error, false, vec3(0.0f), false, min_distance2, e, estimate,
+                         fixed_sum, stats))
+        lc_heap_push(sp, min_distance2, heap_size, e, estimate, fixed_sum, heap_sum, stats);
 }
 
 // Walter 2005, section 4: start from the roots, repeatedly replace the
@@ -195,8 +237,8 @@ void lc_cut_start(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_
     for (uint type = 0u; type < kLightTypeCount; ++type) {
         if (f.roots[type] == kInvalidIndex) continue;
         LightNode root = LC_LIGHT_NODE(f.roots[type]);
-        lc_add_cluster(sp, f.roots[type], root, lc_cluster_error(sp, m, root, f.min_distance2), false, vec3(0.0f),
-                       false, f.min_distance2, heap_size, fixed_sum, heap_sum, stats);
+        lc_add_cluster(sp, f.roots[type], root, lc_cluster_error(sp, m, root, f.min_distance2), f.min_distance2,
+                       heap_size, fixed_sum, heap_sum, stats);
         root_count += 1u;
     }
     stats.cut_size = root_count;
@@ -217,7 +259,6 @@ bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) he
         stats.hit_max_cut = 1u;
         return false;
     }
-    lc_heap_pop(heap_size);
     LightNode node = LC_LIGHT_NODE(lc_entry_node(top));
     bool visible = lc_entry_visible(top);
     vec3 unit = lc_entry_unit(sp, top, node, f.min_distance2);
@@ -231,10 +272,36 @@ bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) he
 #else
     vec2 errors = vec2(lc_cluster_error(sp, m, left, f.min_distance2), lc_cluster_error(sp, m, right, f.min_distance2));
 #endif
-    lc_add_cluster(sp, node.left, left, errors.x, !right_shares, unit, visible, f.min_distance2, heap_size,
-                   fixed_sum, heap_sum, stats);
-    lc_add_cluster(sp, node.left + 1u, right, errors.y, right_shares, unit, visible, f.min_distance2, heap_size,
-                   fixed_sum, heap_sum, stats);
+    HeapEntry a, b;
+    vec3 estimate_a, estimate_b;
+    bool has_a = lc_cluster_entry(sp, node.left, left, errors.x, !right_shares, unit, visible, f.min_distance2, a,
+                                  estimate_a, fixed_sum, stats);
+    bool has_b = lc_cluster_entry(sp, node.left + 1u, right, errors.y, right_shares, unit, visible, f.min_distance2,
+                                  b, estimate_b, fixed_sum, stats);
+    // The parent leaves the heap and its children enter it: the larger
+    // child takes the parent's slot and sinks from there, one pass where a
+    // pop and a push take two; the smaller one is pushed (and may freeze
+    // the heap's smallest entry).
+    if (has_a && has_b && b.error > a.error) {
+        HeapEntry swap_entry = a;
+        vec3 swap_estimate = estimate_a;
+        a = b;
+        estimate_a = estimate_b;
+        b = swap_entry;
+        estimate_b = swap_estimate;
+    } else if (has_b && !has_a) {
+        a = b;
+        estimate_a = estimate_b;
+        has_a = true;
+        has_b = false;
+    }
+    if (has_a) {
+        lc_heap_replace_top(heap_size, a);
+        heap_sum += estimate_a;
+    } else {
+        lc_heap_pop(heap_size);
+    }
+    if (has_b) lc_heap_push(sp, f.min_distance2, heap_size, b, estimate_b, fixed_sum, heap_sum, stats);
     stats.cut_size += 1u;
     if (lc_node_type(node) == kLightVpl) stats.cut_indirect += 1u;
     return true;
