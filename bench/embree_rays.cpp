@@ -190,6 +190,24 @@ int run(int argc, char** argv) {
 
         std::fill(hits.begin(), hits.end(), 0);
         s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+            lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
+            std::size_t h = 0;
+            for (std::size_t i = b; i < e; i += 4) {
+                lc::cpu::RayPacket4 packet;
+                for (std::size_t j = 0; j < 4 && i + j < e; ++j) {
+                    packet.org[j] = r[i + j].org, packet.dir[j] = r[i + j].dir, packet.t_max[j] = r[i + j].t_max;
+                    packet.valid |= 1u << j;
+                }
+                const unsigned got =
+                    lc::cpu::trace_any_wide4(tk, p.bvh.wide_nodes.data(), p.bvh.wide_leaves.data(), packet);
+                h += unsigned(__builtin_popcount(got));
+            }
+            hits[t] = h;
+        });
+        report("software 4-wide BVH, packets of 4", r.size(), s, total(), reference);
+
+        std::fill(hits.begin(), hits.end(), 0);
+        s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
             RTCIntersectContext ctx;
             rtcInitIntersectContext(&ctx);
             std::size_t h = 0;

@@ -57,7 +57,7 @@ glm::vec3 shade_point(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Method
                    (1.0f / float(frame.light_samples));
         case Method::kBrute: break;
     }
-    return k.lc_shade_brute(sp, frame.light_count, frame.min_distance2, ss);
+    return k.lc_shade_brute_packets(sp, frame.light_count, frame.min_distance2, ss);
 }
 
 PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Method method, std::uint32_t x,

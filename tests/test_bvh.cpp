@@ -402,6 +402,54 @@ TEST(Bvh, TraversalMatchesBruteForceIncludingSharedEdges) {
     EXPECT_EQ(misses_inside, 0) << "rays leaked through shared edges or vertices of the closed grid";
 }
 
+// Packets of four rays (trace_any_wide4, the CPU's brute force): each ray
+// gets brute force's any-hit answer, as on its own; rays left out of the
+// packet report nothing. Packets share an origin, as a shaded point's rays
+// do, with directions close together or spread out, including rays from
+// inside the closed grid to its shared edges and vertices.
+TEST(Bvh, PacketsOfFourGiveEachRaysAnswer) {
+    std::mt19937 rng(20261201u);
+    GridCube cube(6, vec3(25.0f, 3.0f, -4.0f), 8.0f, vec3(0.3f, 1.0f, 0.2f), 0.7f);
+    std::vector<Triangle> tris = random_triangles(rng, 2000, 10.0f, 1.5f);
+    const std::vector<Triangle> grid = cube.triangles();
+    tris.insert(tris.end(), grid.begin(), grid.end());
+    const Scene scene(std::move(tris));
+    lc::cpu::TraceKernel k = scene.kernel();
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f), box(-15.0f, 15.0f), inner(-0.35f, 0.35f);
+    int failures = 0, blocked = 0, rays = 0;
+    std::string first_failure;
+    for (int packet_index = 0; packet_index < 4000; ++packet_index) {
+        const bool in_cube = packet_index % 4 == 3;
+        const vec3 org = in_cube ? cube.center + cube.rotation * (vec3(inner(rng), inner(rng), inner(rng)) * cube.size)
+                                 : vec3(box(rng) + 10.0f, box(rng), box(rng));
+        const vec3 base = random_unit(rng);
+        const float spread = std::pow(10.0f, -3.0f * u01(rng));
+        lc::cpu::RayPacket4 packet;
+        for (int j = 0; j < 4; ++j) {
+            packet.org[j] = org;
+            packet.dir[j] = in_cube ? cube.random_edge_point(rng).first - org
+                                    : (packet_index % 2 ? glm::normalize(base + spread * random_unit(rng))
+                                                        : random_unit(rng));
+            packet.t_max[j] = in_cube || u01(rng) < 0.5f ? kRayInfinity : 30.0f * u01(rng);
+        }
+        packet.valid = packet_index % 8 == 5 ? 1u + unsigned(u01(rng) * 14.99f) : 15u;
+        const unsigned valid = packet.valid;
+        const unsigned got =
+            lc::cpu::trace_any_wide4(k, scene.bvh.wide_nodes.data(), scene.bvh.wide_leaves.data(), packet);
+        for (int j = 0; j < 4; ++j) {
+            const bool expected = (valid >> j & 1u) != 0u && brute_any(scene, org, packet.dir[j], packet.t_max[j]);
+            rays += (valid >> j & 1u) != 0u;
+            blocked += expected;
+            if (((got >> j & 1u) != 0u) != expected && failures++ == 0)
+                first_failure = "packet " + std::to_string(packet_index) + " ray " + std::to_string(j) + ": " +
+                                describe(org, packet.dir[j], packet.t_max[j]);
+        }
+    }
+    EXPECT_EQ(failures, 0) << "first: " << first_failure;
+    EXPECT_GT(blocked, rays / 10);
+    EXPECT_LT(blocked, rays - rays / 10);
+}
+
 TEST(Bvh, EmptySceneMissesEverything) {
     std::vector<Triangle> tris;
     std::vector<TriangleNormals> normals;

@@ -394,6 +394,41 @@ TEST(Lightcuts, MaxCutOneUsesTheRootRepresentative) {
     EXPECT_GT(lit, 100);
 }
 
+// The CPU's brute force traces its shadow rays four at a time
+// (lc_shade_brute_packets, trace_any_wide4) and must give the shared
+// per-light loop's result bit for bit, with the same ray count, at every
+// point: the contributions of the unblocked lights are summed in the same
+// order.
+TEST(BruteForce, PacketsGiveTheSharedLoopsResultBitForBit) {
+    Scene s = test::room_scene(test::random_point_lights(2000, {-0.9f, 0.1f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 3), 32);
+    PreparedScene p = prepare_scene(std::move(s), 1);
+    RenderOptions o = test::options("brute", 32);
+    gpu::FrameParams f = make_frame_params(p, o);
+    Kernel k = cpu::make_shade_kernel(p);
+    ASSERT_NE(k.wide_nodes, nullptr);
+    int shadowed = 0;
+    for (std::uint32_t y = 0; y < 32; ++y)
+        for (std::uint32_t x = 0; x < 32; ++x) {
+            Kernel::SurfacePoint sp;
+            ASSERT_TRUE(k.lc_camera_hit(f, x, y, 0, sp));
+            Kernel::ShadeStats loop_stats{}, packet_stats{};
+            const glm::vec3 loop = k.lc_shade_brute(sp, f.light_count, f.min_distance2, loop_stats);
+            const glm::vec3 packets = k.lc_shade_brute_packets(sp, f.light_count, f.min_distance2, packet_stats);
+            ASSERT_EQ(packets, loop) << x << "," << y;
+            ASSERT_EQ(packet_stats.shadow_rays, loop_stats.shadow_rays) << x << "," << y;
+            // Where shadows matter: the unshadowed sum is larger.
+            glm::vec3 unshadowed(0.0f);
+            for (std::uint32_t i = 0; i < f.light_count; ++i) {
+                glm::vec3 wi;
+                float t_max;
+                unshadowed += k.lc_light_unit(sp, p.tree.lights[i], f.min_distance2, wi, t_max) *
+                              k.lc_light_intensity(p.tree.lights[i]);
+            }
+            shadowed += gpu::lc_luminance(unshadowed) > 1.01f * gpu::lc_luminance(loop);
+        }
+    EXPECT_GT(shadowed, 100);
+}
+
 // The seed report compared the bound with the estimate in absolute terms;
 // the threshold here is relative. Scaling every intensity by an exact power
 // of two scales every bound, estimate and cluster sum exactly (no rounding,
