@@ -160,18 +160,15 @@ bool trace_any_wide(Kernel& kernel, const WideBvhNode* nodes, const WideLeaf* le
 }
 
 #if defined(__SSE2__)
-// The rays of a packet as intervals, for a test of a box against all of
-// them at once: on each axis the inverse directions lie in [inv_lo, inv_hi]
-// and share a sign (`coherent`; a packet whose rays point both ways along
-// an axis is traced ray by ray), so every ray enters the slab through the
-// same plane (`near`: lo where the rays go up the axis, hi where they go
-// down) and leaves through the other; o_near and o_far are the extreme
-// origins that make those planes' distances smallest and largest.
+// A packet of rays from one origin as intervals, for a test of a box
+// against all of them at once: on each axis the inverse directions lie in
+// [inv_lo, inv_hi] and share a sign, so every ray enters the slab through
+// the same plane (`near`: lo where the rays go up the axis, hi where they go
+// down) and leaves through the other (`far`).
 struct PacketBounds {
-    bool coherent = false;
     float (WideBvhNode::*near[3])[4];
     float (WideBvhNode::*far[3])[4];
-    __m128 inv_lo[3], inv_hi[3], o_near[3], o_far[3];
+    __m128 inv_lo[3], inv_hi[3], org[3];
     __m128 t_max;  // the longest ray's
 };
 #endif
@@ -188,64 +185,58 @@ struct RayPacket4 {
 };
 
 #if defined(__SSE2__)
+// The packet's PacketBounds, if it is coherent: its rays leave one point in
+// similar directions (a shaded point's rays to neighbouring lights), the
+// case where interval bounds are tight. Rays from several points, or whose
+// inverse directions differ in sign or by more than a factor of five on an
+// axis, are traced ray by ray. (On the room's brute-force rays a factor of
+// 1.25 took a third of the packets' gain away; 2, 5 and no limit ran at the
+// same speed, bench/embree_rays.)
 template <class Kernel>
-PacketBounds packet_bounds(Kernel& kernel, const RayPacket4& packet) {
-    PacketBounds b;
-    float inv_lo[3] = {}, inv_hi[3] = {}, o_lo[3] = {}, o_hi[3] = {}, t_max = 0.0f;
-    bool first = true;
-    for (unsigned r = 0; r < 4u; ++r) {
+bool packet_bounds(Kernel& kernel, const RayPacket4& packet, PacketBounds& b) {
+    const unsigned first = unsigned(__builtin_ctz(packet.valid));
+    const glm::vec3 org = packet.org[first];
+    glm::vec3 inv_lo = kernel.lc_safe_inverse(packet.dir[first]), inv_hi = inv_lo;
+    float t_max = packet.t_max[first];
+    for (unsigned r = first + 1u; r < 4u; ++r) {
         if ((packet.valid >> r & 1u) == 0u) continue;
+        if (packet.org[r] != org) return false;
         const glm::vec3 inv = kernel.lc_safe_inverse(packet.dir[r]);
-        for (int k = 0; k < 3; ++k) {
-            inv_lo[k] = first ? inv[k] : std::min(inv_lo[k], inv[k]);
-            inv_hi[k] = first ? inv[k] : std::max(inv_hi[k], inv[k]);
-            o_lo[k] = first ? packet.org[r][k] : std::min(o_lo[k], packet.org[r][k]);
-            o_hi[k] = first ? packet.org[r][k] : std::max(o_hi[k], packet.org[r][k]);
-        }
-        t_max = first ? packet.t_max[r] : std::max(t_max, packet.t_max[r]);
-        first = false;
+        inv_lo = glm::min(inv_lo, inv);
+        inv_hi = glm::max(inv_hi, inv);
+        t_max = std::max(t_max, packet.t_max[r]);
     }
-    b.coherent = true;
     float(WideBvhNode::*const lo[3])[4] = {&WideBvhNode::lo_x, &WideBvhNode::lo_y, &WideBvhNode::lo_z};
     float(WideBvhNode::*const hi[3])[4] = {&WideBvhNode::hi_x, &WideBvhNode::hi_y, &WideBvhNode::hi_z};
     for (int k = 0; k < 3; ++k) {
         // lc_safe_inverse never gives 0: each inverse is either side of it.
         const bool up = inv_lo[k] > 0.0f;
-        b.coherent = b.coherent && (up || inv_hi[k] < 0.0f);
+        if (!up && !(inv_hi[k] < 0.0f)) return false;
+        const float small = up ? inv_lo[k] : -inv_hi[k], large = up ? inv_hi[k] : -inv_lo[k];
+        if (!(large <= 5.0f * small)) return false;
         b.near[k] = up ? lo[k] : hi[k];
         b.far[k] = up ? hi[k] : lo[k];
         b.inv_lo[k] = _mm_set1_ps(inv_lo[k]);
         b.inv_hi[k] = _mm_set1_ps(inv_hi[k]);
-        b.o_near[k] = _mm_set1_ps(up ? o_hi[k] : o_lo[k]);
-        b.o_far[k] = _mm_set1_ps(up ? o_lo[k] : o_hi[k]);
+        b.org[k] = _mm_set1_ps(org[k]);
     }
     b.t_max = _mm_set1_ps(t_max);
-    // The bounds are tight only for rays that leave one point in similar
-    // directions (a shaded point's rays to neighbouring lights): rays from
-    // several points, or whose inverse directions differ by more than a
-    // factor of five on an axis, are traced ray by ray. (On the room's brute
-    // force rays, a factor of 1.25 took a third of the packets' gain away;
-    // 2, 5 and no limit gave the same speed, bench/embree_rays.)
-    for (int k = 0; k < 3; ++k)
-        b.coherent = b.coherent && o_lo[k] == o_hi[k] &&
-                     std::max(std::fabs(inv_lo[k]), std::fabs(inv_hi[k])) <=
-                         5.0f * std::min(std::fabs(inv_lo[k]), std::fabs(inv_hi[k]));
-    return b;
+    return true;
 }
 
 // lc_hit_box for a whole packet on a node's four boxes: bit s is set where
-// child s may be entered by one of the rays. Each ray's entry distance on
-// an axis is (near plane - origin) * inverse, at least the smallest
-// product of the intervals' ends, and its exit distance at most the
-// largest; float rounding is monotonic, so these bounds hold for the
-// products lc_hit_box computes too, and a box that any ray's own test
-// enters passes here (the converse need not hold: the leaves' triangle
-// tests are exact, ray by ray).
+// child s may be entered by one of the rays. Each ray's distance to a plane
+// on an axis is (plane - origin) * inverse, the same difference for every
+// ray times an inverse within [inv_lo, inv_hi]: at least the smaller and at
+// most the larger of the two ends' products. Float rounding is monotonic,
+// so those bounds hold for the products lc_hit_box computes too, and a box
+// that any ray's own test enters passes here (the converse need not hold:
+// the triangles are tested ray by ray, exactly).
 inline unsigned packet_hit_boxes(const WideBvhNode& node, const PacketBounds& b) {
     __m128 t_near = _mm_setzero_ps(), t_far = b.t_max;
     for (int k = 0; k < 3; ++k) {
-        const __m128 near_d = _mm_sub_ps(_mm_load_ps(node.*b.near[k]), b.o_near[k]);
-        const __m128 far_d = _mm_sub_ps(_mm_load_ps(node.*b.far[k]), b.o_far[k]);
+        const __m128 near_d = _mm_sub_ps(_mm_load_ps(node.*b.near[k]), b.org[k]);
+        const __m128 far_d = _mm_sub_ps(_mm_load_ps(node.*b.far[k]), b.org[k]);
         t_near = _mm_max_ps(t_near, _mm_min_ps(_mm_mul_ps(near_d, b.inv_lo[k]), _mm_mul_ps(near_d, b.inv_hi[k])));
         t_far = _mm_min_ps(t_far, _mm_max_ps(_mm_mul_ps(far_d, b.inv_lo[k]), _mm_mul_ps(far_d, b.inv_hi[k])));
     }
@@ -306,9 +297,8 @@ template <class Kernel>
 unsigned trace_any_wide4(Kernel& kernel, const WideBvhNode* nodes, const WideLeaf* leaves, const RayPacket4& packet) {
     const unsigned valid = packet.valid & 0xFu;
 #if defined(__SSE2__)
-    if (valid == 0u) return 0u;
-    const PacketBounds bounds = packet_bounds(kernel, packet);
-    if (bounds.coherent) {
+    PacketBounds bounds;
+    if (valid != 0u && packet_bounds(kernel, packet, bounds)) {
         WideRay rays[4];
         for (unsigned r = 0; r < 4u; ++r)
             if ((valid >> r & 1u) != 0u) rays[r] = wide_ray(kernel, packet.org[r], packet.dir[r], packet.t_max[r]);
