@@ -354,7 +354,7 @@ struct GridCube {
 // whose shared edges and vertices rays aim at.
 GridCube traversal_cube() { return GridCube(6, vec3(25.0f, 3.0f, -4.0f), 8.0f, vec3(0.3f, 1.0f, 0.2f), 0.7f); }
 
-std::vector<Triangle> traversal_triangles(std::mt19937& rng, const GridCube& cube) {
+std::vector<Triangle> traversal_triangles(std::mt19937& rng, GridCube& cube) {
     std::vector<Triangle> tris = random_triangles(rng, 2000, 10.0f, 1.5f);
     const std::vector<Triangle> grid = cube.triangles();
     tris.insert(tris.end(), grid.begin(), grid.end());
@@ -365,7 +365,7 @@ std::vector<Triangle> traversal_triangles(std::mt19937& rng, const GridCube& cub
 
 TEST(Bvh, TraversalMatchesBruteForceIncludingSharedEdges) {
     std::mt19937 rng(20240611u);
-    const GridCube cube = traversal_cube();
+    GridCube cube = traversal_cube();
     const Scene scene(traversal_triangles(rng, cube));
     check_invariants(scene);
     lc::cpu::TraceKernel k = scene.kernel();
@@ -417,7 +417,7 @@ TEST(Bvh, TraversalMatchesBruteForceIncludingSharedEdges) {
 // inside the closed grid to its shared edges and vertices.
 TEST(Bvh, PacketsOfFourGiveEachRaysAnswer) {
     std::mt19937 rng(20261201u);
-    const GridCube cube = traversal_cube();
+    GridCube cube = traversal_cube();
     const Scene scene(traversal_triangles(rng, cube));
     lc::cpu::TraceKernel k = scene.kernel();
     std::uniform_real_distribution<float> u01(0.0f, 1.0f), box(-15.0f, 15.0f), inner(-0.35f, 0.35f);
