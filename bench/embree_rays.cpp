@@ -13,7 +13,9 @@
 // pixel, each pixel's rays to all lights) and light by light (the rays of
 // every pixel to one light, then the next light), which is the coherence
 // lightcuts could use by tracing a tile's rays to the same cluster
-// together. Embree runs single rays (rtcOccluded1), packets of 8 consecutive
+// together; lightcuts' rays also with each point's rays sorted by direction
+// (what gathering a pixel's rays before tracing them could give). Embree
+// runs single rays (rtcOccluded1), packets of 8 consecutive
 // rays (rtcOccluded8) and streams (rtcOccluded1M over 256 rays). Built only
 // where Debian's libembree-dev is installed (an optional, benchmark-only
 // dependency).
@@ -127,6 +129,29 @@ int run(int argc, char** argv) {
             }
         for (const auto& r : log) lightcuts_rays.push_back({r.org, r.dir, r.t_max, 0u});
     }
+    // Lightcuts' rays with each point's rays sorted by direction (a Morton
+    // order of the unit direction), the coherence a pixel's cut offers if
+    // its rays were gathered before tracing.
+    std::vector<ShadowRay> lightcuts_sorted = lightcuts_rays;
+    {
+        auto spread = [](std::uint32_t v) {  // 10 bits to every third bit
+            v = (v | (v << 16)) & 0x030000FFu;
+            v = (v | (v << 8)) & 0x0300F00Fu;
+            v = (v | (v << 4)) & 0x030C30C3u;
+            return (v | (v << 2)) & 0x09249249u;
+        };
+        auto key = [&](const ShadowRay& r) {
+            const glm::uvec3 q = glm::uvec3(glm::clamp((r.dir + 1.0f) * 511.5f, 0.0f, 1023.0f));
+            return spread(q.x) | spread(q.y) << 1 | spread(q.z) << 2;
+        };
+        for (std::size_t b = 0; b < lightcuts_sorted.size();) {
+            std::size_t e = b;
+            while (e < lightcuts_sorted.size() && lightcuts_sorted[e].org == lightcuts_sorted[b].org) ++e;
+            std::stable_sort(lightcuts_sorted.begin() + std::ptrdiff_t(b), lightcuts_sorted.begin() + std::ptrdiff_t(e),
+                             [&](const ShadowRay& x, const ShadowRay& y) { return key(x) < key(y); });
+            b = e;
+        }
+    }
     std::vector<ShadowRay> by_light = rays;
     std::stable_sort(by_light.begin(), by_light.end(),
                      [](const ShadowRay& a, const ShadowRay& b) { return a.light < b.light; });
@@ -157,7 +182,8 @@ int run(int argc, char** argv) {
     const std::pair<const char*, const std::vector<ShadowRay>*> sets[] = {
         {"brute force, pixel order", &rays},
         {"brute force, light by light", &by_light},
-        {"lightcuts (error 0.02, max_cut 1000), pixel order", &lightcuts_rays}};
+        {"lightcuts (error 0.02, max_cut 1000), pixel order", &lightcuts_rays},
+        {"lightcuts, each point's rays sorted by direction", &lightcuts_sorted}};
     for (const auto& [order_name, list] : sets) {
         const std::vector<ShadowRay>& r = *list;
         std::printf(" %s:\n", order_name);
