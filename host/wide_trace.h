@@ -192,16 +192,20 @@ struct RayPacket4 {
 // axis, are traced ray by ray. (On the room's brute-force rays a factor of
 // 1.25 took a third of the packets' gain away; 2, 5 and no limit ran at the
 // same speed, bench/embree_rays.)
-template <class Kernel>
-bool packet_bounds(Kernel& kernel, const RayPacket4& packet, PacketBounds& b) {
-    const unsigned first = unsigned(__builtin_ctz(packet.valid));
+// `rays` holds the rays of `valid` (nonzero) set up by wide_ray, whose
+// inverse directions are read back from their lanes.
+inline bool packet_bounds(const RayPacket4& packet, unsigned valid, const WideRay rays[4], PacketBounds& b) {
+    auto inverse = [](const WideRay& r) {
+        return glm::vec3(_mm_cvtss_f32(r.ix), _mm_cvtss_f32(r.iy), _mm_cvtss_f32(r.iz));
+    };
+    const unsigned first = unsigned(__builtin_ctz(valid));
     const glm::vec3 org = packet.org[first];
-    glm::vec3 inv_lo = kernel.lc_safe_inverse(packet.dir[first]), inv_hi = inv_lo;
+    glm::vec3 inv_lo = inverse(rays[first]), inv_hi = inv_lo;
     float t_max = packet.t_max[first];
     for (unsigned r = first + 1u; r < 4u; ++r) {
-        if ((packet.valid >> r & 1u) == 0u) continue;
+        if ((valid >> r & 1u) == 0u) continue;
         if (packet.org[r] != org) return false;
-        const glm::vec3 inv = kernel.lc_safe_inverse(packet.dir[r]);
+        const glm::vec3 inv = inverse(rays[r]);
         inv_lo = glm::min(inv_lo, inv);
         inv_hi = glm::max(inv_hi, inv);
         t_max = std::max(t_max, packet.t_max[r]);
@@ -297,13 +301,12 @@ template <class Kernel>
 unsigned trace_any_wide4(Kernel& kernel, const WideBvhNode* nodes, const WideLeaf* leaves, const RayPacket4& packet) {
     const unsigned valid = packet.valid & 0xFu;
 #if defined(__SSE2__)
+    WideRay rays[4];
+    for (unsigned r = 0; r < 4u; ++r)
+        if ((valid >> r & 1u) != 0u) rays[r] = wide_ray(kernel, packet.org[r], packet.dir[r], packet.t_max[r]);
     PacketBounds bounds;
-    if (valid != 0u && packet_bounds(kernel, packet, bounds)) {
-        WideRay rays[4];
-        for (unsigned r = 0; r < 4u; ++r)
-            if ((valid >> r & 1u) != 0u) rays[r] = wide_ray(kernel, packet.org[r], packet.dir[r], packet.t_max[r]);
+    if (valid != 0u && packet_bounds(packet, valid, rays, bounds))
         return trace_any_coherent(nodes, leaves, bounds, rays, valid);
-    }
 #endif
     unsigned blocked = 0u;
     for (unsigned r = 0; r < 4u; ++r)
