@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config
   libvulkan-volk-dev libvulkan-dev
-  glslang-tools glslang-dev
+  glslang-tools glslang-dev spirv-tools
   mesa-vulkan-drivers vulkan-validationlayers
   libglm-dev libtinyobjloader-dev
   libgtest-dev libgmock-dev libbenchmark-dev

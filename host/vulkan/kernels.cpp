@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstring>
 #include <future>
 #include <string>
 #include <vector>
 
 #include "spirv/primary.h"
+#include "spirv_specialize.h"
 #include "vk_check.h"
 
 namespace lc::vk {
@@ -32,39 +34,65 @@ struct SpecData {
     std::uint32_t chunk_shift[gpu::kSceneArrayCount];
 };
 
+// One specialization constant: its id, where SpecData holds its value, and
+// whether it is a bool (VkBool32) or a 32-bit unsigned integer.
+struct SpecEntry {
+    std::uint32_t id;
+    std::uint32_t offset;
+    bool boolean;
+};
+
+std::vector<SpecEntry> spec_entries() {
+    std::vector<SpecEntry> entries = {
+        {gpu::kSpecWorkgroupSize, offsetof(SpecData, workgroup_size), false},
+        {gpu::kSpecEnableGgx, offsetof(SpecData, enable_ggx), true},
+        {gpu::kSpecEnableShadows, offsetof(SpecData, enable_shadows), true},
+        {gpu::kSpecHeapSlots, offsetof(SpecData, heap_slots), false},
+        {gpu::kSpecEnableOriented, offsetof(SpecData, enable_oriented), true},
+        {gpu::kSpecStochastic, offsetof(SpecData, stochastic), true},
+        {gpu::kSpecEnableTextures, offsetof(SpecData, enable_textures), true},
+        {gpu::kSpecEnableDisney, offsetof(SpecData, enable_disney), true},
+        {gpu::kSpecEnableSheen, offsetof(SpecData, enable_sheen), true},
+        {gpu::kSpecEnableClearcoat, offsetof(SpecData, enable_clearcoat), true},
+        {gpu::kSpecSplitScene, offsetof(SpecData, split_scene), true},
+        {gpu::kSpecTexelReads, offsetof(SpecData, texel_reads), true},
+    };
+    for (std::uint32_t b = 0; b < gpu::kSceneArrayCount; ++b)
+        entries.push_back(
+            {gpu::kSpecChunkShift + b, std::uint32_t(offsetof(SpecData, chunk_shift) + b * sizeof(std::uint32_t)), false});
+    return entries;
+}
+
+// The kernel's pipeline with the constants of `spec`: specialized by the
+// driver, or (`on_host`) in the module itself before the driver sees it
+// (spirv_specialize.h).
 Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const KernelCode& code,
-                          const SpecData& spec) {
+                          const SpecData& spec, bool on_host) {
     VkDevice device = ctx.device().get();
     const VolkDeviceTable& vkd = ctx.fn();
     const std::string name = code.name;
+    const std::vector<SpecEntry> entries = spec_entries();
+    std::vector<VkSpecializationMapEntry> map;
+    SpecValues values;
+    for (const SpecEntry& e : entries) {
+        map.push_back({e.id, e.offset, sizeof(std::uint32_t)});
+        std::uint32_t value = 0;
+        std::memcpy(&value, reinterpret_cast<const char*>(&spec) + e.offset, sizeof value);
+        values[e.id] = e.boolean ? (value != 0u ? "true" : "false") : std::to_string(value);
+    }
+    std::vector<std::uint32_t> specialized;
+    if (on_host) specialized = specialize_spirv(code.words, code.bytes / sizeof(std::uint32_t), values, name);
+
     auto module_info = vk_struct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
-    module_info.codeSize = code.bytes;
-    module_info.pCode = code.words;
+    module_info.codeSize = on_host ? specialized.size() * sizeof(std::uint32_t) : code.bytes;
+    module_info.pCode = on_host ? specialized.data() : code.words;
     VkShaderModule module_handle = VK_NULL_HANDLE;
     VK_CHECK(vkd.vkCreateShaderModule(device, &module_info, nullptr, &module_handle));
     ShaderModule module = own<ShaderModule>(ctx.device(), module_handle, name + " module");
 
-    std::vector<VkSpecializationMapEntry> entries = {
-        {gpu::kSpecWorkgroupSize, offsetof(SpecData, workgroup_size), sizeof(std::uint32_t)},
-        {gpu::kSpecEnableGgx, offsetof(SpecData, enable_ggx), sizeof(VkBool32)},
-        {gpu::kSpecEnableShadows, offsetof(SpecData, enable_shadows), sizeof(VkBool32)},
-        {gpu::kSpecHeapSlots, offsetof(SpecData, heap_slots), sizeof(std::uint32_t)},
-        {gpu::kSpecEnableOriented, offsetof(SpecData, enable_oriented), sizeof(VkBool32)},
-        {gpu::kSpecStochastic, offsetof(SpecData, stochastic), sizeof(VkBool32)},
-        {gpu::kSpecEnableTextures, offsetof(SpecData, enable_textures), sizeof(VkBool32)},
-        {gpu::kSpecEnableDisney, offsetof(SpecData, enable_disney), sizeof(VkBool32)},
-        {gpu::kSpecEnableSheen, offsetof(SpecData, enable_sheen), sizeof(VkBool32)},
-        {gpu::kSpecEnableClearcoat, offsetof(SpecData, enable_clearcoat), sizeof(VkBool32)},
-        {gpu::kSpecSplitScene, offsetof(SpecData, split_scene), sizeof(VkBool32)},
-        {gpu::kSpecTexelReads, offsetof(SpecData, texel_reads), sizeof(VkBool32)},
-    };
-    for (std::uint32_t b = 0; b < gpu::kSceneArrayCount; ++b)
-        entries.push_back({gpu::kSpecChunkShift + b,
-                           std::uint32_t(offsetof(SpecData, chunk_shift) + b * sizeof(std::uint32_t)),
-                           sizeof(std::uint32_t)});
     VkSpecializationInfo spec_info{};
-    spec_info.mapEntryCount = std::uint32_t(entries.size());
-    spec_info.pMapEntries = entries.data();
+    spec_info.mapEntryCount = std::uint32_t(map.size());
+    spec_info.pMapEntries = map.data();
     spec_info.dataSize = sizeof spec;
     spec_info.pData = &spec;
 
@@ -73,7 +101,8 @@ Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const Ker
     info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     info.stage.module = module.get();
     info.stage.pName = "main";
-    info.stage.pSpecializationInfo = &spec_info;
+    // A module specialized on the host has no constants left to set.
+    info.stage.pSpecializationInfo = on_host ? nullptr : &spec_info;
     info.layout = layout;
     VkPipeline pipeline = VK_NULL_HANDLE;
     VK_CHECK(vkd.vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline));
@@ -105,9 +134,10 @@ Kernels::Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMetho
     // without a pipeline cache.
     std::future<Pipeline> primary = std::async(std::launch::async, [&] {
         return compute_pipeline(ctx, layout,
-                                {lc_spirv_primary, sizeof lc_spirv_primary, "primary.comp (camera rays)"}, spec);
+                                {lc_spirv_primary, sizeof lc_spirv_primary, "primary.comp (camera rays)"}, spec,
+                                switches.specialize_on_host);
     });
-    shading_ = compute_pipeline(ctx, layout, method.kernel(), spec);
+    shading_ = compute_pipeline(ctx, layout, method.kernel(), spec, switches.specialize_on_host);
     primary_ = primary.get();
 }
 

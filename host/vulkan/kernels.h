@@ -33,6 +33,7 @@ struct KernelSwitches {
     bool clearcoat = true;           // ... and its clearcoat lobe
     bool texel_reads = false;        // read four scene arrays through their texel views
     SceneChunks chunks;              // how the scene arrays are split (GpuResources)
+    bool specialize_on_host = false; // hand the driver modules specialized on the host (spirv_specialize.h)
 };
 
 class Kernels {

@@ -79,6 +79,8 @@ Tuning device_tuning(const Context& ctx, Tuning tuning) {
         tuning.target_dispatch_ms = cpu ? Tuning::kCpuTargetMs : Tuning::kGpuTargetMs;
     if (tuning.texel_reads == Tuning::TexelReads::kAuto)
         tuning.texel_reads = cpu ? Tuning::TexelReads::kOn : Tuning::TexelReads::kOff;
+    if (tuning.specialize_on_host == Tuning::HostSpecialization::kAuto)
+        tuning.specialize_on_host = cpu ? Tuning::HostSpecialization::kOn : Tuning::HostSpecialization::kOff;
     if (tuning.presplit_on_llvmpipe && tuning.refinements_per_dispatch == 0 && driver_limits_loops(ctx))
         tuning.refinements_per_dispatch = Tuning::kLlvmpipeRefinements;
     return tuning;
@@ -126,7 +128,7 @@ RenderSetup::RenderSetup(const Context& context, const PreparedScene& prepared,
                tuning.force_oriented || prepared.has_oriented, tuning.force_textures || prepared.has_textures,
                tuning.force_disney || prepared.has_disney, tuning.force_sheen || prepared.has_sheen,
                tuning.force_clearcoat || prepared.has_clearcoat, resources.texel_reads(),
-               resources.chunks()}),
+               resources.chunks(), tuning.specialize_on_host == Tuning::HostSpecialization::kOn}),
       pass(context, resources, kernels, *method, timestamps) {}
 
 RenderSetup::~RenderSetup() { ctx.fn().vkDeviceWaitIdle(ctx.device().get()); }
@@ -158,6 +160,11 @@ Tuning Tuning::from_environment() {
         const std::string mode = v;
         if (mode == "on") tuning.texel_reads = Tuning::TexelReads::kOn;
         if (mode == "off") tuning.texel_reads = Tuning::TexelReads::kOff;
+    }
+    if (const char* v = std::getenv("LC_VK_SPECIALIZE_ON_HOST")) {
+        const std::string mode = v;
+        if (mode == "on") tuning.specialize_on_host = Tuning::HostSpecialization::kOn;
+        if (mode == "off") tuning.specialize_on_host = Tuning::HostSpecialization::kOff;
     }
     if (const char* v = std::getenv("LC_VK_TARGET_MS")) {
         const double ms = std::strtod(v, nullptr);

@@ -70,9 +70,17 @@ struct Tuning {
     enum class TexelReads { kAuto, kOn, kOff };
     TexelReads texel_reads = TexelReads::kAuto;
 
+    // Specialize the kernels' SPIR-V on the host (host/vulkan/spirv_specialize.h)
+    // instead of in the driver. kAuto: on CPU devices, where lavapipe then
+    // builds the pipelines in half the time (docs/results/lavapipe.md);
+    // GPUs specialize in the driver until it is measured there.
+    enum class HostSpecialization { kAuto, kOn, kOff };
+    HostSpecialization specialize_on_host = HostSpecialization::kAuto;
+
     // LC_VK_FORCE_FEATURES=ggx,shadows,oriented,textures,disney,sheen,clearcoat (or all), LC_VK_MAX_TILE_PIXELS=N, LC_VK_TARGET_MS=X,
     // LC_VK_LIGHTS_PER_DISPATCH=N, LC_VK_REFINEMENTS_PER_DISPATCH=N, LC_VK_SPLIT_BYTES=N,
-    // LC_VK_CHUNK_BUFFERS=1, LC_VK_HOST_IMPORT=0, LC_VK_TEXEL_READS=on|off.
+    // LC_VK_CHUNK_BUFFERS=1, LC_VK_HOST_IMPORT=0, LC_VK_TEXEL_READS=on|off,
+    // LC_VK_SPECIALIZE_ON_HOST=on|off.
     static Tuning from_environment();
 };
 

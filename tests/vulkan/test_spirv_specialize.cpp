@@ -1,0 +1,136 @@
+// Kernels specialized on the host (host/vulkan/spirv_specialize.h): the
+// module SPIRV-Tools returns is valid, has nothing left to specialize, has
+// lost the code the values switch off, and renders the images the driver's
+// own specialization renders, bit for bit.
+#include <cstdint>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <spirv-tools/libspirv.hpp>
+
+#include "bindings.glsl"
+#include "spirv/lightcuts.h"
+#include "spirv_specialize.h"
+#include "test_util.h"
+#include "vulkan_test_support.h"
+
+namespace lc {
+namespace {
+
+using vulkan_test::max_relative_difference;
+using vulkan_test::options;
+using vulkan_test::random_scene;
+using vulkan_test::Vulkan;
+
+constexpr std::size_t kLightcutsWords = sizeof lc_spirv_lightcuts / sizeof(std::uint32_t);
+
+// The values a scene with every feature (or none) would give the Lightcuts kernel.
+vk::SpecValues lightcuts_values(bool features) {
+    const std::string f = features ? "true" : "false";
+    vk::SpecValues v = {
+        {gpu::kSpecWorkgroupSize, std::to_string(gpu::kWorkgroupSize)},
+        {gpu::kSpecHeapSlots, "64"},
+        {gpu::kSpecEnableGgx, f},
+        {gpu::kSpecEnableShadows, "true"},
+        {gpu::kSpecEnableOriented, f},
+        {gpu::kSpecStochastic, "false"},
+        {gpu::kSpecEnableTextures, f},
+        {gpu::kSpecEnableDisney, f},
+        {gpu::kSpecEnableSheen, f},
+        {gpu::kSpecEnableClearcoat, f},
+        {gpu::kSpecSplitScene, "false"},
+        {gpu::kSpecTexelReads, "true"},
+    };
+    for (std::uint32_t b = 0; b < gpu::kSceneArrayCount; ++b) v[gpu::kSpecChunkShift + b] = "31";
+    return v;
+}
+
+// Instructions of `words` with opcode `op` (and, for OpDecorate, decoration `decoration`).
+std::size_t count_instructions(const std::vector<std::uint32_t>& words, std::uint32_t op,
+                               std::uint32_t decoration = ~0u) {
+    std::size_t count = 0;
+    for (std::size_t i = 5; i < words.size();) {
+        const std::uint32_t length = words[i] >> 16;
+        if (length == 0) {
+            ADD_FAILURE() << "instruction of length 0 at word " << i;
+            break;
+        }
+        if ((words[i] & 0xFFFFu) == op && (decoration == ~0u || (length > 2 && words[i + 2] == decoration))) ++count;
+        i += length;
+    }
+    return count;
+}
+
+constexpr std::uint32_t kOpDecorate = 71, kDecorationSpecId = 1;
+constexpr std::uint32_t kOpSpecConstantTrue = 48, kOpSpecConstantOp = 52;
+
+TEST(SpirvSpecialize, LeavesAValidModuleWithNothingToSpecialize) {
+    const std::vector<std::uint32_t> original(lc_spirv_lightcuts, lc_spirv_lightcuts + kLightcutsWords);
+    ASSERT_GT(count_instructions(original, kOpDecorate, kDecorationSpecId), 10u);
+    const std::vector<std::uint32_t> s =
+        vk::specialize_spirv(lc_spirv_lightcuts, kLightcutsWords, lightcuts_values(false), "lightcuts.comp");
+    spvtools::SpirvTools tools(SPV_ENV_VULKAN_1_2);
+    std::string messages;
+    tools.SetMessageConsumer([&](spv_message_level_t, const char*, const spv_position_t&, const char* m) {
+        messages += std::string(m) + "\n";
+    });
+    EXPECT_TRUE(tools.Validate(s)) << messages;
+    EXPECT_EQ(count_instructions(s, kOpDecorate, kDecorationSpecId), 0u);
+    for (std::uint32_t op = kOpSpecConstantTrue; op <= kOpSpecConstantOp; ++op)
+        EXPECT_EQ(count_instructions(s, op), 0u) << "opcode " << op;
+}
+
+// What host specialization is for: the code of switched-off features leaves
+// the module (the Disney BRDF and texture lookups are most of it).
+TEST(SpirvSpecialize, DropsTheCodeOfSwitchedOffFeatures) {
+    const std::size_t all =
+        vk::specialize_spirv(lc_spirv_lightcuts, kLightcutsWords, lightcuts_values(true), "lightcuts.comp").size();
+    const std::size_t none =
+        vk::specialize_spirv(lc_spirv_lightcuts, kLightcutsWords, lightcuts_values(false), "lightcuts.comp").size();
+    std::printf("[ measured ] lightcuts.comp: %zu words, specialized %zu with every feature, %zu with none\n",
+                kLightcutsWords, all, none);
+    EXPECT_LT(all, kLightcutsWords);
+    EXPECT_LT(double(none), 0.8 * double(all)) << none << " words against " << all;
+}
+
+TEST(SpirvSpecialize, RefusesAModuleItCannotReadNamingTheKernel) {
+    const std::vector<std::uint32_t> garbage = {0x07230203u, 0x00010500u, 0u, 100u, 0u, 0xFFFFFFFFu};
+    try {
+        vk::specialize_spirv(garbage.data(), garbage.size(), {}, "broken.comp");
+        FAIL() << "no exception";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("broken.comp"), std::string::npos) << e.what();
+    }
+}
+
+// Lightcuts on a scene with GGX and shadows, every method on one with
+// textures, Disney materials and spot lights: the same image and shadow rays whether
+// the driver or the host specializes (under the validation layer).
+TEST_F(Vulkan, HostSpecializationGivesTheDriversImages) {
+    Scene textured = load_scene(LC_SOURCE_DIR "/scenes/gltf/textured.gltf");
+    textured.render.area_light_samples = 256;
+    const PreparedScene scenes[] = {prepare_scene(random_scene(68, 60, 2, 12, 10), 1),
+                                    prepare_scene(std::move(textured), 1)};
+    ASSERT_TRUE(scenes[1].has_textures && scenes[1].has_disney && scenes[1].has_oriented);
+    vk::Tuning host, driver;
+    host.specialize_on_host = vk::Tuning::HostSpecialization::kOn;
+    driver.specialize_on_host = vk::Tuning::HostSpecialization::kOff;
+    for (const PreparedScene& p : scenes) {
+        for (const char* method : {"brute", "lightcuts", "sampled", "stochastic"}) {
+            if (&p == &scenes[0] && std::string(method) != "lightcuts") continue;  // the kernels' switches: once
+            SCOPED_TRACE(method);
+            const RenderOptions o = options(method, 12, 10);
+            const RenderResult a = gpu(p, o, host);
+            const RenderResult b = gpu(p, o, driver);
+            EXPECT_EQ(max_relative_difference(a.image, b.image, std::string("host specialization ") + method, 0.0),
+                      0.0);
+            EXPECT_EQ(a.stats.shadow_rays, b.stats.shadow_rays);
+        }
+    }
+}
+
+}  // namespace
+}  // namespace lc
