@@ -151,6 +151,12 @@ struct BasicShadeKernel {
     // size the lobe bounds save. Not conservative; the renderer reads it
     // once per render from LC_CPU_SEED_LOBE_BOUND (cpu_renderer.cpp).
     static inline bool seed_lobe_bound = false;
+    // Benchmarks only: bound a refinement's children by the tightest bound
+    // of Walter's form instead (tightest_error below), to measure how much
+    // smaller the cuts could get with better bounds. It visits every light
+    // of the cluster, so it is far too slow to render with; the renderer
+    // reads it once per render from LC_CPU_TIGHTEST_BOUND.
+    static inline bool tightest_bound = false;
 
 #define LC_BVH_NODE(i) bvh_nodes[i]
 #define LC_TRIANGLE(i) triangles[i]
@@ -211,8 +217,34 @@ struct BasicShadeKernel {
     vec2 lc_child_errors(const SurfacePoint& sp, const Material& m, const LightNode& left, const LightNode& right,
                          float min_distance2) {
         vec2 errors;
+        if (tightest_bound)
+            return vec2(tightest_error(sp, left, min_distance2), tightest_error(sp, right, min_distance2));
         if (pair_errors(*this, sp, m, left, right, min_distance2, errors)) return errors;
         return vec2(lc_cluster_error(sp, m, left, min_distance2), lc_cluster_error(sp, m, right, min_distance2));
+    }
+
+    // The smallest error bound of Walter's form, material * geometry *
+    // emission bounded over the cluster and visibility by 1: the largest
+    // unshadowed unit contribution among the cluster's own lights, channel
+    // by channel, times the cluster's intensity. Every conservative bound
+    // of lc_cluster_error's kind is at least this. Zero for a leaf.
+    float tightest_error(const SurfacePoint& sp, const LightNode& node, float min_distance2) {
+        if ((node.flags & kNodeLeaf) != 0u) return 0.0f;
+        std::vector<uint> stack = {node.left, node.left + 1u};
+        vec3 largest(0.0f);
+        while (!stack.empty()) {
+            const LightNode& n = light_nodes[stack.back()];
+            stack.pop_back();
+            if ((n.flags & kNodeLeaf) == 0u) {
+                stack.push_back(n.left);
+                stack.push_back(n.left + 1u);
+                continue;
+            }
+            vec3 wi;
+            float t_max;
+            largest = max(largest, lc_light_unit(sp, lights[n.rep_light], min_distance2, wi, t_max));
+        }
+        return lc_luminance(largest * lc_node_intensity(node));
     }
 
     // lc_shade_brute's result, bit for bit, with the shadow rays traced four

@@ -96,6 +96,10 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     // bound for the Disney BRDF's non-diffuse lobes.
     const char* seed_bound = std::getenv("LC_CPU_SEED_LOBE_BOUND");
     cpu::ShadeKernel::seed_lobe_bound = seed_bound != nullptr && std::string(seed_bound) == "1";
+    // Benchmarks only (docs/results/speed.md): the tightest bound of
+    // Walter's form for every refinement's children.
+    const char* tightest = std::getenv("LC_CPU_TIGHTEST_BOUND");
+    cpu::ShadeKernel::tightest_bound = tightest != nullptr && std::string(tightest) == "1";
     auto start = std::chrono::steady_clock::now();
 
     RenderResult result;

@@ -164,6 +164,53 @@ TEST(LightcutsBounds, PairOfChildErrorsIsTheScalarOneBitForBit) {
     EXPECT_GT(nonzero, trials / 4);
 }
 
+// The benchmarks' tightest bound of Walter's form (Kernel::tightest_bound,
+// docs/results/speed.md): at every camera hit of a room with 500 lights
+// and a glossy box, for every interior node of the tree, it lies between
+// the largest single light's share (its own unshadowed contribution) and
+// lc_cluster_error, which bounds the same lights less tightly.
+TEST(LightcutsBounds, TightestBoundLiesBetweenEveryLightAndTheBound) {
+    Scene s = test::room_scene(test::random_point_lights(500, {-0.9f, 0.1f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 5), 16);
+    PreparedScene p = prepare_scene(std::move(s), 1);
+    const gpu::FrameParams f = make_frame_params(p, test::options("lightcuts", 16));
+    Kernel k = cpu::make_shade_kernel(p);
+    int tighter = 0, nodes = 0;
+    for (std::uint32_t y = 0; y < 16; ++y)
+        for (std::uint32_t x = 0; x < 16; ++x) {
+            Kernel::SurfacePoint sp;
+            if (!k.lc_camera_hit(f, x, y, 0, sp)) continue;
+            // The largest single light's luminance below each node, leaves up
+            // (children follow their parent in the node array).
+            std::vector<float> largest(p.tree.nodes.size(), 0.0f);
+            for (std::size_t i = p.tree.nodes.size(); i-- > 0;) {
+                const gpu::LightNode& node = p.tree.nodes[i];
+                if ((node.flags & gpu::kNodeLeaf) != 0u) {
+                    glm::vec3 wi;
+                    float t_max;
+                    const gpu::Light& light = p.tree.lights[node.rep_light];
+                    largest[i] = gpu::lc_luminance(k.lc_light_unit(sp, light, f.min_distance2, wi, t_max) *
+                                                   k.lc_light_intensity(light));
+                } else {
+                    largest[i] = std::max(largest[node.left], largest[node.left + 1u]);
+                }
+            }
+            for (std::size_t i = 0; i < p.tree.nodes.size(); ++i) {
+                const gpu::LightNode& node = p.tree.nodes[i];
+                if ((node.flags & gpu::kNodeLeaf) != 0u) continue;
+                const float tightest = k.tightest_error(sp, node, f.min_distance2);
+                const float bound = k.lc_cluster_error(sp, sp.mat, node, f.min_distance2);
+                ASSERT_GE(tightest, largest[i] * (1.0f - 1e-5f)) << "node " << i;
+                ASSERT_LE(tightest, bound * (1.0f + 1e-5f)) << "node " << i;
+                ++nodes;
+                tighter += tightest < 0.5f * bound;
+            }
+        }
+    // Not everywhere equal: the bound is loose somewhere (else the
+    // comparison would show nothing).
+    EXPECT_GT(nodes, 10000);
+    EXPECT_GT(tighter, nodes / 100);
+}
+
 // The GGX bound is tighter than a constant: for a small cluster far from the
 // mirror direction it is far below the lobe's peak D(1) * G1(wo) / (4 cos_o).
 TEST(LightcutsBounds, GgxBoundIsTighterThanThePeak) {
