@@ -117,8 +117,8 @@ int run(int argc, char** argv) {
         lo.width = lo.height = kLightcutsSize;
         const lc::gpu::FrameParams lf = lc::make_frame_params(p, lo);
         std::vector<lc::cpu::ShadowRayRecord> log;
-        std::vector<lc::cpu::HeapEntry> heap(p.tree.cut_heap_slots(lo.max_cut, lo.cut_heap));
-        auto recorder = lc::cpu::make_shade_kernel<true>(p, heap.data(), std::uint32_t(heap.size()));
+        lc::cpu::CutHeap heap(p.tree.cut_heap_slots(lo.max_cut, lo.cut_heap));
+        auto recorder = lc::cpu::make_shade_kernel<true>(p, &heap);
         recorder.ray_log = &log;
         for (std::uint32_t y = 0; y < kLightcutsSize; ++y)
             for (std::uint32_t x = 0; x < kLightcutsSize; ++x) {

@@ -55,7 +55,7 @@ BENCHMARK(BM_BvhBuild)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)
 struct Fixture {
     lc::PreparedScene prepared;
     lc::gpu::FrameParams frame;
-    std::vector<lc::cpu::HeapEntry> heap;
+    lc::cpu::CutHeap heap;
     ShadeKernel k;
     std::vector<ShadeKernel::SurfacePoint> points;
 
@@ -63,8 +63,8 @@ struct Fixture {
         prepared = lc::prepare_scene(lc::test::room_scene(lights_in_room(n_lights), 64), 1);
         lc::RenderOptions o = lc::test::options("lightcuts", 64);
         frame = lc::make_frame_params(prepared, o);
-        heap.resize(prepared.tree.cut_heap_slots(o.max_cut, o.cut_heap));
-        k = lc::cpu::make_shade_kernel(prepared, heap.data(), std::uint32_t(heap.size()));
+        heap = lc::cpu::CutHeap(prepared.tree.cut_heap_slots(o.max_cut, o.cut_heap));
+        k = lc::cpu::make_shade_kernel(prepared, &heap);
         for (std::uint32_t y = 0; y < 64; y += 4)
             for (std::uint32_t x = 0; x < 64; x += 4) {
                 ShadeKernel::SurfacePoint sp;

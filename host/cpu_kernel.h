@@ -76,6 +76,40 @@ struct HeapEntry {
     vec3 unit;
 };
 
+// The CPU's cut heap, stored as two arrays: the entries' errors, which the
+// heap's compares and the search for the smallest read, side by side, and
+// the rest of each entry (16 bytes). A child pair's errors are then one
+// 8-byte load and the search reads whole vectors, where 20-byte entries
+// made it gather one float at a time.
+//
+// Each thread has its own heap, and no cache line of it is shared with
+// anything else: both arrays keep a cache line of padding before and after
+// the slots. The threads' heaps were once allocated back to back, the top
+// of one in the line that held the other's last slots, and rendering on two
+// threads ran at 1.5 to 1.7 times one thread's speed; padded, at 2 times
+// (docs/results/speed.md).
+struct HeapPayload {
+    uint node;
+    vec3 unit;
+};
+
+class CutHeap {
+public:
+    explicit CutHeap(std::size_t slots = 0)
+        : slots_(uint(slots)), error_(slots + 2 * kErrorPad), payload_(slots + 2 * kPayloadPad) {}
+    uint slots() const { return slots_; }
+    float* error() { return error_.data() + kErrorPad; }
+    HeapPayload* payload() { return payload_.data() + kPayloadPad; }
+
+private:
+    static constexpr std::size_t kCacheLine = 64;
+    static constexpr std::size_t kErrorPad = kCacheLine / sizeof(float);
+    static constexpr std::size_t kPayloadPad = kCacheLine / sizeof(HeapPayload);
+    uint slots_;
+    std::vector<float> error_;
+    std::vector<HeapPayload> payload_;
+};
+
 // lc_heap_smallest's answer on the CPU's heap (shared/lightcuts.h): the
 // first slot of [from, to) whose error is the smallest, if that error is
 // below `bound`; kInvalidIndex if none is. A full heap is searched at most
@@ -83,7 +117,7 @@ struct HeapEntry {
 // the shipped room), and the scalar loop's compares form one chain, about
 // four cycles a slot; here the minimum is taken eight slots at a time in
 // two chains of SSE lanes, then its first slot is looked up.
-inline uint heap_smallest(const HeapEntry* heap, uint from, uint to, float bound) {
+inline uint heap_smallest(const float* errors, uint from, uint to, float bound) {
     float best = bound;
     uint i = from;
 #if defined(__SSE2__)
@@ -91,19 +125,18 @@ inline uint heap_smallest(const HeapEntry* heap, uint from, uint to, float bound
     // lane (a NaN error is passed over, as there).
     __m128 lo = _mm_set1_ps(bound), hi = lo;
     for (; i + 8u <= to; i += 8u) {
-        const HeapEntry* h = heap + i;
-        lo = _mm_min_ps(_mm_setr_ps(h[0].error, h[1].error, h[2].error, h[3].error), lo);
-        hi = _mm_min_ps(_mm_setr_ps(h[4].error, h[5].error, h[6].error, h[7].error), hi);
+        lo = _mm_min_ps(_mm_loadu_ps(errors + i), lo);
+        hi = _mm_min_ps(_mm_loadu_ps(errors + i + 4u), hi);
     }
     __m128 m = _mm_min_ps(lo, hi);
     m = _mm_min_ps(m, _mm_movehl_ps(m, m));
     m = _mm_min_ss(m, _mm_shuffle_ps(m, m, 1));
     best = _mm_cvtss_f32(m);
 #endif
-    for (; i < to; ++i) best = heap[i].error < best ? heap[i].error : best;
+    for (; i < to; ++i) best = errors[i] < best ? errors[i] : best;
     if (!(best < bound)) return kInvalidIndex;
     for (uint j = from;; ++j)
-        if (heap[j].error == best) return j;
+        if (errors[j] == best) return j;
 }
 
 // A shadow ray as the kernels cast it (origin, unit direction, length).
@@ -113,9 +146,10 @@ struct ShadowRayRecord {
     float t_max;
 };
 
-// Everything a pixel needs. `heap` holds `heap_slots` entries, the cut
-// heap's capacity (LightTree::cut_heap_slots); one kernel object per thread (make_shade_kernel binds one to a
-// scene). kRecordRays: every shadow ray is also appended to `*ray_log`
+// Everything a pixel needs. `heap_error` and `heap_payload` hold the cut
+// heap's `heap_slots` entries (a CutHeap of LightTree::cut_heap_slots
+// slots, bind_heap); one kernel object per thread (make_shade_kernel binds
+// one to a scene). kRecordRays: every shadow ray is also appended to `*ray_log`
 // (bench/embree_rays traces lightcuts' rays again with other tracers); the
 // renderer's kernel, ShadeKernel, has no such code.
 template <bool kRecordRays>
@@ -133,7 +167,8 @@ struct BasicShadeKernel {
     const LightNode* light_nodes = nullptr;
     const float* environment = nullptr;  // RGB texels of the environment map
     float vpl_min_distance2 = 0.0f;      // FrameParams.vpl_min_distance2
-    HeapEntry* heap = nullptr;
+    float* heap_error = nullptr;          // the cut heap (CutHeap), heap_slots entries
+    HeapPayload* heap_payload = nullptr;
     uint heap_slots = 1u;
     std::vector<ShadowRayRecord>* ray_log = nullptr;  // kRecordRays only
 
@@ -169,11 +204,11 @@ struct BasicShadeKernel {
 #define LC_LIGHT_NODE(i) light_nodes[i]
 #define LC_ENVIRONMENT_TEXEL(i) vec3(environment[3u * (i)], environment[3u * (i) + 1u], environment[3u * (i) + 2u])
 #define LC_VPL_MIN_DISTANCE2 vpl_min_distance2
-#define LC_HEAP_LOAD(i) heap[i]
-#define LC_HEAP_STORE(i, e) heap[i] = (e)
+#define LC_HEAP_LOAD(i) heap_load(i)
+#define LC_HEAP_STORE(i, e) heap_store(i, e)
 #define LC_HEAP_CAPACITY heap_slots
 #define LC_HEAP_KEEPS_UNITS
-#define LC_HEAP_SMALLEST(from, to, bound) heap_smallest(heap, from, to, bound)
+#define LC_HEAP_SMALLEST(from, to, bound) heap_smallest(heap_error, from, to, bound)
 // Both children of a node pushed on the heap, 128 bytes: the profile
 // showed the node reads in lc_add_cluster stalling on cache misses.
 #define LC_PREFETCH_LIGHT_NODES(i) \
@@ -210,6 +245,17 @@ struct BasicShadeKernel {
 #undef LC_SEED_LOBE_BOUND
 #undef LC_TRACE_ANY
 #undef LC_CHILD_ERRORS
+
+    HeapEntry heap_load(uint i) const { return HeapEntry{heap_payload[i].node, heap_error[i], heap_payload[i].unit}; }
+    void heap_store(uint i, const HeapEntry& e) {
+        heap_error[i] = e.error;
+        heap_payload[i] = HeapPayload{e.node, e.unit};
+    }
+    void bind_heap(CutHeap& heap) {
+        heap_error = heap.error();
+        heap_payload = heap.payload();
+        heap_slots = heap.slots();
+    }
 
     // A refinement's two children's lc_cluster_error: both at once in SSE
     // lanes where pair_errors covers them (host/pair_bound.h), the same
@@ -293,10 +339,10 @@ struct BasicShadeKernel {
 
 using ShadeKernel = BasicShadeKernel<false>;
 
-// A kernel reading the prepared scene's arrays, with `heap` (`heap_slots`
-// entries) as its cut heap.
+// A kernel reading the prepared scene's arrays, with `heap` (if any) as its
+// cut heap.
 template <bool kRecordRays = false>
-BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, HeapEntry* heap = nullptr, uint heap_slots = 0u) {
+BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, CutHeap* heap = nullptr) {
     BasicShadeKernel<kRecordRays> k;
     k.bvh_nodes = p.bvh.nodes.data();
     k.wide_nodes = p.bvh.wide_nodes.empty() ? nullptr : p.bvh.wide_nodes.data();
@@ -311,8 +357,7 @@ BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, HeapEntr
     k.light_nodes = p.tree.nodes.data();
     k.environment = p.scene.environment.rgb.data();
     k.vpl_min_distance2 = p.vpl_min_distance2;
-    k.heap = heap;
-    k.heap_slots = heap_slots;
+    if (heap != nullptr) k.bind_heap(*heap);
     return k;
 }
 

@@ -18,9 +18,10 @@
 namespace lc {
 namespace {
 
-// What each worker thread owns: its cut heap and its counters.
-struct Worker {
-    std::vector<cpu::HeapEntry> heap;
+// What each worker thread owns: its cut heap and its counters, on cache
+// lines of its own (the counters change at every pixel).
+struct alignas(64) Worker {
+    cpu::CutHeap heap;
     std::uint64_t shadow_rays = 0;
     std::uint64_t max_cut_hits = 0;
     std::uint64_t cut_indirect = 0;
@@ -116,12 +117,12 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     std::vector<Worker> workers(std::max(1u, std::min(threads, tile_count)));
     const std::uint32_t heap_slots = prepared.tree.cut_heap_slots(frame.max_cut, options.cut_heap);
-    for (Worker& w : workers) w.heap.resize(lightcuts ? heap_slots : 0);
+    for (Worker& w : workers) w.heap = cpu::CutHeap(lightcuts ? heap_slots : 0);
     std::atomic<std::uint32_t> tiles_done{0};
     Progress progress(options.progress);
 
     for_each_tile(tile_count, workers, [&](std::uint32_t tile, Worker& t) {
-        cpu::ShadeKernel k = cpu::make_shade_kernel(prepared, t.heap.data(), heap_slots);
+        cpu::ShadeKernel k = cpu::make_shade_kernel(prepared, &t.heap);
         const std::uint32_t x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
         for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); ++y)
             for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); ++x) {

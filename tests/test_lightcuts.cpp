@@ -275,10 +275,9 @@ TEST(LightcutsBounds, HalfVectorBoundHoldsForEveryDirectionInTheCone) {
 }
 
 TEST(LightcutsHeap, PopsInDecreasingOrder) {
-    std::vector<cpu::HeapEntry> storage(1000);
+    cpu::CutHeap storage(1000);
     Kernel k;
-    k.heap = storage.data();
-    k.heap_slots = 1000;
+    k.bind_heap(storage);
     std::mt19937 rng(4);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     std::uint32_t size = 0;
@@ -289,7 +288,7 @@ TEST(LightcutsHeap, PopsInDecreasingOrder) {
         pushed.push_back(error);
         push_entry(k, size, std::uint32_t(i), error, ss);
         if (i % 3 == 2) {  // interleave pops
-            float top = storage[0].error;
+            float top = storage.error()[0];
             auto it = std::max_element(pushed.begin(), pushed.end());
             ASSERT_EQ(top, *it);
             pushed.erase(it);
@@ -297,7 +296,7 @@ TEST(LightcutsHeap, PopsInDecreasingOrder) {
         }
         if (i % 7 == 5) {  // and replacements of the top (a refinement's larger child)
             auto it = std::max_element(pushed.begin(), pushed.end());
-            ASSERT_EQ(storage[0].error, *it);
+            ASSERT_EQ(storage.error()[0], *it);
             *it = u(rng);
             k.lc_heap_replace_top(size, cpu::HeapEntry{std::uint32_t(i), *it, glm::vec3(0.0f)});
         }
@@ -305,7 +304,7 @@ TEST(LightcutsHeap, PopsInDecreasingOrder) {
     ASSERT_EQ(size, pushed.size());
     std::sort(pushed.rbegin(), pushed.rend());
     for (float expected : pushed) {
-        ASSERT_EQ(storage[0].error, expected);
+        ASSERT_EQ(storage.error()[0], expected);
         k.lc_heap_pop(size);
     }
     EXPECT_EQ(size, 0u);
@@ -320,18 +319,18 @@ TEST(LightcutsHeap, PopsInDecreasingOrder) {
 TEST(LightcutsHeap, SmallestSearchIsTheScalarLoop) {
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    std::vector<cpu::HeapEntry> heap(80);
+    std::vector<float> heap(80);
     int found = 0, none = 0;
     for (int trial = 0; trial < 20000; ++trial) {
-        for (auto& e : heap) e.error = float(int(u(rng) * 16.0f) + 1) / 16.0f;  // ties in every range
+        for (float& e : heap) e = float(int(u(rng) * 16.0f) + 1) / 16.0f;  // ties in every range
         const auto from = std::uint32_t(u(rng) * 40.0f);
         const auto to = from + std::uint32_t(u(rng) * 40.0f);
         const float bound = float(int(u(rng) * 20.0f)) / 16.0f;
         std::uint32_t expected = gpu::kInvalidIndex;
         float smallest = bound;
         for (std::uint32_t i = from; i < to; ++i)
-            if (heap[i].error < smallest) {
-                smallest = heap[i].error;
+            if (heap[i] < smallest) {
+                smallest = heap[i];
                 expected = i;
             }
         ASSERT_EQ(cpu::heap_smallest(heap.data(), from, to, bound), expected)
@@ -348,11 +347,10 @@ TEST(LightcutsHeap, SmallestSearchIsTheScalarLoop) {
 // up in the stats.
 TEST(LightcutsHeap, BoundedHeapKeepsTheLargestAndFreezesTheRest) {
     for (std::uint32_t capacity : {1u, 2u, 7u, 16u}) {
-        std::vector<cpu::HeapEntry> storage(capacity);
+        cpu::CutHeap storage(capacity);
         std::vector<gpu::LightNode> nodes(600, gpu::LightNode{});
         Kernel k;
-        k.heap = storage.data();
-        k.heap_slots = capacity;
+        k.bind_heap(storage);
         k.light_nodes = nodes.data();
         std::mt19937 rng(capacity);
         std::uniform_real_distribution<float> u(0.0f, 1.0f);
@@ -373,10 +371,10 @@ TEST(LightcutsHeap, BoundedHeapKeepsTheLargestAndFreezesTheRest) {
             }
             ASSERT_EQ(size, live.size());
             std::vector<float> held;
-            for (std::uint32_t j = 0; j < size; ++j) held.push_back(storage[j].error);
+            for (std::uint32_t j = 0; j < size; ++j) held.push_back(storage.error()[j]);
             std::sort(held.rbegin(), held.rend());
             ASSERT_EQ(held, live) << "capacity " << capacity << " after push " << i;
-            ASSERT_EQ(storage[0].error, live.front());
+            ASSERT_EQ(storage.error()[0], live.front());
             if (i % 5 == 4) {
                 k.lc_heap_pop(size);
                 live.erase(live.begin());
@@ -421,8 +419,8 @@ TEST(Lightcuts, MaxCutOneUsesTheRootRepresentative) {
     o.max_cut = 1;
     RenderResult r = render_cpu(p, o);
     gpu::FrameParams f = make_frame_params(p, o);
-    std::vector<cpu::HeapEntry> heap(2);
-    Kernel k = cpu::make_shade_kernel(p, heap.data(), 2);
+    cpu::CutHeap heap(2);
+    Kernel k = cpu::make_shade_kernel(p, &heap);
     const gpu::LightNode& root = p.tree.nodes[p.tree.roots[gpu::kLightPoint]];
     glm::vec3 root_intensity(root.intensity_r, root.intensity_g, root.intensity_b);
     int lit = 0;

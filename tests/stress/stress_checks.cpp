@@ -204,8 +204,8 @@ void expect_finite_image(const Image& image, const std::string& what) {
 void expect_cut_guarantee(const PreparedScene& p, const RenderOptions& o,
                           const std::vector<ShadingPoint>& points, const std::string& what) {
     const gpu::FrameParams f = make_frame_params(p, o);
-    std::vector<cpu::HeapEntry> heap(p.tree.cut_heap_slots(o.max_cut, o.cut_heap));
-    Kernel k = cpu::make_shade_kernel(p, heap.data(), std::uint32_t(heap.size()));
+    cpu::CutHeap heap(p.tree.cut_heap_slots(o.max_cut, o.cut_heap));
+    Kernel k = cpu::make_shade_kernel(p, &heap);
     int reports = 0;
     std::size_t violations = 0;
     double largest_share = 0.0;  // |difference| / sum of bounds, the tightest point
@@ -219,7 +219,7 @@ void expect_cut_guarantee(const PreparedScene& p, const RenderOptions& o,
         }
         const double a = luminance(k.lc_cut_result(s.sp, f.min_distance2, heap_size, fixed_sum));
         double bounds = double(stats.frozen_error);
-        for (std::uint32_t i = 0; i < heap_size; ++i) bounds += double(heap[i].error);
+        for (std::uint32_t i = 0; i < heap_size; ++i) bounds += double(heap.error()[i]);
         const double r = luminance(k.lc_shade_brute(s.sp, f.light_count, f.min_distance2, stats));
         const double allowed = bounds + 1e-5 * (a + r + bounds);
         if (bounds > 0.0) largest_share = std::max(largest_share, std::abs(a - r) / bounds);
