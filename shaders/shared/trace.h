@@ -162,26 +162,51 @@ uint lc_trace_closest(vec3 org, vec3 dir, float t_max, LC_OUT(float) t_hit, LC_O
 }
 
 // Any hit with t in (0, t_max): true if something blocks the segment.
+// Both children's boxes are tested at their parent, and only those the ray
+// enters are visited: the first of them next, the other from the stack
+// (which then holds at most one node per level). The GPU's loop thus runs
+// once per node the ray enters rather than once per node tested, and the
+// stack, an array each invocation indexes its own way (a loop over the
+// lanes on llvmpipe), is touched only where the ray enters both children.
+// Each loop iteration also counts against llvmpipe's limit on an
+// invocation's loop iterations (kernel.glsl, lc_loops_were_cut_short), and
+// so does each of a leaf's triangles unless the loop over them is
+// unrolled: it runs over the kBvhMaxLeafTriangles slots of a leaf, a
+// constant the compiler unrolls.
 bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
     vec3 inv_dir = lc_safe_inverse(dir);
     ShearedRay sheared = lc_shear_ray(dir);
     uint stack[kBvhStackSize];
     uint sp = 0u;
-    stack[sp++] = 0u;
-    while (sp > 0u) {
-        uint node_index = stack[--sp];
+    uint node_index = 0u;
+    float t_entry;
+    if (!lc_hit_box(LC_BVH_NODE(0u), org, inv_dir, t_max, t_entry)) return false;
+    while (true) {
         BvhNode node = LC_BVH_NODE(node_index);
-        float t_entry;
-        if (!lc_hit_box(node, org, inv_dir, t_max, t_entry)) continue;
         if (node.tri_count > 0u) {
-            for (uint i = node.first_or_left; i < node.first_or_left + node.tri_count; ++i) {
+            for (uint k = 0u; k < kBvhMaxLeafTriangles; ++k) {
+                if (k >= node.tri_count) break;
                 float u, v;
-                if (lc_intersect_sheared(org, sheared, LC_TRIANGLE(i), t_max, u, v) > 0.0f) return true;
+                if (lc_intersect_sheared(org, sheared, LC_TRIANGLE(node.first_or_left + k), t_max, u, v) > 0.0f)
+                    return true;
             }
         } else {
-            stack[sp++] = node.first_or_left + 1u;
-            stack[sp++] = node.first_or_left;
+            uint left = node.first_or_left;
+            float t_left, t_right;
+            bool hit_left = lc_hit_box(LC_BVH_NODE(left), org, inv_dir, t_max, t_left);
+            bool hit_right = lc_hit_box(LC_BVH_NODE(left + 1u), org, inv_dir, t_max, t_right);
+            if (hit_left) {
+                if (hit_right) stack[sp++] = left + 1u;
+                node_index = left;
+                continue;
+            }
+            if (hit_right) {
+                node_index = left + 1u;
+                continue;
+            }
         }
+        if (sp == 0u) break;
+        node_index = stack[--sp];
     }
     return false;
 }
