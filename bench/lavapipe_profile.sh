@@ -32,8 +32,11 @@ export VK_DRIVER_FILES="${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_6
 perf record -F 499 -o "$tmp/perf.data" "$exe" render "$scene" "$@" --device vulkan \
   -o "$tmp/x.exr" --no-png >"$tmp/render.log" 2>&1 &
 perf_pid=$!
-# The kernels are compiled before the first tile; copy them while the render runs.
-sleep "${LC_PROFILE_DELAY:-3}"
+# The kernels are compiled before the first tile (0.3 s on the room since
+# they are specialized on the host); copy them while the render runs.
+# LC_PROFILE_DELAY: seconds to wait first (a render shorter than it leaves
+# nothing to copy).
+sleep "${LC_PROFILE_DELAY:-1}"
 pid="$(pgrep -n -x lightcuts)"
 grep -E 'r-xp 00000000 00:00 0' "/proc/$pid/maps" | grep -v vdso | while read -r range _; do
   start="${range%-*}" end="${range#*-}"
