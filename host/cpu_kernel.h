@@ -86,8 +86,8 @@ struct HeapEntry {
 // anything else: both arrays keep a cache line of padding before and after
 // the slots. The threads' heaps were once allocated back to back, the top
 // of one in the line that held the other's last slots, and rendering on two
-// threads ran at 1.5 to 1.7 times one thread's speed; padded, at 2 times
-// (docs/results/speed.md).
+// threads ran at 1.4 to 1.7 times one thread's speed; padded, at 1.9 to 2.2
+// times (docs/results/speed.md).
 struct HeapPayload {
     uint node;
     vec3 unit;
