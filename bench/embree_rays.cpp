@@ -214,6 +214,23 @@ int run(int argc, char** argv) {
         });
         report("software 4-wide BVH, single rays", r.size(), s, total(), reference);
 
+#if defined(LC_WIDE8_TRACE)
+        if (lc::cpu::cpu_has_avx2()) {
+            std::fill(hits.begin(), hits.end(), 0);
+            s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+                lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
+                std::size_t h = 0;
+                for (std::size_t i = b; i < e; ++i)
+                    h += lc::cpu::trace_any_wide8(tk, p.bvh.wide8_nodes.data(), p.bvh.wide8_leaves.data(), r[i].org,
+                                                  r[i].dir, r[i].t_max)
+                             ? 1
+                             : 0;
+                hits[t] = h;
+            });
+            report("software 8-wide BVH (AVX2), single rays", r.size(), s, total(), reference);
+        }
+#endif
+
         std::fill(hits.begin(), hits.end(), 0);
         s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
             lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};

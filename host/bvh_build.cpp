@@ -230,17 +230,23 @@ WideLeaf wide_leaf(const BvhNode& leaf, const std::vector<gpu::Triangle>& triang
     return w;
 }
 
+// The slots of a wide node type (4 or 8).
+template <class Node>
+constexpr std::uint32_t kSlots = std::uint32_t(sizeof(Node::child) / sizeof(Node::child[0]));
+
 // An empty wide node: every slot masked out (count -1); an empty slot's box
 // is never tested.
-WideBvhNode empty_wide_node() {
-    WideBvhNode w{};
-    for (std::uint32_t s = 0; s < 4; ++s) w.count[s] = -1;
+template <class Node>
+Node empty_wide_node() {
+    Node w{};
+    for (std::uint32_t s = 0; s < kSlots<Node>; ++s) w.count[s] = -1;
     return w;
 }
 
 // Puts binary node `c` in slot s of w: its box and count, and for a leaf
 // its triangles as a new wide leaf (an inner child's index comes later).
-void fill_slot(WideBvhNode& w, std::uint32_t s, const BvhNode& c, const std::vector<gpu::Triangle>& triangles,
+template <class Node>
+void fill_slot(Node& w, std::uint32_t s, const BvhNode& c, const std::vector<gpu::Triangle>& triangles,
                std::vector<WideLeaf>& leaves) {
     w.lo_x[s] = c.min_x, w.lo_y[s] = c.min_y, w.lo_z[s] = c.min_z;
     w.hi_x[s] = c.max_x, w.hi_y[s] = c.max_y, w.hi_z[s] = c.max_z;
@@ -253,12 +259,12 @@ void fill_slot(WideBvhNode& w, std::uint32_t s, const BvhNode& c, const std::vec
 
 // Writes the wide node for the children of binary node `inner` at
 // wide[index], and its inner children's wide nodes after it (depth first).
+template <class Node>
 void collapse(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
-              std::uint32_t inner, std::uint32_t index, std::vector<WideBvhNode>& wide,
-              std::vector<WideLeaf>& leaves) {
-    std::array<std::uint32_t, 4> slots{nodes[inner].first_or_left, nodes[inner].first_or_left + 1u, 0u, 0u};
+              std::uint32_t inner, std::uint32_t index, std::vector<Node>& wide, std::vector<WideLeaf>& leaves) {
+    std::array<std::uint32_t, kSlots<Node>> slots{nodes[inner].first_or_left, nodes[inner].first_or_left + 1u};
     std::uint32_t used = 2;
-    while (used < 4) {
+    while (used < kSlots<Node>) {
         int widest = -1;
         for (std::uint32_t s = 0; s < used; ++s)
             if (nodes[slots[s]].tri_count == 0 &&
@@ -269,7 +275,7 @@ void collapse(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle
         slots[std::size_t(widest)] = left;
         slots[used++] = left + 1u;
     }
-    WideBvhNode w = empty_wide_node();
+    Node w = empty_wide_node<Node>();
     for (std::uint32_t s = 0; s < used; ++s) fill_slot(w, s, nodes[slots[s]], triangles, leaves);
     wide[index] = w;
     for (std::uint32_t s = 0; s < used; ++s) {
@@ -281,11 +287,10 @@ void collapse(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle
     }
 }
 
-}  // namespace
-
-void collapse_bvh(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
-                  std::vector<WideBvhNode>& wide_nodes, std::vector<WideLeaf>& wide_leaves) {
-    wide_nodes.assign(1, empty_wide_node());
+template <class Node>
+void collapse_tree(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
+                   std::vector<Node>& wide_nodes, std::vector<WideLeaf>& wide_leaves) {
+    wide_nodes.assign(1, empty_wide_node<Node>());
     wide_leaves.clear();
     if (nodes.empty()) return;
     const BvhNode& r = nodes[0];
@@ -295,6 +300,18 @@ void collapse_bvh(const std::vector<BvhNode>& nodes, const std::vector<gpu::Tria
         return;
     }
     collapse(nodes, triangles, 0, 0, wide_nodes, wide_leaves);
+}
+
+}  // namespace
+
+void collapse_bvh(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
+                  std::vector<WideBvhNode>& wide_nodes, std::vector<WideLeaf>& wide_leaves) {
+    collapse_tree(nodes, triangles, wide_nodes, wide_leaves);
+}
+
+void collapse_bvh8(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
+                   std::vector<WideBvhNode8>& wide_nodes, std::vector<WideLeaf>& wide_leaves) {
+    collapse_tree(nodes, triangles, wide_nodes, wide_leaves);
 }
 
 Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNormals>& normals,
@@ -320,6 +337,7 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
         constexpr float far = std::numeric_limits<float>::max();
         bvh.nodes.push_back(BvhNode{far, far, far, 0u, far, far, far, 0u});
         collapse_bvh(bvh.nodes, triangles, bvh.wide_nodes, bvh.wide_leaves);
+        collapse_bvh8(bvh.nodes, triangles, bvh.wide8_nodes, bvh.wide8_leaves);
         bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return bvh;
     }
@@ -359,6 +377,7 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
     }
 
     collapse_bvh(bvh.nodes, triangles, bvh.wide_nodes, bvh.wide_leaves);
+    collapse_bvh8(bvh.nodes, triangles, bvh.wide8_nodes, bvh.wide8_leaves);
     bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;
 }

@@ -123,6 +123,11 @@ std::string check_ray(const Scene& s, vec3 org, vec3 dir, float t_max) {
         return "any-hit disagrees with brute force for " + describe(org, dir, t_max);
     if (lc::cpu::trace_any_wide(k, s.bvh.wide_nodes.data(), s.bvh.wide_leaves.data(), org, dir, t_max) != any)
         return "4-wide any-hit disagrees with brute force for " + describe(org, dir, t_max);
+#if defined(LC_WIDE8_TRACE)
+    if (lc::cpu::cpu_has_avx2() &&
+        lc::cpu::trace_any_wide8(k, s.bvh.wide8_nodes.data(), s.bvh.wide8_leaves.data(), org, dir, t_max) != any)
+        return "8-wide any-hit disagrees with brute force for " + describe(org, dir, t_max);
+#endif
     return {};
 }
 
@@ -142,12 +147,13 @@ bool contains(const BvhNode& box, vec3 p) {
            box.max_z >= p.z;
 }
 
-// The 4-wide tree: every wide node reached once, its slots filled from the
+// A wide tree (4 or 8 wide): every wide node reached once, its slots filled from the
 // first, each child's box one of the binary tree's, leaves exactly the
 // binary tree's leaves (every triangle once, inside its box), no deeper
 // than the binary tree.
-void check_wide_invariants(const Scene& s) {
-    const auto& wide = s.bvh.wide_nodes;
+template <class Node>
+void check_wide_invariants(const Scene& s, const std::vector<Node>& wide, const std::vector<lc::WideLeaf>& wide_leaves) {
+    constexpr int kSlots = int(sizeof(Node::child) / sizeof(Node::child[0]));
     ASSERT_FALSE(wide.empty());
     std::map<std::array<float, 6>, int> binary_boxes;
     std::map<std::pair<std::uint32_t, std::uint32_t>, int> binary_leaves;
@@ -165,10 +171,10 @@ void check_wide_invariants(const Scene& s) {
         ASSERT_LT(index, wide.size());
         ++seen[index];
         max_depth = std::max(max_depth, depth);
-        const lc::WideBvhNode& w = wide[index];
-        for (int slot = 0; slot < 4; ++slot) {
+        const Node& w = wide[index];
+        for (int slot = 0; slot < kSlots; ++slot) {
             if (w.count[slot] < 0) {
-                for (int later = slot; later < 4; ++later) ASSERT_LT(w.count[later], 0) << "slots not filled first";
+                for (int later = slot; later < kSlots; ++later) ASSERT_LT(w.count[later], 0) << "slots not filled first";
                 break;
             }
             EXPECT_EQ(binary_boxes.count({w.lo_x[slot], w.lo_y[slot], w.lo_z[slot], w.hi_x[slot], w.hi_y[slot],
@@ -179,8 +185,8 @@ void check_wide_invariants(const Scene& s) {
                 continue;
             }
             ++leaves;
-            ASSERT_LT(w.child[slot], s.bvh.wide_leaves.size());
-            const lc::WideLeaf& leaf = s.bvh.wide_leaves[w.child[slot]];
+            ASSERT_LT(w.child[slot], wide_leaves.size());
+            const lc::WideLeaf& leaf = wide_leaves[w.child[slot]];
             const auto count = std::uint32_t(w.count[slot]);
             EXPECT_EQ(binary_leaves.count({leaf.first, count}), 1u);
             for (std::uint32_t lane = 0; lane < 4; ++lane) {
@@ -198,7 +204,7 @@ void check_wide_invariants(const Scene& s) {
         }
     }
     EXPECT_EQ(leaves, binary_leaves.size());
-    EXPECT_EQ(s.bvh.wide_leaves.size(), binary_leaves.size());
+    EXPECT_EQ(wide_leaves.size(), binary_leaves.size());
     EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int c) { return c == 1; }));
     EXPECT_TRUE(std::all_of(tri_seen.begin(), tri_seen.end(), [](int c) { return c == 1; }));
     EXPECT_LE(max_depth, max_leaf_depth(s.bvh.nodes, 0, 0));
@@ -248,7 +254,8 @@ void check_invariants(const Scene& s) {
         ASSERT_EQ(s.normals[i].pad0, s.triangles[i].material) << "normals not permuted with triangles";
     }
     EXPECT_TRUE(std::all_of(input_seen.begin(), input_seen.end(), [](int c) { return c == 1; }));
-    check_wide_invariants(s);
+    check_wide_invariants(s, s.bvh.wide_nodes, s.bvh.wide_leaves);
+    check_wide_invariants(s, s.bvh.wide8_nodes, s.bvh.wide8_leaves);
 }
 
 using lc::test::random_unit;
@@ -473,9 +480,17 @@ TEST(Bvh, EmptySceneMissesEverything) {
         EXPECT_EQ(k.lc_trace_closest(org, dir, kRayInfinity, t, b1, b2), kInvalidIndex);
         EXPECT_FALSE(k.lc_trace_any(org, dir, kRayInfinity));
         EXPECT_FALSE(lc::cpu::trace_any_wide(k, bvh.wide_nodes.data(), bvh.wide_leaves.data(), org, dir, kRayInfinity));
+#if defined(LC_WIDE8_TRACE)
+        if (lc::cpu::cpu_has_avx2()) {
+            EXPECT_FALSE(
+                lc::cpu::trace_any_wide8(k, bvh.wide8_nodes.data(), bvh.wide8_leaves.data(), org, dir, kRayInfinity));
+        }
+#endif
     }
     ASSERT_EQ(bvh.wide_nodes.size(), 1u);
     for (int slot = 0; slot < 4; ++slot) EXPECT_EQ(bvh.wide_nodes[0].count[slot], -1);
+    ASSERT_EQ(bvh.wide8_nodes.size(), 1u);
+    for (int slot = 0; slot < 8; ++slot) EXPECT_EQ(bvh.wide8_nodes[0].count[slot], -1);
 }
 
 TEST(Bvh, DegenerateInputsKeepInvariants) {
@@ -516,6 +531,8 @@ TEST(Bvh, DegenerateInputsKeepInvariants) {
     EXPECT_EQ(single.bvh.nodes.size(), 1u);
     ASSERT_EQ(single.bvh.wide_nodes.size(), 1u);  // the root leaf in slot 0
     EXPECT_EQ(single.bvh.wide_nodes[0].count[0], 1);
+    ASSERT_EQ(single.bvh.wide8_nodes.size(), 1u);
+    EXPECT_EQ(single.bvh.wide8_nodes[0].count[0], 1);
     EXPECT_TRUE(check_ray(single, vec3(0.2f, 0.2f, 1.0f), vec3(0, 0, -1), kRayInfinity).empty());
     lc::cpu::TraceKernel single_kernel = single.kernel();
     EXPECT_TRUE(lc::cpu::trace_any_wide(single_kernel, single.bvh.wide_nodes.data(), single.bvh.wide_leaves.data(), vec3(0.2f, 0.2f, 1.0f),
