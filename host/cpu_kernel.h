@@ -333,7 +333,7 @@ struct BasicShadeKernel {
     // The shadow rays' any-hit query: lc_trace_any's answer, from the 8-wide
     // tree where one is bound (AVX2), else from the 4-wide one (1.4 to 2.4
     // times the binary tree's rays per second on the shipped room, and the
-    // 8-wide 1.3 times the 4-wide's on lightcuts' rays; bench/embree_rays).
+    // 8-wide 1.1 to 1.3 times the 4-wide's on lightcuts' rays; bench/embree_rays).
     bool lc_trace_shadow(vec3 org, vec3 dir, float t_max) {
 #if defined(LC_WIDE8_TRACE)
         if (wide8_nodes != nullptr) return trace_any_wide8(*this, wide8_nodes, wide8_leaves, org, dir, t_max);

@@ -173,9 +173,10 @@ inline bool cpu_has_avx2() {
 // trace_any_wide's answer from the 8-wide tree (lc::WideBvhNode8,
 // collapse_bvh8): one 256-bit slab test checks a node's eight boxes, with
 // lc_hit_box's operations lane by lane (AVX2 without FMA, so nothing is
-// contracted), and leaves are tested with wide_hit_leaf. Half the depth of
-// the 4-wide tree: 1.3 times the rays per second on lightcuts' shadow rays
-// of the shipped room (bench/embree_rays). Only where cpu_has_avx2().
+// contracted), and leaves are tested with wide_hit_leaf. Fewer levels than
+// the 4-wide tree, so fewer nodes per ray: 1.1 to 1.3 times the rays per
+// second on lightcuts' shadow rays of the shipped room (bench/embree_rays).
+// Only where cpu_has_avx2().
 template <class Kernel>
 __attribute__((target("avx2"))) bool trace_any_wide8(Kernel& kernel, const WideBvhNode8* nodes,
                                                       const WideLeaf* leaves, glm::vec3 org, glm::vec3 dir,

@@ -4,8 +4,8 @@
 // whole module before it specializes anything, so the code for features a
 // scene does not use (the Disney BRDF, textures, ...) cost it a quarter of a
 // second per render (docs/results/lavapipe.md); handed the specialized
-// module it builds the pipeline in half the time, and the kernel it runs is
-// the same.
+// module, a render's set-up on the room took about 0.3 s instead of 0.45,
+// and the kernel it runs is the same.
 #pragma once
 
 #include <cstddef>

@@ -71,8 +71,8 @@ struct Tuning {
     TexelReads texel_reads = TexelReads::kAuto;
 
     // Specialize the kernels' SPIR-V on the host (host/vulkan/spirv_specialize.h)
-    // instead of in the driver. kAuto: on CPU devices, where lavapipe then
-    // builds the pipelines in half the time (docs/results/lavapipe.md);
+    // instead of in the driver. kAuto: on CPU devices, where lavapipe's
+    // set-up then took about 0.3 s instead of 0.45 (docs/results/lavapipe.md);
     // GPUs specialize in the driver until it is measured there.
     enum class HostSpecialization { kAuto, kOn, kOff };
     HostSpecialization specialize_on_host = HostSpecialization::kAuto;

@@ -23,7 +23,7 @@ struct alignas(16) WideBvhNode {
 
 // The same tree 8 wide, for CPUs with AVX2 (host/wide_trace.h,
 // trace_any_wide8): up to eight children's boxes per node, tested in one
-// 256-bit slab test. Half the depth of the 4-wide tree, so a ray visits
+// 256-bit slab test. Fewer levels than the 4-wide tree, so a ray visits
 // fewer nodes. Made by collapse_bvh8, with leaves of its own.
 struct alignas(32) WideBvhNode8 {
     float lo_x[8], lo_y[8], lo_z[8];
