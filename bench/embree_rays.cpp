@@ -221,7 +221,7 @@ int run(int argc, char** argv) {
                 lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
                 std::size_t h = 0;
                 for (std::size_t i = b; i < e; ++i)
-                    h += lc::cpu::trace_any_wide8(tk, p.bvh.wide8_nodes.data(), p.bvh.wide8_leaves.data(), r[i].org,
+                    h += lc::cpu::trace_any_wide8(tk, p.bvh.wide8_nodes.data(), p.bvh.wide_leaves.data(), r[i].org,
                                                   r[i].dir, r[i].t_max)
                              ? 1
                              : 0;

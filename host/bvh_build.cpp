@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
+#include <unordered_map>
 
 #include <glm/glm.hpp>
 
@@ -244,24 +245,21 @@ Node empty_wide_node() {
 }
 
 // Puts binary node `c` in slot s of w: its box and count, and for a leaf
-// its triangles as a new wide leaf (an inner child's index comes later).
-template <class Node>
-void fill_slot(Node& w, std::uint32_t s, const BvhNode& c, const std::vector<gpu::Triangle>& triangles,
-               std::vector<WideLeaf>& leaves) {
+// the index of its wide leaf, which `leaf_index(c)` gives (an inner
+// child's index comes later).
+template <class Node, class LeafIndex>
+void fill_slot(Node& w, std::uint32_t s, const BvhNode& c, LeafIndex& leaf_index) {
     w.lo_x[s] = c.min_x, w.lo_y[s] = c.min_y, w.lo_z[s] = c.min_z;
     w.hi_x[s] = c.max_x, w.hi_y[s] = c.max_y, w.hi_z[s] = c.max_z;
     w.count[s] = std::int32_t(c.tri_count);
-    if (c.tri_count > 0) {
-        w.child[s] = std::uint32_t(leaves.size());
-        leaves.push_back(wide_leaf(c, triangles));
-    }
+    if (c.tri_count > 0) w.child[s] = leaf_index(c);
 }
 
 // Writes the wide node for the children of binary node `inner` at
 // wide[index], and its inner children's wide nodes after it (depth first).
-template <class Node>
-void collapse(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
-              std::uint32_t inner, std::uint32_t index, std::vector<Node>& wide, std::vector<WideLeaf>& leaves) {
+template <class Node, class LeafIndex>
+void collapse(const std::vector<BvhNode>& nodes, std::uint32_t inner, std::uint32_t index, std::vector<Node>& wide,
+              LeafIndex& leaf_index) {
     std::array<std::uint32_t, kSlots<Node>> slots{nodes[inner].first_or_left, nodes[inner].first_or_left + 1u};
     std::uint32_t used = 2;
     while (used < kSlots<Node>) {
@@ -276,42 +274,48 @@ void collapse(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle
         slots[used++] = left + 1u;
     }
     Node w = empty_wide_node<Node>();
-    for (std::uint32_t s = 0; s < used; ++s) fill_slot(w, s, nodes[slots[s]], triangles, leaves);
+    for (std::uint32_t s = 0; s < used; ++s) fill_slot(w, s, nodes[slots[s]], leaf_index);
     wide[index] = w;
     for (std::uint32_t s = 0; s < used; ++s) {
         if (w.count[s] != 0) continue;
         const auto child = std::uint32_t(wide.size());
         wide.emplace_back();
         wide[index].child[s] = child;
-        collapse(nodes, triangles, slots[s], child, wide, leaves);
+        collapse(nodes, slots[s], child, wide, leaf_index);
     }
 }
 
-template <class Node>
-void collapse_tree(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
-                   std::vector<Node>& wide_nodes, std::vector<WideLeaf>& wide_leaves) {
+template <class Node, class LeafIndex>
+void collapse_tree(const std::vector<BvhNode>& nodes, std::vector<Node>& wide_nodes, LeafIndex leaf_index) {
     wide_nodes.assign(1, empty_wide_node<Node>());
-    wide_leaves.clear();
     if (nodes.empty()) return;
     const BvhNode& r = nodes[0];
     if (r.tri_count == 0 && r.first_or_left == 0) return;  // no triangles (build_bvh's far root)
     if (r.tri_count > 0) {
-        fill_slot(wide_nodes[0], 0, r, triangles, wide_leaves);  // a root leaf: one slot holding it
+        fill_slot(wide_nodes[0], 0, r, leaf_index);  // a root leaf: one slot holding it
         return;
     }
-    collapse(nodes, triangles, 0, 0, wide_nodes, wide_leaves);
+    collapse(nodes, 0, 0, wide_nodes, leaf_index);
 }
 
 }  // namespace
 
 void collapse_bvh(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
                   std::vector<WideBvhNode>& wide_nodes, std::vector<WideLeaf>& wide_leaves) {
-    collapse_tree(nodes, triangles, wide_nodes, wide_leaves);
+    wide_leaves.clear();
+    collapse_tree(nodes, wide_nodes, [&](const BvhNode& leaf) {
+        wide_leaves.push_back(wide_leaf(leaf, triangles));
+        return std::uint32_t(wide_leaves.size() - 1);
+    });
 }
 
-void collapse_bvh8(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
-                   std::vector<WideBvhNode8>& wide_nodes, std::vector<WideLeaf>& wide_leaves) {
-    collapse_tree(nodes, triangles, wide_nodes, wide_leaves);
+void collapse_bvh8(const std::vector<BvhNode>& nodes, const std::vector<WideLeaf>& wide_leaves,
+                   std::vector<WideBvhNode8>& wide_nodes) {
+    // The binary leaves' triangle ranges are disjoint, so a leaf's first
+    // triangle names its wide leaf.
+    std::unordered_map<std::uint32_t, std::uint32_t> leaf_of_first;
+    for (std::uint32_t i = 0; i < wide_leaves.size(); ++i) leaf_of_first[wide_leaves[i].first] = i;
+    collapse_tree(nodes, wide_nodes, [&](const BvhNode& leaf) { return leaf_of_first.at(leaf.first_or_left); });
 }
 
 Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNormals>& normals,
@@ -337,7 +341,7 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
         constexpr float far = std::numeric_limits<float>::max();
         bvh.nodes.push_back(BvhNode{far, far, far, 0u, far, far, far, 0u});
         collapse_bvh(bvh.nodes, triangles, bvh.wide_nodes, bvh.wide_leaves);
-        collapse_bvh8(bvh.nodes, triangles, bvh.wide8_nodes, bvh.wide8_leaves);
+        collapse_bvh8(bvh.nodes, bvh.wide_leaves, bvh.wide8_nodes);
         bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return bvh;
     }
@@ -377,7 +381,7 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
     }
 
     collapse_bvh(bvh.nodes, triangles, bvh.wide_nodes, bvh.wide_leaves);
-    collapse_bvh8(bvh.nodes, triangles, bvh.wide8_nodes, bvh.wide8_leaves);
+    collapse_bvh8(bvh.nodes, bvh.wide_leaves, bvh.wide8_nodes);
     bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;
 }

@@ -125,7 +125,7 @@ std::string check_ray(const Scene& s, vec3 org, vec3 dir, float t_max) {
         return "4-wide any-hit disagrees with brute force for " + describe(org, dir, t_max);
 #if defined(LC_WIDE8_TRACE)
     if (lc::cpu::cpu_has_avx2() &&
-        lc::cpu::trace_any_wide8(k, s.bvh.wide8_nodes.data(), s.bvh.wide8_leaves.data(), org, dir, t_max) != any)
+        lc::cpu::trace_any_wide8(k, s.bvh.wide8_nodes.data(), s.bvh.wide_leaves.data(), org, dir, t_max) != any)
         return "8-wide any-hit disagrees with brute force for " + describe(org, dir, t_max);
 #endif
     return {};
@@ -255,7 +255,7 @@ void check_invariants(const Scene& s) {
     }
     EXPECT_TRUE(std::all_of(input_seen.begin(), input_seen.end(), [](int c) { return c == 1; }));
     check_wide_invariants(s, s.bvh.wide_nodes, s.bvh.wide_leaves);
-    check_wide_invariants(s, s.bvh.wide8_nodes, s.bvh.wide8_leaves);
+    check_wide_invariants(s, s.bvh.wide8_nodes, s.bvh.wide_leaves);
 }
 
 using lc::test::random_unit;
@@ -483,7 +483,7 @@ TEST(Bvh, EmptySceneMissesEverything) {
 #if defined(LC_WIDE8_TRACE)
         if (lc::cpu::cpu_has_avx2()) {
             EXPECT_FALSE(
-                lc::cpu::trace_any_wide8(k, bvh.wide8_nodes.data(), bvh.wide8_leaves.data(), org, dir, kRayInfinity));
+                lc::cpu::trace_any_wide8(k, bvh.wide8_nodes.data(), bvh.wide_leaves.data(), org, dir, kRayInfinity));
         }
 #endif
     }
