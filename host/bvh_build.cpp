@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <unordered_map>
 
 #include <glm/glm.hpp>
@@ -309,6 +310,22 @@ void collapse_bvh(const std::vector<BvhNode>& nodes, const std::vector<gpu::Tria
     });
 }
 
+std::vector<gpu::Bvh4Node> bvh4_nodes(const std::vector<WideBvhNode>& wide_nodes,
+                                      const std::vector<WideLeaf>& wide_leaves) {
+    std::vector<gpu::Bvh4Node> out(wide_nodes.size());
+    for (std::size_t i = 0; i < wide_nodes.size(); ++i) {
+        const WideBvhNode& w = wide_nodes[i];
+        gpu::Bvh4Node& n = out[i];
+        for (int s = 0; s < 4; ++s) {
+            n.lo_x[s] = w.lo_x[s], n.lo_y[s] = w.lo_y[s], n.lo_z[s] = w.lo_z[s];
+            n.hi_x[s] = w.hi_x[s], n.hi_y[s] = w.hi_y[s], n.hi_z[s] = w.hi_z[s];
+            n.child[s] = w.count[s] > 0 ? wide_leaves[w.child[s]].first : w.child[s];
+            n.count[s] = w.count[s];
+        }
+    }
+    return out;
+}
+
 void collapse_bvh8(const std::vector<BvhNode>& nodes, const std::vector<WideLeaf>& wide_leaves,
                    std::vector<WideBvhNode8>& wide_nodes) {
     // The binary leaves' triangle ranges are disjoint, so a leaf's first
@@ -326,8 +343,9 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
     if (uvs && uvs->size() != triangles.size())
         throw std::invalid_argument("build_bvh: triangles and uvs differ in count");
     // Node indices are 32-bit and a tree holds up to 2n - 1 nodes.
-    if (triangles.size() >= std::size_t(std::numeric_limits<std::uint32_t>::max() / 2))
-        throw std::invalid_argument("build_bvh: too many triangles for 32-bit node indices");
+    if (triangles.size() >= std::size_t(gpu::kBvh4MaxTriangles))
+        throw std::invalid_argument("build_bvh: " + std::to_string(triangles.size()) +
+                                    " triangles; at most 2^29 - 1 are supported");
 
     Bvh bvh;
     const auto n = std::uint32_t(triangles.size());
@@ -342,6 +360,7 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
         bvh.nodes.push_back(BvhNode{far, far, far, 0u, far, far, far, 0u});
         collapse_bvh(bvh.nodes, triangles, bvh.wide_nodes, bvh.wide_leaves);
         collapse_bvh8(bvh.nodes, bvh.wide_leaves, bvh.wide8_nodes);
+        bvh.kernel_nodes = bvh4_nodes(bvh.wide_nodes, bvh.wide_leaves);
         bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return bvh;
     }
@@ -382,6 +401,7 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
 
     collapse_bvh(bvh.nodes, triangles, bvh.wide_nodes, bvh.wide_leaves);
     collapse_bvh8(bvh.nodes, bvh.wide_leaves, bvh.wide8_nodes);
+    bvh.kernel_nodes = bvh4_nodes(bvh.wide_nodes, bvh.wide_leaves);
     bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;
 }

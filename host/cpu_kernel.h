@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstring>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -45,6 +46,29 @@ struct TraceKernel {
 #include "shared/trace.h"
 #undef LC_BVH_NODE
 #undef LC_TRIANGLE
+};
+
+// The Vulkan kernels' shadow-ray traversal, through the 4-wide tree they
+// read (Bvh::kernel_nodes), run on the CPU: the tests compare it with brute
+// force. The renderer's own shadow rays use host/wide_trace.h.
+struct Trace4Kernel {
+    const BvhNode* bvh_nodes = nullptr;
+    const Triangle* triangles = nullptr;
+    const Bvh4Node* bvh4_nodes = nullptr;
+
+    uvec4 bvh4_word(uint i, uint k) const {
+        uvec4 w;
+        std::memcpy(&w, reinterpret_cast<const char*>(bvh4_nodes + i) + sizeof(uvec4) * k, sizeof w);
+        return w;
+    }
+
+#define LC_BVH_NODE(i) bvh_nodes[i]
+#define LC_TRIANGLE(i) triangles[i]
+#define LC_BVH4_WORD(i, k) bvh4_word(i, k)
+#include "shared/trace.h"
+#undef LC_BVH_NODE
+#undef LC_TRIANGLE
+#undef LC_BVH4_WORD
 };
 
 // Texture lookups and materials at a point only (shared/textures.h): what

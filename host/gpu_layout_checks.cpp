@@ -11,6 +11,12 @@ static_assert(offsetof(BvhNode, first_or_left) == 12);
 static_assert(offsetof(BvhNode, max_x) == 16);
 static_assert(offsetof(BvhNode, tri_count) == 28);
 
+static_assert(sizeof(Bvh4Node) == 128);  // eight uvec4 words, read as such (shaders/kernel.glsl)
+static_assert(offsetof(Bvh4Node, lo_y) == 16);
+static_assert(offsetof(Bvh4Node, hi_x) == 48);
+static_assert(offsetof(Bvh4Node, child) == 96);
+static_assert(offsetof(Bvh4Node, count) == 112);
+
 static_assert(sizeof(Triangle) == 48);
 static_assert(offsetof(Triangle, v1_x) == 12);
 static_assert(offsetof(Triangle, v2_x) == 24);

@@ -27,32 +27,36 @@ LC_CONST uint kBindingTexels = 6u;        // RGBA8 texels of every texture, one 
 LC_CONST uint kBindingLights = 7u;        // leaf order of the light tree
 LC_CONST uint kBindingLightNodes = 8u;
 LC_CONST uint kBindingEnvironment = 9u;   // RGB floats of the environment map (one black texel if none)
-LC_CONST uint kBindingFrame = 10u;        // one FrameParams
-LC_CONST uint kBindingGBuffer = 11u;      // GBufferTexel per tile pixel
-LC_CONST uint kBindingRadiance = 12u;     // 3 floats per tile pixel, summed over samples
-LC_CONST uint kBindingPixelStats = 13u;   // PixelStats per tile pixel, summed over samples
-LC_CONST uint kBindingHeapSave = 14u;     // cut heaps paused between dispatches (see heap.glsl)
-LC_CONST uint kBindingCutState = 15u;     // CutState per tile pixel, between Lightcuts dispatches
-LC_CONST uint kBindingChunkTable = 16u;   // ChunkTable: where the chunks of a split scene array are
-LC_CONST uint kBindingCount = 17u;        // storage-buffer bindings: 0 .. kBindingCount - 1
-// Uniform texel buffers (RGBA32UI views) over four of the scene arrays
+LC_CONST uint kBindingWideBvhNodes = 10u; // the BVH 4 wide for shadow rays (Bvh4Node, 8 uvec4 each)
+LC_CONST uint kBindingFrame = 11u;        // one FrameParams
+LC_CONST uint kBindingGBuffer = 12u;      // GBufferTexel per tile pixel
+LC_CONST uint kBindingRadiance = 13u;     // 3 floats per tile pixel, summed over samples
+LC_CONST uint kBindingPixelStats = 14u;   // PixelStats per tile pixel, summed over samples
+LC_CONST uint kBindingHeapSave = 15u;     // cut heaps paused between dispatches (see heap.glsl)
+LC_CONST uint kBindingCutState = 16u;     // CutState per tile pixel, between Lightcuts dispatches
+LC_CONST uint kBindingChunkTable = 17u;   // ChunkTable: where the chunks of a split scene array are
+LC_CONST uint kBindingCount = 18u;        // storage-buffer bindings: 0 .. kBindingCount - 1
+// Uniform texel buffers (RGBA32UI views) over five of the scene arrays
 // above: the arrays the shadow rays and cut selection read most, read
 // through these instead where kSpecTexelReads is set (docs/vulkan.md).
-LC_CONST uint kBindingBvhNodeTexels = 17u;
-LC_CONST uint kBindingTriangleTexels = 18u;
-LC_CONST uint kBindingLightTexels = 19u;
-LC_CONST uint kBindingLightNodeTexels = 20u;
-LC_CONST uint kTexelBindingCount = 4u;
+LC_CONST uint kBindingBvhNodeTexels = 18u;
+LC_CONST uint kBindingTriangleTexels = 19u;
+LC_CONST uint kBindingLightTexels = 20u;
+LC_CONST uint kBindingLightNodeTexels = 21u;
+LC_CONST uint kBindingWideBvhNodeTexels = 22u;
+LC_CONST uint kTexelBindingCount = 5u;
 
 // Scene arrays (bindings 0 .. kSceneArrayCount - 1) larger than one buffer
 // may be are split into chunks of 2^shift elements each. Chunk 0 stays at
 // the array's binding; every chunk's buffer device address is in the
 // ChunkTable, whose std430 layout is:
-//   uint first[kSceneArrayCount];  // index in addr of each array's chunk 0
-//   uvec2 addr[];                  // device addresses, low word first
-// (shaders/kernel.glsl reads it; GpuResources writes it.)
-LC_CONST uint kSceneArrayCount = 10u;
-LC_CONST uint kChunkTableHeaderBytes = 4u * kSceneArrayCount;
+//   uint first[kChunkTableFirstWords];  // index in addr of each array's chunk 0
+//   uvec2 addr[];                       // device addresses, low word first
+// (shaders/kernel.glsl reads it; GpuResources writes it.) The header has an
+// even number of words, so the addresses follow it unpadded.
+LC_CONST uint kSceneArrayCount = 11u;
+LC_CONST uint kChunkTableFirstWords = (kSceneArrayCount + 1u) & ~1u;
+LC_CONST uint kChunkTableHeaderBytes = 4u * kChunkTableFirstWords;
 
 // Specialization constant ids.
 LC_CONST uint kSpecWorkgroupSize = 0u;    // local_size_x

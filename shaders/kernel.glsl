@@ -35,7 +35,7 @@ layout(std430, binding = kBindingFrame) readonly buffer Frame { FrameParams fram
 // buffer"). With no array split, kSplitScene folds the second path away.
 layout(constant_id = kSpecSplitScene) const bool kSplitScene = false;
 layout(std430, binding = kBindingChunkTable) readonly buffer ChunkTable {
-    uint chunk_first[kSceneArrayCount];
+    uint chunk_first[kChunkTableFirstWords];
     uvec2 chunk_addr[];
 };
 #define LC_SCENE_ARRAY(Type, name, binding_index)                                                      \
@@ -59,11 +59,12 @@ LC_SCENE_ARRAY(uint, texels, kBindingTexels)
 LC_SCENE_ARRAY(Light, lights, kBindingLights)
 LC_SCENE_ARRAY(LightNode, light_nodes, kBindingLightNodes)
 LC_SCENE_ARRAY(float, environment, kBindingEnvironment)
+LC_SCENE_ARRAY(uvec4, wide_bvh_nodes, kBindingWideBvhNodes)
 layout(std430, binding = kBindingGBuffer) buffer GBuffer { GBufferTexel gbuffer[]; };
 layout(std430, binding = kBindingRadiance) buffer Radiance { float radiance[]; };
 layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_stats[]; };
 
-// The same four arrays as 16-byte texels (kBindingBvhNodeTexels ..). On
+// The same five arrays as 16-byte texels (kBindingBvhNodeTexels ..). On
 // llvmpipe a storage-buffer load whose address differs between lanes is a
 // loop over the lanes, a texel fetch one gather (docs/results/lavapipe.md);
 // the host sets kTexelReads where it measured that to pay and every array
@@ -73,6 +74,7 @@ layout(binding = kBindingBvhNodeTexels) uniform usamplerBuffer bvh_node_texels;
 layout(binding = kBindingTriangleTexels) uniform usamplerBuffer triangle_texels;
 layout(binding = kBindingLightTexels) uniform usamplerBuffer light_texels;
 layout(binding = kBindingLightNodeTexels) uniform usamplerBuffer light_node_texels;
+layout(binding = kBindingWideBvhNodeTexels) uniform usamplerBuffer wide_bvh_node_texels;
 
 BvhNode lc_bvh_node(uint i) {
     if (!kTexelReads) return lc_bvh_nodes(i);
@@ -80,6 +82,12 @@ BvhNode lc_bvh_node(uint i) {
     const uvec4 b = texelFetch(bvh_node_texels, int(2u * i + 1u));
     return BvhNode(uintBitsToFloat(a.x), uintBitsToFloat(a.y), uintBitsToFloat(a.z), a.w,
                    uintBitsToFloat(b.x), uintBitsToFloat(b.y), uintBitsToFloat(b.z), b.w);
+}
+
+// Word k (16 bytes) of Bvh4Node i.
+uvec4 lc_bvh4_word(uint i, uint k) {
+    if (!kTexelReads) return lc_wide_bvh_nodes(8u * i + k);
+    return texelFetch(wide_bvh_node_texels, int(8u * i + k));
 }
 
 Triangle lc_triangle(uint i) {
@@ -110,6 +118,7 @@ LightNode lc_light_node(uint i) {
 }
 
 #define LC_BVH_NODE(i) lc_bvh_node(i)
+#define LC_BVH4_WORD(i, k) lc_bvh4_word(i, k)
 #define LC_TRIANGLE(i) lc_triangle(i)
 #define LC_MATERIAL(i) lc_materials(i)
 #define LC_UVS(i) lc_uvs(i)

@@ -123,6 +123,9 @@ std::string check_ray(const Scene& s, vec3 org, vec3 dir, float t_max) {
         return "any-hit disagrees with brute force for " + describe(org, dir, t_max);
     if (lc::cpu::trace_any_wide(k, s.bvh.wide_nodes.data(), s.bvh.wide_leaves.data(), org, dir, t_max) != any)
         return "4-wide any-hit disagrees with brute force for " + describe(org, dir, t_max);
+    lc::cpu::Trace4Kernel k4{s.bvh.nodes.data(), s.triangles.data(), s.bvh.kernel_nodes.data()};
+    if (k4.lc_trace_any(org, dir, t_max) != any)
+        return "the kernels' 4-wide any-hit disagrees with brute force for " + describe(org, dir, t_max);
 #if defined(LC_WIDE8_TRACE)
     if (lc::cpu::cpu_has_avx2() &&
         lc::cpu::trace_any_wide8(k, s.bvh.wide8_nodes.data(), s.bvh.wide_leaves.data(), org, dir, t_max) != any)
@@ -256,6 +259,26 @@ void check_invariants(const Scene& s) {
     EXPECT_TRUE(std::all_of(input_seen.begin(), input_seen.end(), [](int c) { return c == 1; }));
     check_wide_invariants(s, s.bvh.wide_nodes, s.bvh.wide_leaves);
     check_wide_invariants(s, s.bvh.wide8_nodes, s.bvh.wide_leaves);
+    // The kernels' copy of the 4-wide tree: the same slots, a leaf's slot
+    // naming its first triangle.
+    ASSERT_EQ(s.bvh.kernel_nodes.size(), s.bvh.wide_nodes.size());
+    for (std::size_t i = 0; i < s.bvh.wide_nodes.size(); ++i) {
+        const lc::WideBvhNode& w = s.bvh.wide_nodes[i];
+        const lc::gpu::Bvh4Node& g = s.bvh.kernel_nodes[i];
+        for (int slot = 0; slot < 4; ++slot) {
+            EXPECT_EQ(g.count[slot], w.count[slot]);
+            const std::array<float, 6> kernel_box = {g.lo_x[slot], g.lo_y[slot], g.lo_z[slot],
+                                                     g.hi_x[slot], g.hi_y[slot], g.hi_z[slot]};
+            const std::array<float, 6> box = {w.lo_x[slot], w.lo_y[slot], w.lo_z[slot],
+                                              w.hi_x[slot], w.hi_y[slot], w.hi_z[slot]};
+            EXPECT_EQ(kernel_box, box);
+            if (w.count[slot] > 0) {
+                EXPECT_EQ(g.child[slot], s.bvh.wide_leaves[w.child[slot]].first);
+            } else if (w.count[slot] == 0) {
+                EXPECT_EQ(g.child[slot], w.child[slot]);
+            }
+        }
+    }
 }
 
 using lc::test::random_unit;
@@ -469,6 +492,7 @@ TEST(Bvh, EmptySceneMissesEverything) {
     ASSERT_EQ(bvh.nodes.size(), 1u);
     EXPECT_EQ(bvh.nodes[0].tri_count, 0u);
     lc::cpu::TraceKernel k{bvh.nodes.data(), nullptr};
+    lc::cpu::Trace4Kernel k4{bvh.nodes.data(), nullptr, bvh.kernel_nodes.data()};
     std::mt19937 rng(7u);
     std::uniform_real_distribution<float> pos(-1e3f, 1e3f);
     std::vector<std::pair<vec3, vec3>> rays = {{vec3(0.0f), vec3(1.0f)},   // towards the sentinel box
@@ -479,6 +503,7 @@ TEST(Bvh, EmptySceneMissesEverything) {
         float t, b1, b2;
         EXPECT_EQ(k.lc_trace_closest(org, dir, kRayInfinity, t, b1, b2), kInvalidIndex);
         EXPECT_FALSE(k.lc_trace_any(org, dir, kRayInfinity));
+        EXPECT_FALSE(k4.lc_trace_any(org, dir, kRayInfinity));
         EXPECT_FALSE(lc::cpu::trace_any_wide(k, bvh.wide_nodes.data(), bvh.wide_leaves.data(), org, dir, kRayInfinity));
 #if defined(LC_WIDE8_TRACE)
         if (lc::cpu::cpu_has_avx2()) {
@@ -489,6 +514,8 @@ TEST(Bvh, EmptySceneMissesEverything) {
     }
     ASSERT_EQ(bvh.wide_nodes.size(), 1u);
     for (int slot = 0; slot < 4; ++slot) EXPECT_EQ(bvh.wide_nodes[0].count[slot], -1);
+    ASSERT_EQ(bvh.kernel_nodes.size(), 1u);
+    for (int slot = 0; slot < 4; ++slot) EXPECT_EQ(bvh.kernel_nodes[0].count[slot], -1);
     ASSERT_EQ(bvh.wide8_nodes.size(), 1u);
     for (int slot = 0; slot < 8; ++slot) EXPECT_EQ(bvh.wide8_nodes[0].count[slot], -1);
 }

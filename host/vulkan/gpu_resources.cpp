@@ -38,6 +38,7 @@ constexpr SceneBinding kSceneBindings[] = {
     {gpu::kBindingLights, "lights", sizeof(gpu::Light)},
     {gpu::kBindingLightNodes, "light_tree_nodes", sizeof(gpu::LightNode)},
     {gpu::kBindingEnvironment, "environment", sizeof(float)},
+    {gpu::kBindingWideBvhNodes, "wide_bvh_nodes", sizeof(gpu::Bvh4Node) / 8},
     {gpu::kBindingFrame, "frame", sizeof(gpu::FrameParams)},  // appended by RenderSetup
 };
 constexpr bool scene_bindings_in_order() {
@@ -67,14 +68,16 @@ constexpr TexelArray kTexelArrays[] = {
     {gpu::kBindingTriangles, gpu::kBindingTriangleTexels},
     {gpu::kBindingLights, gpu::kBindingLightTexels},
     {gpu::kBindingLightNodes, gpu::kBindingLightNodeTexels},
+    {gpu::kBindingWideBvhNodes, gpu::kBindingWideBvhNodeTexels},
 };
 constexpr VkFormat kTexelFormat = VK_FORMAT_R32G32B32A32_UINT;
 constexpr VkDeviceSize kTexelBytes = 16;
 static_assert(std::size(kTexelArrays) == gpu::kTexelBindingCount &&
               gpu::kBindingBvhNodeTexels == gpu::kBindingCount &&
-              gpu::kBindingLightNodeTexels == gpu::kBindingCount + gpu::kTexelBindingCount - 1);
+              gpu::kBindingWideBvhNodeTexels == gpu::kBindingCount + gpu::kTexelBindingCount - 1);
 static_assert(sizeof(gpu::BvhNode) == 2 * kTexelBytes && sizeof(gpu::Triangle) == 3 * kTexelBytes &&
-              sizeof(gpu::Light) == 3 * kTexelBytes && sizeof(gpu::LightNode) == 4 * kTexelBytes,
+              sizeof(gpu::Light) == 3 * kTexelBytes && sizeof(gpu::LightNode) == 4 * kTexelBytes &&
+              sizeof(gpu::Bvh4Node) == 8 * kTexelBytes,
               "shaders/kernel.glsl unpacks these structs from whole texels");
 
 bool has_texel_view(std::uint32_t binding) {
@@ -272,14 +275,14 @@ void GpuResources::upload_scene(const std::vector<SceneArray>& scene) {
 // ChunkTable (shaders/bindings.glsl): for each scene array, the index of its
 // chunk 0 in the address list, then the device address of every chunk.
 void GpuResources::create_chunk_table() {
-    std::vector<std::uint32_t> words(gpu::kSceneArrayCount);
+    std::vector<std::uint32_t> words(gpu::kChunkTableFirstWords);
     const auto address_of = [&](const Buffer& buffer) {
         auto info = vk_struct<VkBufferDeviceAddressInfo>(VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO);
         info.buffer = buffer.get();
         return ctx_.fn().vkGetBufferDeviceAddress(ctx_.device().get(), &info);
     };
     for (std::uint32_t b = 0; b < gpu::kSceneArrayCount; ++b) {
-        words[b] = std::uint32_t((words.size() - gpu::kSceneArrayCount) / 2);
+        words[b] = std::uint32_t((words.size() - gpu::kChunkTableFirstWords) / 2);
         for (std::uint64_t c = 0; c < chunk_counts_[b]; ++c) {
             // Chunk c: buffer c, or the window c of the array's one buffer.
             const bool windows = scene_[b].size() == 1;

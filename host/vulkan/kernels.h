@@ -20,7 +20,10 @@ struct SceneChunks {
     bool split = false;  // some array has more than one chunk
     // log2 of the elements per chunk of the array at each binding; 31 for an
     // array in one buffer (no index reaches 2^31).
-    std::uint32_t shift[gpu::kSceneArrayCount] = {31, 31, 31, 31, 31, 31, 31, 31, 31, 31};
+    std::uint32_t shift[gpu::kSceneArrayCount];
+    SceneChunks() {
+        for (std::uint32_t& s : shift) s = 31;
+    }
 };
 
 struct KernelSwitches {
@@ -31,7 +34,7 @@ struct KernelSwitches {
     bool disney = true;              // compile the Disney BRDF in
     bool sheen = true;               // ... and its sheen lobe
     bool clearcoat = true;           // ... and its clearcoat lobe
-    bool texel_reads = false;        // read four scene arrays through their texel views
+    bool texel_reads = false;        // read five scene arrays through their texel views
     SceneChunks chunks;              // how the scene arrays are split (GpuResources)
     bool specialize_on_host = false; // hand the driver modules specialized on the host (spirv_specialize.h)
 };

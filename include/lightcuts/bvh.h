@@ -46,6 +46,7 @@ struct Bvh {
     std::vector<WideBvhNode> wide_nodes;  // root at 0 (all slots empty if no triangles)
     std::vector<WideLeaf> wide_leaves;    // one per leaf of wide_nodes
     std::vector<WideBvhNode8> wide8_nodes;  // root at 0 (all slots empty if no triangles); leaves in wide_leaves
+    std::vector<gpu::Bvh4Node> kernel_nodes;  // wide_nodes as the Vulkan kernels read them (bvh4_nodes)
     double build_seconds = 0.0;
 };
 
@@ -59,6 +60,12 @@ void collapse_bvh(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu:
 // collapse_bvh made of the same binary tree.
 void collapse_bvh8(const std::vector<gpu::BvhNode>& nodes, const std::vector<WideLeaf>& wide_leaves,
                    std::vector<WideBvhNode8>& wide_nodes);
+
+// The 4-wide tree as the Vulkan kernels' shadow rays read it: wide_nodes
+// with each leaf slot naming the leaf's first triangle (WideLeaf::first)
+// instead of its WideLeaf.
+std::vector<gpu::Bvh4Node> bvh4_nodes(const std::vector<WideBvhNode>& wide_nodes,
+                                      const std::vector<WideLeaf>& wide_leaves);
 
 // Builds the BVH and reorders `triangles`, `normals` and `uvs` when given
 // (same permutation) so that each leaf references a contiguous range. Depth

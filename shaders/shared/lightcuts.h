@@ -272,12 +272,27 @@ bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) he
 #else
     vec2 errors = vec2(lc_cluster_error(sp, m, left, f.min_distance2), lc_cluster_error(sp, m, right, f.min_distance2));
 #endif
+    // One child keeps the parent's representative; the other has a new one,
+    // whose contribution (one shadow ray) is found here, once, where that
+    // child enters the cut (lc_cluster_entry: a leaf, or a bound above
+    // zero). One call for whichever child it is, not one per child: lanes
+    // of a SIMD group refining different nodes then trace their rays
+    // together instead of in two rounds.
+    uint fresh_rep = right_shares ? left.rep_light : right.rep_light;
+    bool fresh_leaf = ((right_shares ? left.flags : right.flags) & kNodeLeaf) != 0u;
+    float fresh_error = right_shares ? errors.x : errors.y;
+    vec3 fresh_unit = vec3(0.0f);
+    bool fresh_visible = false;
+    if (fresh_leaf || fresh_error > 0.0f)
+        fresh_unit = lc_rep_unit(sp, fresh_rep, f.min_distance2, fresh_visible, stats);
     HeapEntry a, b;
     vec3 estimate_a, estimate_b;
-    bool has_a = lc_cluster_entry(sp, node.left, left, errors.x, !right_shares, unit, visible, f.min_distance2, a,
-                                  estimate_a, fixed_sum, stats);
-    bool has_b = lc_cluster_entry(sp, node.left + 1u, right, errors.y, right_shares, unit, visible, f.min_distance2,
-                                  b, estimate_b, fixed_sum, stats);
+    bool has_a = lc_cluster_entry(sp, node.left, left, errors.x, true, right_shares ? fresh_unit : unit,
+                                  right_shares ? fresh_visible : visible, f.min_distance2, a, estimate_a, fixed_sum,
+                                  stats);
+    bool has_b = lc_cluster_entry(sp, node.left + 1u, right, errors.y, true, right_shares ? unit : fresh_unit,
+                                  right_shares ? visible : fresh_visible, f.min_distance2, b, estimate_b, fixed_sum,
+                                  stats);
     // The parent leaves the heap and its children enter it: the larger
     // child takes the parent's slot and sinks from there, one pass where a
     // pop and a push take two; the smaller one is pushed (and may freeze

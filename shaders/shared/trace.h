@@ -4,6 +4,8 @@
 // The includer defines:
 //   LC_BVH_NODE(i)   -> BvhNode
 //   LC_TRIANGLE(i)   -> Triangle
+//   LC_BVH4_WORD(i, k) (optional) -> uvec4, word k of Bvh4Node i: shadow
+//                       rays then go through the 4-wide tree (lc_trace_any)
 // No include guard: each kernel context (a GLSL shader, a C++ kernel
 // struct in host/cpu_kernel.h) includes it exactly once.
 
@@ -161,8 +163,59 @@ uint lc_trace_closest(vec3 org, vec3 dir, float t_max, LC_OUT(float) t_hit, LC_O
     return hit;
 }
 
+#ifdef LC_BVH4_WORD
+// A Bvh4Node unpacked: the four children's boxes as vectors, slot by slot.
+struct Bvh4Boxes {
+    vec4 lo_x, lo_y, lo_z;
+    vec4 hi_x, hi_y, hi_z;
+    uvec4 child;
+    ivec4 count;
+};
+
+Bvh4Boxes lc_bvh4_node(uint i) {
+    Bvh4Boxes n;
+    n.lo_x = uintBitsToFloat(LC_BVH4_WORD(i, 0u));
+    n.lo_y = uintBitsToFloat(LC_BVH4_WORD(i, 1u));
+    n.lo_z = uintBitsToFloat(LC_BVH4_WORD(i, 2u));
+    n.hi_x = uintBitsToFloat(LC_BVH4_WORD(i, 3u));
+    n.hi_y = uintBitsToFloat(LC_BVH4_WORD(i, 4u));
+    n.hi_z = uintBitsToFloat(LC_BVH4_WORD(i, 5u));
+    n.child = LC_BVH4_WORD(i, 6u);
+    n.count = ivec4(LC_BVH4_WORD(i, 7u));
+    return n;
+}
+
+// A stack entry of lc_trace_any: an inner node's Bvh4Node index, or a
+// leaf: this flag, its triangle count - 1 in bits 29 and 30, and its first
+// triangle below (kBvh4MaxTriangles). No leaf entry is kInvalidIndex: a
+// leaf of four triangles starts at most at kBvh4MaxTriangles - 4.
+LC_KCONST uint kBvh4LeafEntry = 0x80000000u;
+// The stack holds the unvisited children of nodes on the current path, at
+// most one group per level. A visit pushes at most three (one child is
+// visited next, or becomes the pending leaf), or four where all four are
+// leaves and a leaf is still pending, which has no deeper level after it;
+// and no wide node is deeper than the binary tree's deepest.
+LC_KCONST uint kBvh4StackSize = 3u * kBvhStackSize + 1u;
+#endif
+
 // Any hit with t in (0, t_max): true if something blocks the segment.
-// Both children's boxes are tested at their parent, and only those the ray
+//
+// Through the 4-wide tree where the includer provides it (LC_BVH4_WORD,
+// the Vulkan kernels). Each trip round the loop tests one triangle of the
+// pending leaf and one node's four boxes (lc_hit_box's operations slot by
+// slot); of the children the ray enters, the first inner one is the next
+// node, the first leaf the next pending leaf if none is, and the rest go
+// on the stack. On SIMD hardware a trip costs the group of lanes its
+// node test and its triangle test whichever of them each lane needs:
+// llvmpipe runs both sides of every branch under a lane mask, and GPUs
+// run a divergent branch's sides one after the other. Testing a whole
+// leaf per trip (four triangle tests, or a loop) or visiting leaves in
+// trips of their own costs more on lavapipe; this loop takes 6.1 trips per
+// lightcuts ray on the shipped room, the binary tree 12.0
+// (docs/results/lavapipe.md, §10).
+//
+// Otherwise through the binary tree:
+// both children's boxes are tested at their parent, and only those the ray
 // enters are visited: the first of them next, the other from the stack
 // (which then holds at most one node per level). The GPU's loop thus runs
 // once per node the ray enters rather than once per node tested, and the
@@ -176,6 +229,58 @@ uint lc_trace_closest(vec3 org, vec3 dir, float t_max, LC_OUT(float) t_hit, LC_O
 bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
     vec3 inv_dir = lc_safe_inverse(dir);
     ShearedRay sheared = lc_shear_ray(dir);
+#ifdef LC_BVH4_WORD
+    uint stack[kBvh4StackSize];
+    uint sp = 0u;
+    uint node = 0u;            // the node to test this trip, or kInvalidIndex
+    uint leaf = kInvalidIndex; // the leaf to test this trip (a stack entry), or kInvalidIndex
+    while (true) {
+        if (leaf != kInvalidIndex) {
+            float u, v;
+            if (lc_intersect_sheared(org, sheared, LC_TRIANGLE(leaf & (kBvh4MaxTriangles - 1u)), t_max, u, v) > 0.0f)
+                return true;
+            // The leaf's next triangle: one fewer left, the first one on.
+            leaf = (leaf & (3u << 29u)) != 0u ? leaf - (1u << 29u) + 1u : kInvalidIndex;
+        }
+        if (node != kInvalidIndex) {
+            Bvh4Boxes n = lc_bvh4_node(node);
+            vec4 t0x = (n.lo_x - org.x) * inv_dir.x;
+            vec4 t1x = (n.hi_x - org.x) * inv_dir.x;
+            vec4 t0y = (n.lo_y - org.y) * inv_dir.y;
+            vec4 t1y = (n.hi_y - org.y) * inv_dir.y;
+            vec4 t0z = (n.lo_z - org.z) * inv_dir.z;
+            vec4 t1z = (n.hi_z - org.z) * inv_dir.z;
+            vec4 t_near = max(max(min(t0x, t1x), min(t0y, t1y)), max(min(t0z, t1z), vec4(0.0f)));
+            vec4 t_far = min(min(max(t0x, t1x), max(t0y, t1y)), min(max(t0z, t1z), vec4(t_max))) * 1.0000004f;
+            node = kInvalidIndex;
+            for (uint s = 0u; s < 4u; ++s) {
+                if (n.count[s] < 0 || !(t_near[s] <= t_far[s])) continue;
+                if (n.count[s] == 0 && node == kInvalidIndex) {
+                    node = n.child[s];
+                } else if (n.count[s] > 0 && leaf == kInvalidIndex) {
+                    leaf = kBvh4LeafEntry | (uint(n.count[s] - 1) << 29u) | n.child[s];
+                } else {
+                    stack[sp++] = n.count[s] == 0 ? n.child[s]
+                                                  : (kBvh4LeafEntry | (uint(n.count[s] - 1) << 29u) | n.child[s]);
+                }
+            }
+        }
+        // Refill from the stack: a node where none is left to test, a leaf
+        // where none is pending (a leaf on top waits while one is).
+        if (node == kInvalidIndex && sp > 0u) {
+            uint top = stack[sp - 1u];
+            if ((top & kBvh4LeafEntry) == 0u) {
+                node = top;
+                --sp;
+            } else if (leaf == kInvalidIndex) {
+                leaf = top;
+                --sp;
+            }
+        }
+        if (node == kInvalidIndex && leaf == kInvalidIndex) break;
+    }
+    return false;
+#else
     uint stack[kBvhStackSize];
     uint sp = 0u;
     uint node_index = 0u;
@@ -209,6 +314,7 @@ bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
         node_index = stack[--sp];
     }
     return false;
+#endif
 }
 
 // Moves a hit point off its triangle along the geometric normal ng (turned

@@ -72,6 +72,25 @@ struct BvhNode {
     uint tri_count;
 };
 
+// The same tree four wide, as the kernels' shadow rays read it (128 bytes,
+// eight 16-byte words): the boxes of up to four children side by side, then
+// each child's index and kind. Made from the binary tree by pulling
+// grandchildren up (collapse_bvh), so its leaves are the binary leaves. The
+// kernels read it as uvec4 words (shaders/kernel.glsl, lc_bvh4_node).
+struct Bvh4Node {
+    float lo_x[4];
+    float lo_y[4];
+    float lo_z[4];
+    float hi_x[4];
+    float hi_y[4];
+    float hi_z[4];
+    uint child[4];  // an inner child's Bvh4Node index, or a leaf's first triangle
+    int count[4];   // a leaf's triangles (1 .. kBvhMaxLeafTriangles); 0: an inner child; -1: none
+};
+// A leaf's first triangle shares a stack word with its count and a flag in
+// the kernels' traversal (lc_trace_any), so triangles are fewer than 2^29.
+LC_CONST uint kBvh4MaxTriangles = 0x20000000u;
+
 // Triangle positions for ray intersection, in BVH leaf order (48 bytes).
 struct Triangle {
     float v0_x, v0_y, v0_z;

@@ -289,11 +289,12 @@ TEST_F(Vulkan, TexelReadsGiveTheImagesOfStorageBufferReads) {
 
 // Cuts refined at error 0 over 20000 lights: each refinement loops over
 // heap levels, the search for the smallest entry of a full heap (64 slots)
-// and a shadow ray's BVH nodes, through a grid of boxes; together past the
-// limit (with 4000 lights and no grid, the full heap ends the cuts at about
-// 400 refinements, under it). On llvmpipe the renderer splits Lightcuts
-// from the start (Tuning::presplit_on_llvmpipe); without that, the failed
-// pass must split it.
+// and a shadow ray's BVH nodes and triangles, here about 130 trips a ray
+// (the needles below); together past the limit (with 4000 lights and no
+// needles, the full heap ends the cuts at about 400 refinements, under it).
+// On llvmpipe the renderer splits Lightcuts from the start
+// (Tuning::presplit_on_llvmpipe); without that, the failed pass must split
+// it.
 TEST_F(Vulkan, LoopLimitSplitsLightcutsAutomatically) {
     Scene s;
     s.materials = {test::lambert({0.6f, 0.5f, 0.4f})};
@@ -301,13 +302,15 @@ TEST_F(Vulkan, LoopLimitSplitsLightcutsAutomatically) {
     test::add_box(s, {-1.0f, 0.0f, -1.0f}, {-0.3f, 0.6f, -0.3f}, 0);
     test::add_box(s, {0.4f, 0.0f, 0.2f}, {0.9f, 0.4f, 0.8f}, 0);
     test::add_box(s, {-0.5f, 0.8f, 0.5f}, {0.0f, 1.0f, 1.0f}, 0);
-    // A grid of small boxes over the floor, which every shadow ray crosses:
-    // longer BVH walks.
-    for (int i = 0; i < 12; ++i)
-        for (int j = 0; j < 12; ++j) {
-            const glm::vec3 lo(-1.8f + 0.3f * float(i), 0.3f, -1.8f + 0.3f * float(j));
-            test::add_box(s, lo, lo + glm::vec3(0.12f, 0.12f, 0.12f), 0);
-        }
+    // 300 needles: long thin triangles across the room, which the shadow
+    // rays pass without touching but whose boxes they all enter: the BVH
+    // cannot separate boxes that each span the room, so every ray tests
+    // many of them.
+    for (int k = 0; k < 300; ++k) {
+        const float f = float(k) / 300.0f;
+        const glm::vec3 a(-1.9f, 0.05f + 0.4f * f, -1.9f + 3.8f * f), b(1.9f, 0.45f - 0.4f * f, 1.9f - 3.8f * f);
+        test::add_triangle(s, a, b, b + glm::vec3(0.0f, 0.001f, 0.0f), 0);
+    }
     s.lights = test::random_point_lights(20000, {-2, 0.5f, -2}, {2, 2, 2}, 10.0f, 65);
     s.camera = test::camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 50.0f, 4, 4);
     update_bounds(s);
