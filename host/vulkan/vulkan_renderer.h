@@ -42,9 +42,14 @@ struct Tuning {
     // one of its threads: long dispatches of many workgroups keep them all
     // busy (docs/results/lavapipe.md).
     static constexpr double kCpuTargetMs = 1000.0;
-    // The refinement budget that llvmpipe's retries settle on for the
-    // shipped scenes (shading_method.cpp starts its retries with it).
-    static constexpr std::uint32_t kLlvmpipeRefinements = 128;
+    // The refinement budget Lightcuts starts with on llvmpipe. Each
+    // refinement's loop trips (the heap's levels, the search of a full heap,
+    // a shadow ray's walk) count against the 65535-trip limit; 512 stay
+    // under it on the shipped scenes, where all but 0.3% of the room's cuts
+    // then finish in one dispatch, their heaps never leaving shared memory
+    // (docs/results/lavapipe.md, §10). A scene that needs less gets it by
+    // a retry (shading_method.cpp: a quarter of the budget each time).
+    static constexpr std::uint32_t kLlvmpipeRefinements = 512;
 
     // Split every scene array into chunks of at most this many bytes, as is
     // otherwise done only for arrays larger than one buffer may be (0: no

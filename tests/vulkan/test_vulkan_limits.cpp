@@ -324,12 +324,21 @@ TEST_F(Vulkan, LoopLimitSplitsLightcutsAutomatically) {
     expect_lightcuts_matches(p, o, g);
     expect_resplit_on_llvmpipe(g.stats);
 
-    // Split from the start: no pass is spoilt, and the image is the same.
+    // Split from the start, as the renderer does on llvmpipe (512
+    // refinements a dispatch): the same image. This scene's rays take so
+    // many trips that the split must still be made finer once.
     const RenderResult presplit = gpu(p, o);
     expect_lightcuts_matches(p, o, presplit);
     std::printf("[ measured ] %s, split from the start: %u loop-limit retries\n",
                 presplit.stats.device.c_str(), presplit.stats.loop_limit_retries);
-    EXPECT_EQ(presplit.stats.loop_limit_retries, 0u);
+    EXPECT_LE(presplit.stats.loop_limit_retries, 1u);
+
+    // Split finely enough from the start: no pass is spoilt.
+    vk::Tuning fine;
+    fine.refinements_per_dispatch = 128;
+    const RenderResult fine_split = gpu(p, o, fine);
+    expect_lightcuts_matches(p, o, fine_split);
+    EXPECT_EQ(fine_split.stats.loop_limit_retries, 0u);
 }
 
 }  // namespace
