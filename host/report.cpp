@@ -60,6 +60,7 @@ LightcutsReport lightcuts_report(const RenderOptions& o, const PreparedScene& p,
     l.cut_heap = o.cut_heap;
     l.heap_slots = s.heap_slots;
     l.heap_bytes = s.heap_shared_bytes;
+    l.heap_private = s.heap_private;
     l.workgroup_size = s.workgroup_size;
     l.heap_frozen_samples = s.heap_frozen_samples;
     l.heap_paused_samples = s.heap_paused_samples;
@@ -80,12 +81,16 @@ std::string lightcuts_text(const RenderReport& r, const LightcutsReport& l) {
                    "heap\n",
                    l.heap_slots, l.cut_heap, static_cast<unsigned long long>(l.heap_frozen_samples),
                    100.0 * double(l.heap_frozen_samples) / samples);
-    if (r.device != "cpu")
-        text += format("  cut heap in shared memory: %s per workgroup of %u; %llu samples (%.2f%%) paused it in "
-                       "global memory between dispatches\n",
-                       human_bytes(l.heap_bytes).c_str(), l.workgroup_size,
+    if (r.device != "cpu") {
+        const std::string where =
+            l.heap_private ? format("cut heap in private memory: %s per invocation",
+                                    human_bytes(std::uint64_t(l.heap_slots) * sizeof(gpu::CutEntry)).c_str())
+                           : format("cut heap in shared memory: %s per workgroup of %u",
+                                    human_bytes(l.heap_bytes).c_str(), l.workgroup_size);
+        text += format("  %s; %llu samples (%.2f%%) paused it in global memory between dispatches\n", where.c_str(),
                        static_cast<unsigned long long>(l.heap_paused_samples),
                        100.0 * double(l.heap_paused_samples) / samples);
+    }
     return text;
 }
 
@@ -103,6 +108,7 @@ json lightcuts_json(const LightcutsReport& l) {
             {"cut_heap", l.cut_heap},
             {"heap_slots", l.heap_slots},
             {"heap_bytes_per_workgroup", l.heap_bytes},
+            {"heap_memory", l.heap_private ? "private" : "shared"},
             {"heap_frozen_samples", l.heap_frozen_samples},
             {"heap_paused_samples", l.heap_paused_samples}};
 }

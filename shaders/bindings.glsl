@@ -63,6 +63,7 @@ LC_CONST uint kSpecWorkgroupSize = 0u;    // local_size_x
 LC_CONST uint kSpecEnableGgx = 1u;        // any material has a GGX lobe
 LC_CONST uint kSpecEnableShadows = 2u;    // any triangle can block a light
 LC_CONST uint kSpecHeapSlots = 3u;        // K: cut-heap slots per invocation, in shared memory
+LC_CONST uint kSpecHeapPrivate = 4u;      // the K slots in each invocation's private memory instead
 LC_CONST uint kSpecTexelReads = 5u;       // read the four texel-buffer arrays through their views
 LC_CONST uint kSpecEnableOriented = 6u;   // any spot or oriented light (emission cones)
 LC_CONST uint kSpecStochastic = 7u;       // lightcuts.comp: Stochastic Lightcuts' fresh representatives

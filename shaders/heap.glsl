@@ -4,6 +4,13 @@
 // LightTree::cut_heap_capacity(max_cut); a cut that would outgrow it freezes
 // its smallest clusters (lc_heap_push), on the CPU reference alike.
 //
+// On CPU devices the K entries are an array of the invocation's own
+// instead (kHeapPrivate): llvmpipe turns every shared-memory access whose
+// address differs between lanes into a loop over the lanes, and an
+// invocation's own array indexed by the same slot in every lane into one
+// vector access; lavapipe's shading took 0.78-0.82 s instead of 0.93-1.42 s
+// on the room (docs/results/lavapipe.md, §10). GPUs keep shared memory.
+//
 // Only where a cut is spread over several dispatches (the driver limits how
 // long an invocation may loop: lavapipe) is its heap saved to the heap-save
 // buffer at the end of a dispatch and restored at the start of the next.
@@ -11,27 +18,40 @@
 #define LC_HEAP_GLSL
 
 layout(constant_id = kSpecHeapSlots) const uint kHeapSlots = 1u;
+layout(constant_id = kSpecHeapPrivate) const bool kHeapPrivate = false;
 
 layout(std430, binding = kBindingHeapSave) buffer HeapSave { CutEntry heap_save[]; };
 
-// Slot-major, so neighbouring invocations touch neighbouring entries.
-shared CutEntry s_heap[kHeapSlots * gl_WorkGroupSize.x];
+// Slot-major, so neighbouring invocations touch neighbouring entries. The
+// array that is not used has one entry.
+shared CutEntry s_heap[kHeapPrivate ? 1u : kHeapSlots * gl_WorkGroupSize.x];
+CutEntry p_heap[kHeapPrivate ? kHeapSlots : 1u];
 
 uint lc_shared_slot(uint slot) { return slot * gl_WorkGroupSize.x + gl_LocalInvocationIndex; }
 uint lc_saved_slot(uint slot) { return slot * push.heap_save_stride + gl_GlobalInvocationID.x; }
 
-// Shared slots to global memory and back, around a pause between dispatches.
+CutEntry lc_heap_load(uint slot) { return kHeapPrivate ? p_heap[slot] : s_heap[lc_shared_slot(slot)]; }
+
+void lc_heap_store(uint slot, CutEntry e) {
+    if (kHeapPrivate) {
+        p_heap[slot] = e;
+    } else {
+        s_heap[lc_shared_slot(slot)] = e;
+    }
+}
+
+// The slots to global memory and back, around a pause between dispatches.
 void lc_heap_save(uint heap_size) {
-    for (uint slot = 0u; slot < heap_size; ++slot) heap_save[lc_saved_slot(slot)] = s_heap[lc_shared_slot(slot)];
+    for (uint slot = 0u; slot < heap_size; ++slot) heap_save[lc_saved_slot(slot)] = lc_heap_load(slot);
 }
 
 void lc_heap_restore(uint heap_size) {
-    for (uint slot = 0u; slot < heap_size; ++slot) s_heap[lc_shared_slot(slot)] = heap_save[lc_saved_slot(slot)];
+    for (uint slot = 0u; slot < heap_size; ++slot) lc_heap_store(slot, heap_save[lc_saved_slot(slot)]);
 }
 
 #define HeapEntry CutEntry
-#define LC_HEAP_LOAD(i) s_heap[lc_shared_slot(i)]
-#define LC_HEAP_STORE(i, e) s_heap[lc_shared_slot(i)] = (e)
+#define LC_HEAP_LOAD(i) lc_heap_load(i)
+#define LC_HEAP_STORE(i, e) lc_heap_store(i, e)
 #define LC_HEAP_CAPACITY kHeapSlots
 
 #endif

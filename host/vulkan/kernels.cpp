@@ -31,6 +31,7 @@ struct SpecData {
     VkBool32 enable_clearcoat;
     VkBool32 split_scene;
     VkBool32 texel_reads;
+    VkBool32 heap_private;
     std::uint32_t chunk_shift[gpu::kSceneArrayCount];
 };
 
@@ -56,6 +57,7 @@ std::vector<SpecEntry> spec_entries() {
         {gpu::kSpecEnableClearcoat, offsetof(SpecData, enable_clearcoat), true},
         {gpu::kSpecSplitScene, offsetof(SpecData, split_scene), true},
         {gpu::kSpecTexelReads, offsetof(SpecData, texel_reads), true},
+        {gpu::kSpecHeapPrivate, offsetof(SpecData, heap_private), true},
     };
     for (std::uint32_t b = 0; b < gpu::kSceneArrayCount; ++b)
         entries.push_back(
@@ -127,6 +129,7 @@ Kernels::Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMetho
     spec.enable_clearcoat = switches.clearcoat;
     spec.split_scene = switches.chunks.split;
     spec.texel_reads = switches.texel_reads;
+    spec.heap_private = switches.heap_private;
     for (std::uint32_t b = 0; b < gpu::kSceneArrayCount; ++b) spec.chunk_shift[b] = switches.chunks.shift[b];
     // Both pipelines at once: a driver that compiles on the host (lavapipe,
     // when it specialized the kernels itself: about 0.17 s for the

@@ -37,6 +37,7 @@ struct KernelSwitches {
     bool texel_reads = false;        // read five scene arrays through their texel views
     SceneChunks chunks;              // how the scene arrays are split (GpuResources)
     bool specialize_on_host = false; // hand the driver modules specialized on the host (spirv_specialize.h)
+    bool heap_private = false;       // the cut heaps in private memory instead of shared memory (heap.glsl)
 };
 
 class Kernels {

@@ -65,7 +65,9 @@ RenderResult render(const Context& ctx, const PreparedScene& prepared,
     stats.spp_done = frame.spp;
     stats.camera_rays = std::uint64_t(frame.width) * frame.height * frame.spp;
     stats.heap_slots = setup.method->heap_slots();
-    stats.heap_shared_bytes = std::uint64_t(stats.heap_slots) * gpu::kWorkgroupSize * sizeof(gpu::CutEntry);
+    stats.heap_private = tuning.heap_memory == Tuning::HeapMemory::kPrivate;
+    stats.heap_shared_bytes =
+        stats.heap_private ? 0 : std::uint64_t(stats.heap_slots) * gpu::kWorkgroupSize * sizeof(gpu::CutEntry);
     stats.workgroup_size = gpu::kWorkgroupSize;
     stats.buffer_bytes = setup.resources.buffer_bytes();
     return result;
@@ -81,6 +83,8 @@ Tuning device_tuning(const Context& ctx, Tuning tuning) {
         tuning.texel_reads = cpu ? Tuning::TexelReads::kOn : Tuning::TexelReads::kOff;
     if (tuning.specialize_on_host == Tuning::HostSpecialization::kAuto)
         tuning.specialize_on_host = cpu ? Tuning::HostSpecialization::kOn : Tuning::HostSpecialization::kOff;
+    if (tuning.heap_memory == Tuning::HeapMemory::kAuto)
+        tuning.heap_memory = cpu ? Tuning::HeapMemory::kPrivate : Tuning::HeapMemory::kShared;
     if (tuning.presplit_on_llvmpipe && tuning.refinements_per_dispatch == 0 && driver_limits_loops(ctx))
         tuning.refinements_per_dispatch = Tuning::kLlvmpipeRefinements;
     return tuning;
@@ -128,7 +132,8 @@ RenderSetup::RenderSetup(const Context& context, const PreparedScene& prepared,
                tuning.force_oriented || prepared.has_oriented, tuning.force_textures || prepared.has_textures,
                tuning.force_disney || prepared.has_disney, tuning.force_sheen || prepared.has_sheen,
                tuning.force_clearcoat || prepared.has_clearcoat, resources.texel_reads(),
-               resources.chunks(), tuning.specialize_on_host == Tuning::HostSpecialization::kOn}),
+               resources.chunks(), tuning.specialize_on_host == Tuning::HostSpecialization::kOn,
+               tuning.heap_memory == Tuning::HeapMemory::kPrivate}),
       pass(context, resources, kernels, *method, timestamps) {}
 
 RenderSetup::~RenderSetup() { ctx.fn().vkDeviceWaitIdle(ctx.device().get()); }
@@ -165,6 +170,11 @@ Tuning Tuning::from_environment() {
         const std::string mode = v;
         if (mode == "on") tuning.specialize_on_host = Tuning::HostSpecialization::kOn;
         if (mode == "off") tuning.specialize_on_host = Tuning::HostSpecialization::kOff;
+    }
+    if (const char* v = std::getenv("LC_VK_HEAP_MEMORY")) {
+        const std::string mode = v;
+        if (mode == "shared") tuning.heap_memory = Tuning::HeapMemory::kShared;
+        if (mode == "private") tuning.heap_memory = Tuning::HeapMemory::kPrivate;
     }
     if (const char* v = std::getenv("LC_VK_TARGET_MS")) {
         const double ms = std::strtod(v, nullptr);

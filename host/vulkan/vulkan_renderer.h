@@ -82,10 +82,17 @@ struct Tuning {
     enum class HostSpecialization { kAuto, kOn, kOff };
     HostSpecialization specialize_on_host = HostSpecialization::kAuto;
 
+    // Where the kernels keep each invocation's cut heap (shaders/heap.glsl).
+    // kAuto: in private memory on CPU devices, where lavapipe's shading ran
+    // 20 to 40% faster than with shared memory (docs/results/lavapipe.md);
+    // in workgroup shared memory on GPUs, the heap's place there.
+    enum class HeapMemory { kAuto, kShared, kPrivate };
+    HeapMemory heap_memory = HeapMemory::kAuto;
+
     // LC_VK_FORCE_FEATURES=ggx,shadows,oriented,textures,disney,sheen,clearcoat (or all), LC_VK_MAX_TILE_PIXELS=N, LC_VK_TARGET_MS=X,
     // LC_VK_LIGHTS_PER_DISPATCH=N, LC_VK_REFINEMENTS_PER_DISPATCH=N, LC_VK_SPLIT_BYTES=N,
     // LC_VK_CHUNK_BUFFERS=1, LC_VK_HOST_IMPORT=0, LC_VK_TEXEL_READS=on|off,
-    // LC_VK_SPECIALIZE_ON_HOST=on|off.
+    // LC_VK_SPECIALIZE_ON_HOST=on|off, LC_VK_HEAP_MEMORY=shared|private.
     static Tuning from_environment();
 };
 

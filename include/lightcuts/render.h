@@ -95,6 +95,8 @@ struct RenderStats {
     std::uint64_t heap_paused_samples = 0;  // GPU: samples whose heap waited in global memory
                                             // between dispatches (the driver's loop limit)
     std::uint64_t heap_shared_bytes = 0;    // GPU: shared memory of one workgroup's heaps
+    bool heap_private = false;              // GPU: the heaps in each invocation's private memory
+                                            // instead (CPU devices, heap.glsl)
     std::uint32_t workgroup_size = 0;       // GPU: invocations per workgroup
     std::uint32_t loop_limit_retries = 0;   // GPU: tiles rendered again with the work split over
                                             // more dispatches (the driver cut loops short)

@@ -30,6 +30,7 @@ struct LightcutsReport {
     std::uint32_t heap_slots = 0;             // slots a heap gets: K, or less where the tree
                                               // cannot fill K (GPU: in shared memory)
     std::uint64_t heap_bytes = 0;             // GPU: shared memory the heaps of a workgroup take
+    bool heap_private = false;                // GPU: each heap in its invocation's private memory instead
     std::uint32_t workgroup_size = 0;         // GPU: invocations per workgroup
     std::uint64_t heap_frozen_samples = 0;    // samples whose cut froze clusters out of a full heap
     std::uint64_t heap_paused_samples = 0;    // GPU: samples whose heap waited in global memory

@@ -287,6 +287,40 @@ TEST_F(Vulkan, TexelReadsGiveTheImagesOfStorageBufferReads) {
     }
 }
 
+// The cut heaps in each invocation's private memory (Tuning::heap_memory;
+// the default on CPU devices) and in workgroup shared memory (GPUs') hold
+// the same entries: the images and counts are identical for Lightcuts and
+// Stochastic Lightcuts, with each cut in one dispatch and spread over many
+// (its heap paused in global memory between them). A heap of 8 slots
+// fills, so clusters are frozen too.
+TEST_F(Vulkan, PrivateHeapsGiveTheImagesOfSharedHeaps) {
+    const PreparedScene p = prepare_scene(random_scene(71, 300, 2, 12, 10), 1);
+    for (const char* method : {"lightcuts", "stochastic"}) {
+        for (const std::uint32_t budget : {0u, 4u}) {
+            SCOPED_TRACE(std::string(method) + ", refinements per dispatch " + std::to_string(budget));
+            RenderOptions o = options(method, 12, 10);
+            o.cut_heap = 8;
+            vk::Tuning shared, own;
+            shared.heap_memory = vk::Tuning::HeapMemory::kShared;
+            own.heap_memory = vk::Tuning::HeapMemory::kPrivate;
+            shared.refinements_per_dispatch = own.refinements_per_dispatch = budget;
+            const RenderResult a = gpu(p, o, shared);
+            const RenderResult b = gpu(p, o, own);
+            EXPECT_FALSE(a.stats.heap_private);
+            EXPECT_TRUE(b.stats.heap_private);
+            EXPECT_EQ(max_relative_difference(b.image, a.image, std::string("private heaps ") + method, 0.0), 0.0);
+            EXPECT_EQ(a.stats.shadow_rays, b.stats.shadow_rays);
+            EXPECT_EQ(a.stats.heap_frozen_samples, b.stats.heap_frozen_samples);
+            EXPECT_GT(b.stats.heap_frozen_samples, 0u);
+            EXPECT_EQ(a.stats.heap_paused_samples, b.stats.heap_paused_samples);
+            if (budget > 0) {
+                EXPECT_GT(b.stats.heap_paused_samples, 0u);
+            }
+            if (std::string(method) == "lightcuts") expect_lightcuts_matches(p, o, b);
+        }
+    }
+}
+
 // Cuts refined at error 0 over 20000 lights: each refinement loops over
 // heap levels, the search for the smallest entry of a full heap (64 slots)
 // and a shadow ray's BVH nodes and triangles, here about 130 trips a ray
