@@ -94,6 +94,26 @@ struct PixelStats {
     uint cut_indirect_lo, cut_indirect_hi;  // ... of which virtual point lights
 };
 
+// Where tile pixel i (of a tile `width` x `height`) lies in its tile. The
+// rows are taken in pairs and a pair's pixels column by column, so eight
+// consecutive invocations (one SIMD group on lavapipe) shade a 4x2 block
+// of neighbours instead of eight pixels of one row; an odd last row is
+// taken in order.
+#ifdef __cplusplus
+inline
+#endif
+uint lc_tile_column(uint i, uint width, uint height) {
+    uint pair = i / (2u * width);
+    return 2u * pair + 1u < height ? (i % (2u * width)) / 2u : i % (2u * width);
+}
+#ifdef __cplusplus
+inline
+#endif
+uint lc_tile_row(uint i, uint width, uint height) {
+    uint pair = i / (2u * width);
+    return 2u * pair + (2u * pair + 1u < height ? (i & 1u) : 0u);
+}
+
 #ifdef __cplusplus
 inline std::uint64_t count64(uint lo, uint hi) { return std::uint64_t(hi) << 32 | lo; }
 #else

@@ -145,8 +145,8 @@ uint lc_tile_pixel() {
 }
 
 // Image coordinates of tile pixel i.
-uint lc_tile_x(uint i) { return push.tile_x + i % push.tile_width; }
-uint lc_tile_y(uint i) { return push.tile_y + i / push.tile_width; }
+uint lc_tile_x(uint i) { return push.tile_x + lc_tile_column(i, push.tile_width, push.tile_height); }
+uint lc_tile_y(uint i) { return push.tile_y + lc_tile_row(i, push.tile_width, push.tile_height); }
 
 SurfacePoint lc_texel_surface(GBufferTexel g) {
     return lc_make_surface(vec3(g.px, g.py, g.pz), vec3(g.nx, g.ny, g.nz), vec3(g.wo_x, g.wo_y, g.wo_z), g.material,

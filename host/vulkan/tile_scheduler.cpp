@@ -100,8 +100,9 @@ std::uint32_t TileScheduler::loop_limited_pixels(const Tile& tile) const {
         }
         if (flags & gpu::kPixelCutUnfinished)
             throw std::logic_error(
-                "Lightcuts kernel: cut unfinished after the last dispatch at pixel (" + std::to_string(tile.x0 + i % tile.width) + ", " +
-                std::to_string(tile.y0 + i / tile.width) + ")");
+                "Lightcuts kernel: cut unfinished after the last dispatch at pixel (" +
+                std::to_string(tile.x0 + gpu::lc_tile_column(i, tile.width, tile.height)) + ", " +
+                std::to_string(tile.y0 + gpu::lc_tile_row(i, tile.width, tile.height)) + ")");
     }
     return cut_short;
 }
@@ -127,7 +128,8 @@ void TileScheduler::read_back(const Tile& tile, RenderResult& result) const {
     const double spp = double(frame_.spp);
     RenderStats& out = result.stats;
     for (std::uint32_t i = 0; i < tile.pixels(); ++i) {
-        const std::uint32_t x = tile.x0 + i % tile.width, y = tile.y0 + i / tile.width;
+        const std::uint32_t x = tile.x0 + gpu::lc_tile_column(i, tile.width, tile.height);
+        const std::uint32_t y = tile.y0 + gpu::lc_tile_row(i, tile.width, tile.height);
         const glm::vec3 sum(sums[3 * i], sums[3 * i + 1], sums[3 * i + 2]);
         result.image.set(x, y, sum / float(frame_.spp));
         const gpu::PixelStats& ps = pixel_stats[i];

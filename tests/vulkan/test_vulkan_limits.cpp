@@ -287,6 +287,33 @@ TEST_F(Vulkan, TexelReadsGiveTheImagesOfStorageBufferReads) {
     }
 }
 
+// The kernels' order of a tile's pixels (lc_tile_column, lc_tile_row):
+// every pixel of the tile exactly once, whatever its size, and eight
+// consecutive invocations a 4x2 block wherever two whole rows remain.
+TEST(TilePixels, EveryPixelOnceInBlocksOfFourByTwo) {
+    for (const std::uint32_t width : {1u, 3u, 8u, 128u, 130u})
+        for (const std::uint32_t height : {1u, 2u, 5u, 64u}) {
+            SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height));
+            std::vector<int> seen(std::size_t(width) * height, 0);
+            for (std::uint32_t i = 0; i < width * height; ++i) {
+                const std::uint32_t x = gpu::lc_tile_column(i, width, height), y = gpu::lc_tile_row(i, width, height);
+                ASSERT_LT(x, width);
+                ASSERT_LT(y, height);
+                ++seen[std::size_t(y) * width + x];
+            }
+            EXPECT_TRUE(std::all_of(seen.begin(), seen.end(), [](int c) { return c == 1; }));
+            if (width % 4 != 0) continue;
+            for (std::uint32_t group = 0; 8 * group + 7 < width * (height - height % 2); ++group) {
+                const std::uint32_t i = 8 * group;
+                const std::uint32_t x0 = gpu::lc_tile_column(i, width, height), y0 = gpu::lc_tile_row(i, width, height);
+                for (std::uint32_t lane = 0; lane < 8; ++lane) {
+                    EXPECT_EQ(gpu::lc_tile_column(i + lane, width, height), x0 + lane / 2);
+                    EXPECT_EQ(gpu::lc_tile_row(i + lane, width, height), y0 + lane % 2);
+                }
+            }
+        }
+}
+
 // The cut heaps in each invocation's private memory (Tuning::heap_memory;
 // the default on CPU devices) and in workgroup shared memory (GPUs') hold
 // the same entries: the images and counts are identical for Lightcuts and
