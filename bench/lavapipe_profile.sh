@@ -11,7 +11,7 @@
 # size from a table at 16 bytes per binding, which names the binding. The
 # table's start (0x7f08 below: binding 0) is what llvmpipe 22.3.6 / LLVM 15
 # generated here; check it against the bindings (the heap spill buffer,
-# binding 14, is the one that is both loaded and stored in the hot code)
+# binding 15, is the one that is both loaded and stored in the hot code)
 # before trusting the names on another Mesa. Loops without a bounds check
 # are shared memory or an invocation's own arrays with a dynamic index.
 #
@@ -54,8 +54,8 @@ python3 - "$tmp/code.asm" "$tmp/ips.txt" <<'EOF'
 import bisect, collections, re, sys
 
 names = ["BVH nodes", "triangles", "normals", "uvs", "materials", "textures", "texels",
-         "lights", "light-tree nodes", "environment", "frame", "g-buffer", "radiance",
-         "pixel stats", "heap spill", "cut state"]
+         "lights", "light-tree nodes", "environment", "4-wide BVH nodes", "frame", "g-buffer",
+         "radiance", "pixel stats", "heap spill", "cut state"]
 first_binding = 0x7f08  # llvmpipe 22.3.6: where binding 0's size sits (see the header)
 
 code = []
