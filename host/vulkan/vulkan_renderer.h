@@ -66,11 +66,11 @@ struct Tuning {
     // whole pages) in host memory, without copying them.
     bool host_import = true;
 
-    // Read the BVH nodes, triangles, lights and light-tree nodes through
-    // uniform texel buffers instead of storage buffers. kAuto: on CPU
+    // Read the BVH nodes, triangles, lights, light-tree nodes and the 4-wide
+    // BVH through uniform texel buffers instead of storage buffers. kAuto: on CPU
     // devices (lavapipe), where it measured faster (docs/results/lavapipe.md);
     // GPUs keep storage buffers until it is measured there. Either way only
-    // where each of the four arrays is in one buffer (split or not) and
+    // where each of the five arrays is in one buffer (split or not) and
     // fits maxTexelBufferElements.
     enum class TexelReads { kAuto, kOn, kOff };
     TexelReads texel_reads = TexelReads::kAuto;

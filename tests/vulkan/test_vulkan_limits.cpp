@@ -258,8 +258,8 @@ TEST_F(Vulkan, LargeArraysAreReadInPlaceOnCpuDevices) {
     }
 }
 
-// The BVH nodes, triangles, lights and light-tree nodes can be read through
-// uniform texel buffers instead of storage buffers (Tuning::texel_reads;
+// The BVH nodes, triangles, lights, light-tree nodes and the 4-wide BVH can
+// be read through uniform texel buffers instead of storage buffers (Tuning::texel_reads;
 // the default on CPU devices). The same kernels read the same bits: the
 // images are identical for every method. A split scene keeps the texel
 // reads while each array's chunks are windows of one buffer, and falls
