@@ -442,6 +442,29 @@ TEST(SceneLoader, FarPointLightDoesNotChangeTheBounds) {
     expect_near(far.bounds_max, {2.5f, 3.0f, 3.0f});
 }
 
+// Tiny triangles keep unit normals: the cross product of edges of 1e-10
+// is about 1e-20, whose square underflows a float, so a length taken in
+// float came out short (a glTF the fuzzer made, regressions_gltf/
+// tiny-triangle-normal.gltf). The face normals and the file's vertex
+// normals of that size are normalised in double.
+TEST(SceneLoader, TinyTrianglesKeepUnitNormals) {
+    TempDir dir;
+    dir.write("tiny.obj",
+              "v 0 0 0\nv 1e-10 0 0\nv 0 1.3e-10 0\nv 5 0 0\nv 5 1e-10 0\nv 5.0000001 0 1e-10\n"
+              "vn 0 0 1e-21\nvn 3e-21 0 1e-21\nvn 0 2e-21 1e-21\n"
+              "f 1 2 3\nf 4//1 5//2 6//3\n");
+    const Scene scene = load_scene(dir.write("tiny.json", R"({
+        "camera": {"position": [0, 0, 5], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y_degrees": 40,
+                   "width": 8, "height": 8},
+        "meshes": [{"obj": "tiny.obj"}],
+        "lights": [{"type": "point", "position": [0, 0, 1], "intensity": [1, 1, 1]}]})"));
+    ASSERT_EQ(scene.normals.size(), 2u);
+    for (const gpu::TriangleNormals& n : scene.normals)
+        for (const glm::vec3 v : {glm::vec3(n.n0_x, n.n0_y, n.n0_z), glm::vec3(n.n1_x, n.n1_y, n.n1_z),
+                                  glm::vec3(n.n2_x, n.n2_y, n.n2_z)})
+            EXPECT_NEAR(glm::length(v), 1.0f, 1e-6f);
+}
+
 TEST(SceneLoader, UpdateBoundsRefusesAnExtentBeyondFloat) {
     Scene scene;
     scene.file = "hand_built.json";

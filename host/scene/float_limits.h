@@ -9,6 +9,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -19,6 +20,18 @@
 namespace lc::loader {
 
 inline constexpr double kFloatMax = std::numeric_limits<float>::max();
+
+// The unit vector along v, its length taken in double: a float's square
+// underflows below about 1e-19 (the cross product of a tiny triangle's
+// edges, say), so a length taken in float comes out short and v divided by
+// it is not of unit length. False where v has no direction (zero, or not
+// finite).
+inline bool unit_vector(glm::dvec3 v, glm::vec3& unit) {
+    const double length = glm::length(v);
+    if (!(length > 0.0) || !std::isfinite(length)) return false;
+    unit = glm::vec3(v / length);
+    return true;
+}
 
 // Finite and within ±FLT_MAX (false for NaN).
 inline bool fits_float(double v) { return v >= -kFloatMax && v <= kFloatMax; }

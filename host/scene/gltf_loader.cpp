@@ -246,8 +246,11 @@ private:
         for (int k = 0; k < 3; ++k) v[std::size_t(k)] = glm::vec3(t.position * glm::vec4(p[c[std::size_t(k)]], 1.0f));
         const glm::vec3 cross = glm::cross(v[1] - v[0], v[2] - v[0]);
         const float twice_area = glm::length(cross);
+        // The face normal from the exact cross product of the float corners.
+        glm::vec3 face;
         if (!is_finite(v[0]) || !is_finite(v[1]) || !is_finite(v[2]) || !std::isfinite(twice_area) ||
-            !(twice_area > 0.0f)) {
+            !(twice_area > 0.0f) ||
+            !unit_vector(glm::cross(glm::dvec3(v[1]) - glm::dvec3(v[0]), glm::dvec3(v[2]) - glm::dvec3(v[0])), face)) {
             ++target_.scene.degenerate_triangles_dropped;
             return false;
         }
@@ -256,17 +259,14 @@ private:
             fail(field, "too far from the rest of the geometry: " + problem);
         // glTF 3.7.2.1: a negative determinant flips the winding; the face
         // normal keeps the side the file's winding means.
-        const glm::vec3 face = cross / twice_area * (t.mirrors ? -1.0f : 1.0f);
+        if (t.mirrors) face = -face;
         std::array<glm::vec3, 3> sn{face, face, face};
         if (!n.empty()) {
             for (std::size_t k = 0; k < 3; ++k) {
-                const glm::vec3 vn = t.normal * n[c[k]];
-                const float length = glm::length(vn);
-                if (!(length > 0.0f) || !std::isfinite(length)) {
+                if (!unit_vector(glm::dvec3(t.normal * n[c[k]]), sn[k])) {
                     sn = {face, face, face};  // a zero normal would poison shading
                     break;
                 }
-                sn[k] = vn / length;
             }
         }
         Scene& s = target_.scene;

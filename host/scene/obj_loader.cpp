@@ -201,10 +201,7 @@ private:
         std::array<glm::vec3, 3> vn{};
         for (std::size_t c = 0; c < 3; ++c) {
             if (idx[c].normal_index < 0) return flat;
-            vn[c] = normal(idx[c].normal_index);
-            const float len = glm::length(vn[c]);
-            if (!(len > 0.0f) || !std::isfinite(len)) return flat;
-            vn[c] /= len;
+            if (!unit_vector(glm::dvec3(normal(idx[c].normal_index)), vn[c])) return flat;
         }
         return vn;
     }
@@ -228,7 +225,11 @@ private:
         const glm::vec3 cross = glm::cross(v[1] - v[0], v[2] - v[0]);
         const float twice_area = glm::length(cross);
         const bool finite = is_finite(v[0]) && is_finite(v[1]) && is_finite(v[2]) && std::isfinite(twice_area);
-        if (!finite || !(twice_area > 0.0f)) {
+        // The face normal from the exact cross product of the float corners.
+        glm::vec3 face_normal;
+        if (!finite || !(twice_area > 0.0f) ||
+            !unit_vector(glm::cross(glm::dvec3(v[1]) - glm::dvec3(v[0]), glm::dvec3(v[2]) - glm::dvec3(v[0])),
+                         face_normal)) {
             ++target_.scene.degenerate_triangles_dropped;
             return false;
         }
@@ -238,7 +239,7 @@ private:
         }
         // Keep the face normal on the side the OBJ winding says, even when a
         // mirroring scale has flipped the winding.
-        const glm::vec3 face_normal = cross / twice_area * (transform_.mirrors ? -1.0f : 1.0f);
+        if (transform_.mirrors) face_normal = -face_normal;
         const std::array<glm::vec3, 3> n = shading_normals(idx, face_normal);
         // After the degenerate check: a dropped face must not add the default material.
         const std::uint32_t material = material_of(mtl_id);
