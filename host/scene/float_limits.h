@@ -33,6 +33,14 @@ inline bool unit_vector(glm::dvec3 v, glm::vec3& unit) {
     return true;
 }
 
+// A triangle's unit face normal (its winding's side) from the exact cross
+// product of its float corners; false where it has none (the corners are
+// collinear, or not finite).
+inline bool face_normal(const std::array<glm::vec3, 3>& v, glm::vec3& unit) {
+    const glm::dvec3 a(v[0]), b(v[1]), c(v[2]);
+    return unit_vector(glm::cross(b - a, c - a), unit);
+}
+
 // Finite and within ±FLT_MAX (false for NaN).
 inline bool fits_float(double v) { return v >= -kFloatMax && v <= kFloatMax; }
 inline bool fits_float(glm::dvec3 p) { return fits_float(p.x) && fits_float(p.y) && fits_float(p.z); }

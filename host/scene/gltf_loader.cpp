@@ -246,11 +246,9 @@ private:
         for (int k = 0; k < 3; ++k) v[std::size_t(k)] = glm::vec3(t.position * glm::vec4(p[c[std::size_t(k)]], 1.0f));
         const glm::vec3 cross = glm::cross(v[1] - v[0], v[2] - v[0]);
         const float twice_area = glm::length(cross);
-        // The face normal from the exact cross product of the float corners.
         glm::vec3 face;
         if (!is_finite(v[0]) || !is_finite(v[1]) || !is_finite(v[2]) || !std::isfinite(twice_area) ||
-            !(twice_area > 0.0f) ||
-            !unit_vector(glm::cross(glm::dvec3(v[1]) - glm::dvec3(v[0]), glm::dvec3(v[2]) - glm::dvec3(v[0])), face)) {
+            !(twice_area > 0.0f) || !face_normal(v, face)) {
             ++target_.scene.degenerate_triangles_dropped;
             return false;
         }

@@ -225,11 +225,8 @@ private:
         const glm::vec3 cross = glm::cross(v[1] - v[0], v[2] - v[0]);
         const float twice_area = glm::length(cross);
         const bool finite = is_finite(v[0]) && is_finite(v[1]) && is_finite(v[2]) && std::isfinite(twice_area);
-        // The face normal from the exact cross product of the float corners.
-        glm::vec3 face_normal;
-        if (!finite || !(twice_area > 0.0f) ||
-            !unit_vector(glm::cross(glm::dvec3(v[1]) - glm::dvec3(v[0]), glm::dvec3(v[2]) - glm::dvec3(v[0])),
-                         face_normal)) {
+        glm::vec3 face;
+        if (!finite || !(twice_area > 0.0f) || !loader::face_normal(v, face)) {
             ++target_.scene.degenerate_triangles_dropped;
             return false;
         }
@@ -239,8 +236,8 @@ private:
         }
         // Keep the face normal on the side the OBJ winding says, even when a
         // mirroring scale has flipped the winding.
-        if (transform_.mirrors) face_normal = -face_normal;
-        const std::array<glm::vec3, 3> n = shading_normals(idx, face_normal);
+        if (transform_.mirrors) face = -face;
+        const std::array<glm::vec3, 3> n = shading_normals(idx, face);
         // After the degenerate check: a dropped face must not add the default material.
         const std::uint32_t material = material_of(mtl_id);
         target_.scene.triangles.push_back(gpu::Triangle{v[0].x, v[0].y, v[0].z, v[1].x, v[1].y, v[1].z,

@@ -83,8 +83,9 @@ struct Tuning {
     HostSpecialization specialize_on_host = HostSpecialization::kAuto;
 
     // Where the kernels keep each invocation's cut heap (shaders/heap.glsl).
-    // kAuto: in private memory on CPU devices, where lavapipe's shading ran
-    // 20 to 40% faster than with shared memory (docs/results/lavapipe.md);
+    // kAuto: in private memory on CPU devices, where lavapipe's shading took
+    // 0.78-0.82 s against 0.93-1.42 s with shared memory on the room
+    // (docs/results/lavapipe.md, §10);
     // in workgroup shared memory on GPUs, the heap's place there.
     enum class HeapMemory { kAuto, kShared, kPrivate };
     HeapMemory heap_memory = HeapMemory::kAuto;

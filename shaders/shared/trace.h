@@ -255,13 +255,14 @@ bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
             node = kInvalidIndex;
             for (uint s = 0u; s < 4u; ++s) {
                 if (n.count[s] < 0 || !(t_near[s] <= t_far[s])) continue;
-                if (n.count[s] == 0 && node == kInvalidIndex) {
-                    node = n.child[s];
-                } else if (n.count[s] > 0 && leaf == kInvalidIndex) {
-                    leaf = kBvh4LeafEntry | (uint(n.count[s] - 1) << 29u) | n.child[s];
+                bool is_leaf = n.count[s] > 0;
+                uint entry = is_leaf ? (kBvh4LeafEntry | (uint(n.count[s] - 1) << 29u) | n.child[s]) : n.child[s];
+                if (!is_leaf && node == kInvalidIndex) {
+                    node = entry;
+                } else if (is_leaf && leaf == kInvalidIndex) {
+                    leaf = entry;
                 } else {
-                    stack[sp++] = n.count[s] == 0 ? n.child[s]
-                                                  : (kBvh4LeafEntry | (uint(n.count[s] - 1) << 29u) | n.child[s]);
+                    stack[sp++] = entry;
                 }
             }
         }
