@@ -70,7 +70,11 @@ void main() {
             selected = true;
             heap_sum = fixed_sum;  // the fresh sum starts from the single lights and frozen clusters
             done = !kStochastic;
-        } else if (shaded < heap_size) {
+        } else if (kStochastic && shaded < heap_size) {
+            // kStochastic written into the condition lets the host's
+            // specialization drop this branch, and the ray and light
+            // sampling code under it, from Lightcuts' kernel: the loop state
+            // alone does not show the compiler that it is dead there.
             heap_sum += lc_shade_cluster_stochastic(sp, lc_entry_node(LC_HEAP_LOAD(shaded)), frame.min_distance2, stream,
                                                     draw, stats) *
                         (1.0f / float(frame.light_samples));

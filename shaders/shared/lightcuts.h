@@ -165,16 +165,25 @@ float lc_cluster_error(LC_IN(SurfacePoint) sp, LC_IN(Material) m, LC_IN(LightNod
     return lc_luminance(lc_cluster_bound(sp, m, node, min_distance2) * lc_node_intensity(node));
 }
 
+// Whether a cluster with this lc_cluster_error needs its representative's
+// contribution: a leaf always; an interior node whose bound is zero
+// contributes exactly zero, and needs no ray.
+bool lc_cluster_needs_unit(LC_IN(LightNode) node, float error) {
+    return (node.flags & kNodeLeaf) != 0u || error > 0.0f;
+}
+
 // One cluster (`node`, at node_index, with its lc_cluster_error) entering
-// the cut: a zero bound means no ray at all; a leaf is final (exact, zero
-// error) and goes to fixed_sum. True for a refinable interior node, whose
-// heap entry and estimate are then in `e` and `estimate` for the caller to
-// place in the heap.
-// `inherited` is true when the caller already knows the representative's
-// unit contribution (shared with the parent) and the visibility behind it.
-bool lc_cluster_entry(LC_IN(SurfacePoint) sp, uint node_index, LC_IN(LightNode) node, float error, bool inherited,
-                      vec3 inherited_unit, bool inherited_visible, float min_distance2, LC_OUT(HeapEntry) e,
-                      LC_OUT(vec3) estimate, LC_INOUT(vec3) fixed_sum, LC_INOUT(ShadeStats) stats) {
+// the cut, with its representative's unit contribution `unit` and the
+// visibility behind it, as lc_rep_unit found them (or anything, where
+// lc_cluster_needs_unit is false). A leaf is final (exact, zero error) and
+// goes to fixed_sum. True for a refinable interior node, whose heap entry
+// and estimate are then in `e` and `estimate` for the caller to place in
+// the heap.
+// The ray is the caller's: a kernel compiled for a GPU or lavapipe inlines
+// every call, and one call site of the ray per caller keeps one copy of the
+// traversal loop there.
+bool lc_cluster_entry(uint node_index, LC_IN(LightNode) node, float error, vec3 unit, bool visible,
+                      LC_OUT(HeapEntry) e, LC_OUT(vec3) estimate, LC_INOUT(vec3) fixed_sum) {
     // Defined on every path (the caller reads them only after a true).
     e.node = kInvalidIndex;
     e.error = 0.0f;
@@ -184,10 +193,7 @@ bool lc_cluster_entry(LC_IN(SurfacePoint) sp, uint node_index, LC_IN(LightNode) 
     estimate = vec3(0.0f);
     vec3 intensity = lc_node_intensity(node);
     bool leaf = (node.flags & kNodeLeaf) != 0u;
-    // A cluster whose bound is zero contributes exactly zero: no ray.
-    if (!leaf && !(error > 0.0f)) return false;
-    bool visible = inherited_visible;
-    vec3 unit = inherited ? inherited_unit : lc_rep_unit(sp, node.rep_light, min_distance2, visible, stats);
+    if (!lc_cluster_needs_unit(node, error)) return false;
     if (leaf) {
         fixed_sum += unit * intensity;
         return false;
@@ -213,8 +219,10 @@ void lc_add_cluster(LC_IN(SurfacePoint) sp, uint node_index, LC_IN(LightNode) no
                     LC_INOUT(ShadeStats) stats) {
     HeapEntry e;
     vec3 estimate;
-    if (lc_cluster_entry(sp, node_index, node, error, false, vec3(0.0f), false, min_distance2, e, estimate,
-                         fixed_sum, stats))
+    bool visible = false;
+    vec3 unit = vec3(0.0f);
+    if (lc_cluster_needs_unit(node, error)) unit = lc_rep_unit(sp, node.rep_light, min_distance2, visible, stats);
+    if (lc_cluster_entry(node_index, node, error, unit, visible, e, estimate, fixed_sum))
         lc_heap_push(sp, min_distance2, heap_size, e, estimate, fixed_sum, heap_sum, stats);
 }
 
@@ -274,7 +282,7 @@ bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) he
 #endif
     // One child keeps the parent's representative; the other has a new one,
     // whose contribution (one shadow ray) is found here, once, where that
-    // child enters the cut (lc_cluster_entry: a leaf, or a bound above
+    // child enters the cut (lc_cluster_needs_unit: a leaf, or a bound above
     // zero). One call for whichever child it is, not one per child: lanes
     // of a SIMD group refining different nodes then trace their rays
     // together instead of in two rounds.
@@ -287,12 +295,10 @@ bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) he
         fresh_unit = lc_rep_unit(sp, fresh_rep, f.min_distance2, fresh_visible, stats);
     HeapEntry a, b;
     vec3 estimate_a, estimate_b;
-    bool has_a = lc_cluster_entry(sp, node.left, left, errors.x, true, right_shares ? fresh_unit : unit,
-                                  right_shares ? fresh_visible : visible, f.min_distance2, a, estimate_a, fixed_sum,
-                                  stats);
-    bool has_b = lc_cluster_entry(sp, node.left + 1u, right, errors.y, true, right_shares ? unit : fresh_unit,
-                                  right_shares ? visible : fresh_visible, f.min_distance2, b, estimate_b, fixed_sum,
-                                  stats);
+    bool has_a = lc_cluster_entry(node.left, left, errors.x, right_shares ? fresh_unit : unit,
+                                  right_shares ? fresh_visible : visible, a, estimate_a, fixed_sum);
+    bool has_b = lc_cluster_entry(node.left + 1u, right, errors.y, right_shares ? unit : fresh_unit,
+                                  right_shares ? visible : fresh_visible, b, estimate_b, fixed_sum);
     // The parent leaves the heap and its children enter it: the larger
     // child takes the parent's slot and sinks from there, one pass where a
     // pop and a push take two; the smaller one is pushed (and may freeze
