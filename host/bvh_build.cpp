@@ -310,17 +310,70 @@ void collapse_bvh(const std::vector<BvhNode>& nodes, const std::vector<gpu::Tria
     });
 }
 
+namespace {
+
+// A plane of a Bvh4Node as the kernels decode it (shared/trace.h,
+// lc_bvh4_node): plane * scale is exact, so this is their sum bit for bit.
+float bvh4_plane(float origin, float scale, std::uint32_t plane) { return origin + float(plane) * scale; }
+
+// One axis of a Bvh4Node: the grid (origin and power-of-two scale) and each
+// used slot's lower and upper plane, rounded outwards so that the decoded
+// interval holds [lo, hi], and as tight as the grid allows.
+void quantize_axis(const float (&lo)[4], const float (&hi)[4], const std::int32_t (&count)[4], float& origin,
+                   float& scale, std::uint32_t& lo_planes, std::uint32_t& hi_planes) {
+    origin = std::numeric_limits<float>::max();
+    float top = -std::numeric_limits<float>::max();
+    for (int s = 0; s < 4; ++s) {
+        if (count[s] < 0) continue;
+        origin = std::min(origin, lo[s]);
+        top = std::max(top, hi[s]);
+    }
+    lo_planes = hi_planes = 0;
+    if (top < origin) {  // no child: any grid
+        origin = 0.0f;
+        scale = 1.0f;
+        return;
+    }
+    // The smallest power of two (a normal float, so that plane * scale stays
+    // exact) whose 255th plane reaches the top.
+    const double extent = double(top) - double(origin);
+    int exponent = std::numeric_limits<float>::min_exponent - 1;  // 2^-126
+    if (extent > 0.0) exponent = std::max(exponent, int(std::ceil(std::log2(extent / 255.0))));
+    scale = std::ldexp(1.0f, exponent);
+    while (bvh4_plane(origin, scale, 255u) < top) scale *= 2.0f;
+    for (int s = 0; s < 4; ++s) {
+        if (count[s] < 0) continue;
+        const double offset_lo = (double(lo[s]) - double(origin)) / double(scale);
+        const double offset_hi = (double(hi[s]) - double(origin)) / double(scale);
+        auto q_lo = std::uint32_t(std::clamp(std::floor(offset_lo), 0.0, 255.0));
+        auto q_hi = std::uint32_t(std::clamp(std::ceil(offset_hi), 0.0, 255.0));
+        // The sum rounds: step outwards until the decoded plane holds the box.
+        while (q_lo > 0 && bvh4_plane(origin, scale, q_lo) > lo[s]) --q_lo;
+        while (bvh4_plane(origin, scale, q_hi) < hi[s]) ++q_hi;
+        lo_planes |= q_lo << (8 * s);
+        hi_planes |= q_hi << (8 * s);
+    }
+}
+
+}  // namespace
+
 std::vector<gpu::Bvh4Node> bvh4_nodes(const std::vector<WideBvhNode>& wide_nodes,
                                       const std::vector<WideLeaf>& wide_leaves) {
     std::vector<gpu::Bvh4Node> out(wide_nodes.size());
     for (std::size_t i = 0; i < wide_nodes.size(); ++i) {
         const WideBvhNode& w = wide_nodes[i];
         gpu::Bvh4Node& n = out[i];
+        quantize_axis(w.lo_x, w.hi_x, w.count, n.origin_x, n.scale_x, n.lo_x, n.hi_x);
+        quantize_axis(w.lo_y, w.hi_y, w.count, n.origin_y, n.scale_y, n.lo_y, n.hi_y);
+        quantize_axis(w.lo_z, w.hi_z, w.count, n.origin_z, n.scale_z, n.lo_z, n.hi_z);
         for (int s = 0; s < 4; ++s) {
-            n.lo_x[s] = w.lo_x[s], n.lo_y[s] = w.lo_y[s], n.lo_z[s] = w.lo_z[s];
-            n.hi_x[s] = w.hi_x[s], n.hi_y[s] = w.hi_y[s], n.hi_z[s] = w.hi_z[s];
-            n.child[s] = w.count[s] > 0 ? wide_leaves[w.child[s]].first : w.child[s];
-            n.count[s] = w.count[s];
+            if (w.count[s] < 0) {
+                n.entry[s] = gpu::kInvalidIndex;
+            } else if (w.count[s] == 0) {
+                n.entry[s] = w.child[s];
+            } else {
+                n.entry[s] = gpu::kBvh4LeafEntry | (std::uint32_t(w.count[s] - 1) << 29) | wide_leaves[w.child[s]].first;
+            }
         }
     }
     return out;

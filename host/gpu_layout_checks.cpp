@@ -11,11 +11,16 @@ static_assert(offsetof(BvhNode, first_or_left) == 12);
 static_assert(offsetof(BvhNode, max_x) == 16);
 static_assert(offsetof(BvhNode, tri_count) == 28);
 
-static_assert(sizeof(Bvh4Node) == 128);  // eight uvec4 words, read as such (shaders/kernel.glsl)
-static_assert(offsetof(Bvh4Node, lo_y) == 16);
-static_assert(offsetof(Bvh4Node, hi_x) == 48);
-static_assert(offsetof(Bvh4Node, child) == 96);
-static_assert(offsetof(Bvh4Node, count) == 112);
+// kBvh4NodeWords uvec4 words, read as such (shaders/kernel.glsl, shared/trace.h's lc_bvh4_node).
+static_assert(sizeof(Bvh4Node) == 16 * kBvh4NodeWords);
+static_assert(offsetof(Bvh4Node, scale_x) == 12);
+static_assert(offsetof(Bvh4Node, scale_y) == 16);
+static_assert(offsetof(Bvh4Node, lo_x) == 24);
+static_assert(offsetof(Bvh4Node, lo_z) == 32);
+static_assert(offsetof(Bvh4Node, hi_z) == 44);
+static_assert(offsetof(Bvh4Node, entry) == 48);
+// A leaf's triangle count - 1 fits the two bits of its entry.
+static_assert(kBvhMaxLeafTriangles <= 4u);
 
 static_assert(sizeof(Triangle) == 48);
 static_assert(offsetof(Triangle, v1_x) == 12);

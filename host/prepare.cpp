@@ -153,9 +153,9 @@ std::vector<SceneArray> scene_arrays(const PreparedScene& p) {
         array("lights", p.tree.lights),
         array("light_tree_nodes", p.tree.nodes),
         array("environment", p.scene.environment.rgb),
-        // Eight 16-byte words a node, as the kernels declare it.
-        SceneArray{"wide_bvh_nodes", p.bvh.kernel_nodes.data(), sizeof(gpu::Bvh4Node) / 8,
-                   8 * p.bvh.kernel_nodes.size()},
+        // kBvh4NodeWords 16-byte words a node, as the kernels declare it.
+        SceneArray{"wide_bvh_nodes", p.bvh.kernel_nodes.data(), sizeof(gpu::Bvh4Node) / gpu::kBvh4NodeWords,
+                   gpu::kBvh4NodeWords * p.bvh.kernel_nodes.size()},
     };
 }
 

@@ -86,8 +86,8 @@ BvhNode lc_bvh_node(uint i) {
 
 // Word k (16 bytes) of Bvh4Node i.
 uvec4 lc_bvh4_word(uint i, uint k) {
-    if (!kTexelReads) return lc_wide_bvh_nodes(8u * i + k);
-    return texelFetch(wide_bvh_node_texels, int(8u * i + k));
+    if (!kTexelReads) return lc_wide_bvh_nodes(kBvh4NodeWords * i + k);
+    return texelFetch(wide_bvh_node_texels, int(kBvh4NodeWords * i + k));
 }
 
 Triangle lc_triangle(uint i) {

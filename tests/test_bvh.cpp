@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <random>
@@ -134,6 +135,66 @@ std::string check_ray(const Scene& s, vec3 org, vec3 dir, float t_max) {
     return {};
 }
 
+// The kernels' copy of the 4-wide tree (Bvh4Node) against wide_nodes: the
+// same slots, a leaf's entry naming its triangles; each box as the kernels
+// decode it (lc_bvh4_node, compiled here as C++) holds the child's box, and
+// no plane could move inwards by one step of its grid and still hold it.
+void check_kernel_nodes(const Scene& s) {
+    ASSERT_EQ(s.bvh.kernel_nodes.size(), s.bvh.wide_nodes.size());
+    lc::cpu::Trace4Kernel k4{s.bvh.nodes.data(), s.triangles.data(), s.bvh.kernel_nodes.data()};
+    for (std::size_t i = 0; i < s.bvh.wide_nodes.size(); ++i) {
+        const lc::WideBvhNode& w = s.bvh.wide_nodes[i];
+        const lc::gpu::Bvh4Node& g = s.bvh.kernel_nodes[i];
+        const auto n = k4.lc_bvh4_node(std::uint32_t(i));
+        const std::array<float, 3> scale = {g.scale_x, g.scale_y, g.scale_z};
+        for (float sc : scale) {
+            int exponent = 0;
+            EXPECT_EQ(std::frexp(sc, &exponent), 0.5f) << "scale " << sc << " is not a power of two";
+            EXPECT_GE(sc, std::numeric_limits<float>::min());
+        }
+        for (int slot = 0; slot < 4; ++slot) {
+            if (w.count[slot] < 0) {
+                EXPECT_EQ(g.entry[slot], kInvalidIndex);
+                continue;
+            }
+            if (w.count[slot] > 0) {
+                EXPECT_EQ(g.entry[slot], lc::gpu::kBvh4LeafEntry | std::uint32_t(w.count[slot] - 1) << 29 |
+                                             s.bvh.wide_leaves[w.child[slot]].first);
+            } else {
+                EXPECT_EQ(g.entry[slot], w.child[slot]);
+            }
+            const std::array<float, 3> lo = {n.lo_x[slot], n.lo_y[slot], n.lo_z[slot]};
+            const std::array<float, 3> hi = {n.hi_x[slot], n.hi_y[slot], n.hi_z[slot]};
+            const std::array<float, 3> true_lo = {w.lo_x[slot], w.lo_y[slot], w.lo_z[slot]};
+            const std::array<float, 3> true_hi = {w.hi_x[slot], w.hi_y[slot], w.hi_z[slot]};
+            for (int a = 0; a < 3; ++a) {
+                EXPECT_LE(lo[a], true_lo[a]) << "node " << i << " slot " << slot << " axis " << a;
+                EXPECT_GE(hi[a], true_hi[a]) << "node " << i << " slot " << slot << " axis " << a;
+                // Tight: within a step of the grid, give or take the
+                // rounding of the decoded sums.
+                EXPECT_LT(true_lo[a] - lo[a], 1.5f * scale[a]) << "node " << i << " slot " << slot << " axis " << a;
+                EXPECT_LT(hi[a] - true_hi[a], 1.5f * scale[a]) << "node " << i << " slot " << slot << " axis " << a;
+            }
+        }
+        // The grid: the finest power of two whose 255 steps span the
+        // children (or the smallest normal float), doubled at most once
+        // where the rounding of the last plane fell short.
+        for (int a = 0; a < 3; ++a) {
+            const float(&lo)[4] = a == 0 ? w.lo_x : a == 1 ? w.lo_y : w.lo_z;
+            const float(&hi)[4] = a == 0 ? w.hi_x : a == 1 ? w.hi_y : w.hi_z;
+            double bottom = INFINITY, top = -INFINITY;
+            for (int slot = 0; slot < 4; ++slot) {
+                if (w.count[slot] < 0) continue;
+                bottom = std::min(bottom, double(lo[slot]));
+                top = std::max(top, double(hi[slot]));
+            }
+            if (top < bottom) continue;
+            EXPECT_LE(double(scale[a]), std::max(4.0 * (top - bottom) / 255.0, double(std::numeric_limits<float>::min())))
+                << "node " << i << " axis " << a;
+        }
+    }
+}
+
 int max_leaf_depth(const std::vector<BvhNode>& nodes, std::uint32_t index, int depth) {
     const BvhNode& n = nodes[index];
     if (n.tri_count > 0) return depth;
@@ -259,26 +320,7 @@ void check_invariants(const Scene& s) {
     EXPECT_TRUE(std::all_of(input_seen.begin(), input_seen.end(), [](int c) { return c == 1; }));
     check_wide_invariants(s, s.bvh.wide_nodes, s.bvh.wide_leaves);
     check_wide_invariants(s, s.bvh.wide8_nodes, s.bvh.wide_leaves);
-    // The kernels' copy of the 4-wide tree: the same slots, a leaf's slot
-    // naming its first triangle.
-    ASSERT_EQ(s.bvh.kernel_nodes.size(), s.bvh.wide_nodes.size());
-    for (std::size_t i = 0; i < s.bvh.wide_nodes.size(); ++i) {
-        const lc::WideBvhNode& w = s.bvh.wide_nodes[i];
-        const lc::gpu::Bvh4Node& g = s.bvh.kernel_nodes[i];
-        for (int slot = 0; slot < 4; ++slot) {
-            EXPECT_EQ(g.count[slot], w.count[slot]);
-            const std::array<float, 6> kernel_box = {g.lo_x[slot], g.lo_y[slot], g.lo_z[slot],
-                                                     g.hi_x[slot], g.hi_y[slot], g.hi_z[slot]};
-            const std::array<float, 6> box = {w.lo_x[slot], w.lo_y[slot], w.lo_z[slot],
-                                              w.hi_x[slot], w.hi_y[slot], w.hi_z[slot]};
-            EXPECT_EQ(kernel_box, box);
-            if (w.count[slot] > 0) {
-                EXPECT_EQ(g.child[slot], s.bvh.wide_leaves[w.child[slot]].first);
-            } else if (w.count[slot] == 0) {
-                EXPECT_EQ(g.child[slot], w.child[slot]);
-            }
-        }
-    }
+    check_kernel_nodes(s);
 }
 
 using lc::test::random_unit;
@@ -515,7 +557,7 @@ TEST(Bvh, EmptySceneMissesEverything) {
     ASSERT_EQ(bvh.wide_nodes.size(), 1u);
     for (int slot = 0; slot < 4; ++slot) EXPECT_EQ(bvh.wide_nodes[0].count[slot], -1);
     ASSERT_EQ(bvh.kernel_nodes.size(), 1u);
-    for (int slot = 0; slot < 4; ++slot) EXPECT_EQ(bvh.kernel_nodes[0].count[slot], -1);
+    for (int slot = 0; slot < 4; ++slot) EXPECT_EQ(bvh.kernel_nodes[0].entry[slot], kInvalidIndex);
     ASSERT_EQ(bvh.wide8_nodes.size(), 1u);
     for (int slot = 0; slot < 8; ++slot) EXPECT_EQ(bvh.wide8_nodes[0].count[slot], -1);
 }
@@ -548,6 +590,27 @@ TEST(Bvh, DegenerateInputsKeepInvariants) {
         const vec3 target = (v0(tri) + v1(tri) + v2(tri)) / 3.0f;
         const vec3 org = target + vec3(0.0f, 2.0f, 3.0f) + random_unit(rng);
         const std::string problem = check_ray(deep, org, target - org, kRayInfinity);
+        if (!problem.empty() && failures++ == 0) first_failure = problem;
+    }
+    EXPECT_EQ(failures, 0) << first_failure;
+
+    // Millimetre triangles 10^5 units from the origin: the kernels'
+    // quantized boxes (Bvh4Node) have grids of a few float ulps there.
+    std::vector<Triangle> far_small;
+    std::uniform_real_distribution<float> jitter(-0.05f, 0.05f);
+    const vec3 far_centre(1e5f, -1e5f, 3e4f);
+    for (int i = 0; i < 300; ++i) {
+        const vec3 c = far_centre + vec3(jitter(rng), jitter(rng), jitter(rng));
+        far_small.push_back(make_triangle(c, c + vec3(1e-3f, 0, 0), c + vec3(0, 1e-3f, 1e-3f)));
+    }
+    const Scene far_away(far_small);
+    check_invariants(far_away);
+    failures = 0;
+    for (int i = 0; i < 2000; ++i) {
+        const Triangle& tri = far_away.triangles[pick(rng) % far_away.triangles.size()];
+        const vec3 target = (v0(tri) + v1(tri) + v2(tri)) / 3.0f;
+        const vec3 org = target + 0.2f * random_unit(rng);
+        const std::string problem = check_ray(far_away, org, target - org, kRayInfinity);
         if (!problem.empty() && failures++ == 0) first_failure = problem;
     }
     EXPECT_EQ(failures, 0) << first_failure;

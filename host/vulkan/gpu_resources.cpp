@@ -38,7 +38,7 @@ constexpr SceneBinding kSceneBindings[] = {
     {gpu::kBindingLights, "lights", sizeof(gpu::Light)},
     {gpu::kBindingLightNodes, "light_tree_nodes", sizeof(gpu::LightNode)},
     {gpu::kBindingEnvironment, "environment", sizeof(float)},
-    {gpu::kBindingWideBvhNodes, "wide_bvh_nodes", sizeof(gpu::Bvh4Node) / 8},
+    {gpu::kBindingWideBvhNodes, "wide_bvh_nodes", sizeof(gpu::Bvh4Node) / gpu::kBvh4NodeWords},
     {gpu::kBindingFrame, "frame", sizeof(gpu::FrameParams)},  // appended by RenderSetup
 };
 constexpr bool scene_bindings_in_order() {
@@ -77,7 +77,7 @@ static_assert(std::size(kTexelArrays) == gpu::kTexelBindingCount &&
               gpu::kBindingWideBvhNodeTexels == gpu::kBindingCount + gpu::kTexelBindingCount - 1);
 static_assert(sizeof(gpu::BvhNode) == 2 * kTexelBytes && sizeof(gpu::Triangle) == 3 * kTexelBytes &&
               sizeof(gpu::Light) == 3 * kTexelBytes && sizeof(gpu::LightNode) == 4 * kTexelBytes &&
-              sizeof(gpu::Bvh4Node) == 8 * kTexelBytes,
+              sizeof(gpu::Bvh4Node) == gpu::kBvh4NodeWords * kTexelBytes,
               "shaders/kernel.glsl unpacks these structs from whole texels");
 
 bool has_texel_view(std::uint32_t binding) {

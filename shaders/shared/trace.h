@@ -164,32 +164,40 @@ uint lc_trace_closest(vec3 org, vec3 dir, float t_max, LC_OUT(float) t_hit, LC_O
 }
 
 #ifdef LC_BVH4_WORD
-// A Bvh4Node unpacked: the four children's boxes as vectors, slot by slot.
+// A Bvh4Node unpacked: the four children's boxes as vectors, slot by slot,
+// and their stack entries.
 struct Bvh4Boxes {
     vec4 lo_x, lo_y, lo_z;
     vec4 hi_x, hi_y, hi_z;
-    uvec4 child;
-    ivec4 count;
+    uvec4 entry;
 };
 
+// The four planes in the bytes of w, as floats (exact: at most 255).
+vec4 lc_bvh4_planes(uint w) { return vec4((uvec4(w) >> uvec4(0u, 8u, 16u, 24u)) & uvec4(255u)); }
+
 Bvh4Boxes lc_bvh4_node(uint i) {
+    uvec4 w0 = LC_BVH4_WORD(i, 0u);
+    uvec4 w1 = LC_BVH4_WORD(i, 1u);
+    uvec4 w2 = LC_BVH4_WORD(i, 2u);
+    float origin_x = uintBitsToFloat(w0.x), origin_y = uintBitsToFloat(w0.y), origin_z = uintBitsToFloat(w0.z);
+    float scale_x = uintBitsToFloat(w0.w), scale_y = uintBitsToFloat(w1.x), scale_z = uintBitsToFloat(w1.y);
     Bvh4Boxes n;
-    n.lo_x = uintBitsToFloat(LC_BVH4_WORD(i, 0u));
-    n.lo_y = uintBitsToFloat(LC_BVH4_WORD(i, 1u));
-    n.lo_z = uintBitsToFloat(LC_BVH4_WORD(i, 2u));
-    n.hi_x = uintBitsToFloat(LC_BVH4_WORD(i, 3u));
-    n.hi_y = uintBitsToFloat(LC_BVH4_WORD(i, 4u));
-    n.hi_z = uintBitsToFloat(LC_BVH4_WORD(i, 5u));
-    n.child = LC_BVH4_WORD(i, 6u);
-    n.count = ivec4(LC_BVH4_WORD(i, 7u));
+    // plane * scale is exact (a power of two times at most 255), so a fused
+    // multiply-add gives the same sums as bvh4_nodes, which rounded them.
+    n.lo_x = origin_x + lc_bvh4_planes(w1.z) * scale_x;
+    n.lo_y = origin_y + lc_bvh4_planes(w1.w) * scale_y;
+    n.lo_z = origin_z + lc_bvh4_planes(w2.x) * scale_z;
+    n.hi_x = origin_x + lc_bvh4_planes(w2.y) * scale_x;
+    n.hi_y = origin_y + lc_bvh4_planes(w2.z) * scale_y;
+    n.hi_z = origin_z + lc_bvh4_planes(w2.w) * scale_z;
+    n.entry = LC_BVH4_WORD(i, 3u);
     return n;
 }
 
-// A stack entry of lc_trace_any: an inner node's Bvh4Node index, or a
-// leaf: this flag, its triangle count - 1 in bits 29 and 30, and its first
-// triangle below (kBvh4MaxTriangles). No leaf entry is kInvalidIndex: a
-// leaf of four triangles starts at most at kBvh4MaxTriangles - 4.
-LC_KCONST uint kBvh4LeafEntry = 0x80000000u;
+// A stack entry of lc_trace_any is a Bvh4Node's entry (types.h). No leaf
+// entry is kInvalidIndex: a leaf of four triangles starts at most at
+// kBvh4MaxTriangles - 4.
+//
 // The stack holds the unvisited children of nodes on the current path, at
 // most one group per level. A visit pushes at most three (one child is
 // visited next, or becomes the pending leaf), or four where all four are
@@ -254,9 +262,9 @@ bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
             vec4 t_far = min(min(max(t0x, t1x), max(t0y, t1y)), min(max(t0z, t1z), vec4(t_max))) * 1.0000004f;
             node = kInvalidIndex;
             for (uint s = 0u; s < 4u; ++s) {
-                if (n.count[s] < 0 || !(t_near[s] <= t_far[s])) continue;
-                bool is_leaf = n.count[s] > 0;
-                uint entry = is_leaf ? (kBvh4LeafEntry | (uint(n.count[s] - 1) << 29u) | n.child[s]) : n.child[s];
+                uint entry = n.entry[s];
+                if (entry == kInvalidIndex || !(t_near[s] <= t_far[s])) continue;
+                bool is_leaf = (entry & kBvh4LeafEntry) != 0u;
                 if (!is_leaf && node == kInvalidIndex) {
                     node = entry;
                 } else if (is_leaf && leaf == kInvalidIndex) {

@@ -72,21 +72,31 @@ struct BvhNode {
     uint tri_count;
 };
 
-// The same tree four wide, as the kernels' shadow rays read it (128 bytes,
-// eight 16-byte words): the boxes of up to four children side by side, then
-// each child's index and kind. Made from the binary tree by pulling
-// grandchildren up (collapse_bvh), so its leaves are the binary leaves. The
-// kernels read it as uvec4 words (shaders/kernel.glsl, lc_bvh4_node).
+// The same tree four wide, as the kernels' shadow rays read it: 64 bytes,
+// four 16-byte words. Made from the binary tree by pulling grandchildren up
+// (collapse_bvh), so its leaves are the binary leaves. The four children's
+// boxes are quantized to 8 bits a plane in a grid over the node (Ylitie,
+// Karras and Laine, "Efficient Incoherent Ray Traversal on GPUs Through
+// Compressed Wide BVHs", HPG 2017): plane q of axis a lies at
+// origin_a + q * scale_a, with scale_a a power of two, so that the product
+// is exact and the sum rounds the same way everywhere; bvh4_nodes rounds
+// every box outwards, so a decoded box holds the child's true box. Half
+// the words of the boxes as floats, and half the texel reads per node
+// (docs/results/lavapipe.md, section 11). The kernels read it as uvec4
+// words (shaders/kernel.glsl, lc_bvh4_node).
 struct Bvh4Node {
-    float lo_x[4];
-    float lo_y[4];
-    float lo_z[4];
-    float hi_x[4];
-    float hi_y[4];
-    float hi_z[4];
-    uint child[4];  // an inner child's Bvh4Node index, or a leaf's first triangle
-    int count[4];   // a leaf's triangles (1 .. kBvhMaxLeafTriangles); 0: an inner child; -1: none
+    float origin_x, origin_y, origin_z;
+    float scale_x, scale_y, scale_z;  // powers of two
+    // Byte s of each word: child slot s's lower or upper plane, 0 .. 255.
+    uint lo_x, lo_y, lo_z;
+    uint hi_x, hi_y, hi_z;
+    // Each child slot as lc_trace_any's stack entry: an inner child's
+    // Bvh4Node index; a leaf (kBvh4LeafEntry) with its triangle count - 1 in
+    // bits 29 and 30 and its first triangle below; kInvalidIndex: no child.
+    uint entry[4];
 };
+LC_CONST uint kBvh4NodeWords = 4u;
+LC_CONST uint kBvh4LeafEntry = 0x80000000u;
 // A leaf's first triangle shares a stack word with its count and a flag in
 // the kernels' traversal (lc_trace_any), so triangles are fewer than 2^29.
 LC_CONST uint kBvh4MaxTriangles = 0x20000000u;
