@@ -99,4 +99,19 @@ for ip in inside:
 print("%d of %d samples in the shader code copied out" % (len(inside), len(samples)))
 for kind, n in split.most_common():
     print("%5.1f%%  %s" % (100.0 * n / max(1, len(inside)), kind))
+
+# The same samples by function of the generated code (a function ends at a
+# ret). The kernels are one large function each; llvmpipe 22.3 reads a
+# texel buffer through small functions of its own (about 46 instructions:
+# the eight lanes' addresses extracted, eight 16-byte loads, a transpose),
+# called through a pointer once per texelFetch.
+starts = [0] + [j + 1 for j, (_, text) in enumerate(code) if text.startswith("ret") and j + 1 < len(code)]
+by_function = collections.Counter()
+for ip in inside:
+    k = bisect.bisect_right(starts, bisect.bisect_right(addresses, ip) - 1) - 1
+    by_function[starts[k]] += 1
+print("by function of the generated code (instructions, share of the samples above):")
+for start, n in by_function.most_common(6):
+    end = next((s for s in starts if s > start), len(code))
+    print("%5.1f%%  %d instructions at %#x" % (100.0 * n / max(1, len(inside)), end - start, code[start][0]))
 EOF
