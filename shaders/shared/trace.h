@@ -197,7 +197,6 @@ Bvh4Boxes lc_bvh4_node(uint i) {
 // A stack entry of lc_trace_any is a Bvh4Node's entry (types.h). No leaf
 // entry is kInvalidIndex: a leaf of four triangles starts at most at
 // kBvh4MaxTriangles - 4.
-//
 // The stack holds the unvisited children of nodes on the current path, at
 // most one group per level. A visit pushes at most three (one child is
 // visited next, or becomes the pending leaf), or four where all four are

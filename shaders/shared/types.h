@@ -81,9 +81,9 @@ struct BvhNode {
 // origin_a + q * scale_a, with scale_a a power of two, so that the product
 // is exact and the sum rounds the same way everywhere; bvh4_nodes rounds
 // every box outwards, so a decoded box holds the child's true box. Half
-// the words of the boxes as floats, and half the texel reads per node
-// (docs/results/lavapipe.md, section 11). The kernels read it as uvec4
-// words (shaders/kernel.glsl, lc_bvh4_node).
+// the size of a node with float boxes (128 bytes), so half the texel reads
+// a node (docs/results/lavapipe.md, section 11). The kernels read it as
+// uvec4 words (shaders/kernel.glsl, lc_bvh4_node).
 struct Bvh4Node {
     float origin_x, origin_y, origin_z;
     float scale_x, scale_y, scale_z;  // powers of two
