@@ -37,6 +37,14 @@ json.dump(s, open(dst, "w"), indent=1)
 PY
 
 "$exe" info "$scene" | sed -n '/buffers:/,$p'
+# llvmpipe compiles a kernel it has not cached at its first dispatch (about
+# 1.3 s for Lightcuts'), and this scene's kernels differ from smaller
+# scenes' (their arrays are split): one small render first puts them in
+# Mesa's shader cache, as bench/speed.py does, so that the timed render
+# below measures rendering.
+VK_DRIVER_FILES="$lvp" "$exe" render "$scene" -o "$out/warm-up.exr" --device vulkan --width 8 --height 8 \
+  --no-png >/dev/null 2>&1 || true
+rm -f "$out/warm-up.exr"
 for device in cpu vulkan; do
   env=()
   [ "$device" = vulkan ] && env=(VK_DRIVER_FILES="$lvp")
