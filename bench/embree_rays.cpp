@@ -231,6 +231,23 @@ int run(int argc, char** argv) {
         }
 #endif
 
+        // The Vulkan kernels' walk (lc_trace_any through Bvh4Node),
+        // compiled as C++: its trips round the loop, each one node's test
+        // and one triangle's, are what a SIMD group pays for on lavapipe.
+        std::fill(hits.begin(), hits.end(), 0);
+        std::vector<std::uint64_t> trips(threads, 0);
+        s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+            lc::cpu::Trace4Kernel k4{p.bvh.nodes.data(), p.scene.triangles.data(), p.bvh.kernel_nodes.data(),
+                                     &trips[t]};
+            std::size_t h = 0;
+            for (std::size_t i = b; i < e; ++i) h += k4.lc_trace_any(r[i].org, r[i].dir, r[i].t_max) ? 1 : 0;
+            hits[t] = h;
+        });
+        report("the Vulkan kernels' 4-wide walk, single rays (counting trips)", r.size(), s, total(), reference);
+        std::uint64_t trip_total = 0;
+        for (std::uint64_t n : trips) trip_total += n;
+        std::printf("    %.2f trips round the kernels' loop per ray\n", double(trip_total) / double(r.size()));
+
         std::fill(hits.begin(), hits.end(), 0);
         s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
             lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};

@@ -55,6 +55,7 @@ struct Trace4Kernel {
     const BvhNode* bvh_nodes = nullptr;
     const Triangle* triangles = nullptr;
     const Bvh4Node* bvh4_nodes = nullptr;
+    std::uint64_t* trips = nullptr;  // where given, counts the trips round the walk's loop (bench/embree_rays)
 
     uvec4 bvh4_word(uint i, uint k) const {
         uvec4 w;
@@ -65,10 +66,12 @@ struct Trace4Kernel {
 #define LC_BVH_NODE(i) bvh_nodes[i]
 #define LC_TRIANGLE(i) triangles[i]
 #define LC_BVH4_WORD(i, k) bvh4_word(i, k)
+#define LC_ON_TRIP() (trips != nullptr ? void(++*trips) : void())
 #include "shared/trace.h"
 #undef LC_BVH_NODE
 #undef LC_TRIANGLE
 #undef LC_BVH4_WORD
+#undef LC_ON_TRIP
 };
 
 // Texture lookups and materials at a point only (shared/textures.h): what

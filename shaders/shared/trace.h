@@ -6,6 +6,8 @@
 //   LC_TRIANGLE(i)   -> Triangle
 //   LC_BVH4_WORD(i, k) (optional) -> uvec4, word k of Bvh4Node i: shadow
 //                       rays then go through the 4-wide tree (lc_trace_any)
+//   LC_ON_TRIP()     (optional) called at each trip round that tree's loop
+//                       (the benchmarks count them)
 // No include guard: each kernel context (a GLSL shader, a C++ kernel
 // struct in host/cpu_kernel.h) includes it exactly once.
 
@@ -217,9 +219,10 @@ LC_KCONST uint kBvh4StackSize = 3u * kBvhStackSize + 1u;
 // llvmpipe runs both sides of every branch under a lane mask, and GPUs
 // run a divergent branch's sides one after the other. Testing a whole
 // leaf per trip (four triangle tests, or a loop) or visiting leaves in
-// trips of their own costs more on lavapipe; this loop takes 6.1 trips per
-// lightcuts ray on the shipped room, the binary tree 12.0
-// (docs/results/lavapipe.md, §10).
+// trips of their own costs more on lavapipe; this loop takes 6.3 trips per
+// lightcuts ray on the shipped room (6.1 before the boxes were quantized),
+// the binary tree 12.0 (docs/results/lavapipe.md, §10 and §11;
+// bench/embree_rays counts them).
 //
 // Otherwise through the binary tree:
 // both children's boxes are tested at their parent, and only those the ray
@@ -242,6 +245,9 @@ bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
     uint node = 0u;            // the node to test this trip, or kInvalidIndex
     uint leaf = kInvalidIndex; // the leaf to test this trip (a stack entry), or kInvalidIndex
     while (true) {
+#ifdef LC_ON_TRIP
+        LC_ON_TRIP();
+#endif
         if (leaf != kInvalidIndex) {
             float u, v;
             if (lc_intersect_sheared(org, sheared, LC_TRIANGLE(leaf & (kBvh4MaxTriangles - 1u)), t_max, u, v) > 0.0f)
