@@ -83,7 +83,9 @@ Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const Ker
         values[e.id] = e.boolean ? (value != 0u ? "true" : "false") : std::to_string(value);
     }
     std::vector<std::uint32_t> specialized;
-    if (on_host) specialized = specialize_spirv(code.words, code.bytes / sizeof(std::uint32_t), values, name);
+    if (on_host)
+        specialized =
+            specialize_spirv_cached(code.words, code.bytes / sizeof(std::uint32_t), values, name, spirv_cache_dir());
 
     auto module_info = vk_struct<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
     module_info.codeSize = on_host ? specialized.size() * sizeof(std::uint32_t) : code.bytes;

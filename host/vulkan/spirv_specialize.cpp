@@ -1,6 +1,15 @@
 #include "spirv_specialize.h"
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <cstdio>
 #include <stdexcept>
+#include <system_error>
+#include <utility>
 
 #include <spirv-tools/optimizer.hpp>
 
@@ -35,6 +44,111 @@ std::vector<std::uint32_t> specialize_spirv(const std::uint32_t* words, std::siz
         throw std::runtime_error("could not specialize the SPIR-V of " + name + " on the host:" +
                                  (messages.empty() ? std::string(" SPIRV-Tools gave no reason") : messages));
     return specialized;
+}
+
+namespace {
+
+// 64-bit FNV-1a, continued from `hash`.
+std::uint64_t fnv1a(const void* data, std::size_t bytes, std::uint64_t hash = 14695981039346656037ull) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < bytes; ++i) hash = (hash ^ p[i]) * 1099511628211ull;
+    return hash;
+}
+
+// The values in constant-id order, as text: part of the cache's key and of
+// its files.
+std::string values_text(const SpecValues& values) {
+    std::vector<std::pair<std::uint32_t, std::string>> sorted(values.begin(), values.end());
+    std::sort(sorted.begin(), sorted.end());
+    std::string text;
+    for (const auto& [id, value] : sorted) text += std::to_string(id) + "=" + value + ";";
+    return text;
+}
+
+// A cache file: this magic, the input's word count and hash, the values'
+// text and its length, the output's word count and hash, the output.
+constexpr char kCacheMagic[8] = {'L', 'C', 'S', 'P', 'V', 'C', '1', '\n'};
+
+struct CacheHeader {
+    char magic[8];
+    std::uint64_t input_words, input_hash, values_bytes, output_words, output_hash;
+};
+
+std::vector<std::uint32_t> read_cached(const std::filesystem::path& file, const CacheHeader& want,
+                                       const std::string& values) {
+    std::ifstream in(file, std::ios::binary);
+    CacheHeader got{};
+    if (!in.read(reinterpret_cast<char*>(&got), sizeof got)) return {};
+    if (std::memcmp(got.magic, want.magic, sizeof got.magic) != 0 || got.input_words != want.input_words ||
+        got.input_hash != want.input_hash || got.values_bytes != values.size() || got.output_words == 0 ||
+        got.output_words > (std::uint64_t(1) << 26))
+        return {};
+    std::string stored(values.size(), '\0');
+    if (!in.read(stored.data(), std::streamsize(stored.size())) || stored != values) return {};
+    std::vector<std::uint32_t> words(got.output_words);
+    if (!in.read(reinterpret_cast<char*>(words.data()), std::streamsize(words.size() * sizeof(std::uint32_t))))
+        return {};
+    if (in.peek() != std::ifstream::traits_type::eof()) return {};
+    if (fnv1a(words.data(), words.size() * sizeof(std::uint32_t)) != got.output_hash) return {};
+    return words;
+}
+
+void write_cached(const std::filesystem::path& dir, const std::filesystem::path& file, CacheHeader header,
+                  const std::string& values, const std::vector<std::uint32_t>& words) {
+    std::error_code error;
+    std::filesystem::create_directories(dir, error);
+    if (error) return;
+    header.output_words = words.size();
+    header.output_hash = fnv1a(words.data(), words.size() * sizeof(std::uint32_t));
+    const std::filesystem::path temporary = file.string() + ".tmp-" + std::to_string(::getpid());
+    {
+        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        out.write(reinterpret_cast<const char*>(&header), sizeof header);
+        out.write(values.data(), std::streamsize(values.size()));
+        out.write(reinterpret_cast<const char*>(words.data()), std::streamsize(words.size() * sizeof(std::uint32_t)));
+        if (!out.flush()) {
+            out.close();
+            std::filesystem::remove(temporary, error);
+            return;
+        }
+    }
+    std::filesystem::rename(temporary, file, error);
+    if (error) std::filesystem::remove(temporary, error);
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> specialize_spirv_cached(const std::uint32_t* words, std::size_t word_count,
+                                                   const SpecValues& values, const std::string& name,
+                                                   const std::filesystem::path& cache_dir) {
+    if (cache_dir.empty()) return specialize_spirv(words, word_count, values, name);
+    const std::string text = values_text(values);
+    CacheHeader header{};
+    std::memcpy(header.magic, kCacheMagic, sizeof header.magic);
+    header.input_words = word_count;
+    header.input_hash = fnv1a(words, word_count * sizeof(std::uint32_t));
+    header.values_bytes = text.size();
+    char key[17];
+    std::snprintf(key, sizeof key, "%016llx",
+                  static_cast<unsigned long long>(fnv1a(text.data(), text.size(), header.input_hash)));
+    const std::filesystem::path file = cache_dir / ("spirv-" + std::string(key) + ".bin");
+    std::vector<std::uint32_t> cached = read_cached(file, header, text);
+    if (!cached.empty()) return cached;
+    std::vector<std::uint32_t> specialized = specialize_spirv(words, word_count, values, name);
+    write_cached(cache_dir, file, header, text, specialized);
+    return specialized;
+}
+
+std::filesystem::path spirv_cache_dir() {
+    if (const char* v = std::getenv("LC_SPIRV_CACHE")) {
+        const std::string dir = v;
+        return dir.empty() || dir == "off" ? std::filesystem::path() : std::filesystem::path(dir);
+    }
+    if (const char* v = std::getenv("XDG_CACHE_HOME"); v != nullptr && *v != '\0')
+        return std::filesystem::path(v) / "lightcuts";
+    if (const char* v = std::getenv("HOME"); v != nullptr && *v != '\0')
+        return std::filesystem::path(v) / ".cache" / "lightcuts";
+    return {};
 }
 
 }  // namespace lc::vk

@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -28,5 +29,23 @@ using SpecValues = std::unordered_map<std::uint32_t, std::string>;
 // messages if the optimizer fails.
 std::vector<std::uint32_t> specialize_spirv(const std::uint32_t* words, std::size_t word_count,
                                             const SpecValues& values, const std::string& name);
+
+// specialize_spirv's module, kept in `cache_dir` between runs (as Mesa keeps
+// the machine code it compiles): one file per module and set of values,
+// named by a hash of both and holding both again, so that a file made for
+// other inputs, or cut short, or changed, is never used; it is made afresh
+// and written over. SPIRV-Tools takes 0.07-0.09 s for the room's Lightcuts
+// kernel, on the critical path of every lavapipe render's set-up
+// (docs/results/lavapipe.md, section 11). Files are written to a temporary
+// name and renamed, so concurrent renders share the folder safely. An empty
+// `cache_dir`, or one that cannot be read or written, only means no cache.
+std::vector<std::uint32_t> specialize_spirv_cached(const std::uint32_t* words, std::size_t word_count,
+                                                   const SpecValues& values, const std::string& name,
+                                                   const std::filesystem::path& cache_dir);
+
+// Where specialize_spirv_cached keeps modules: LC_SPIRV_CACHE if set ("off"
+// or empty: nowhere), else $XDG_CACHE_HOME/lightcuts, else
+// $HOME/.cache/lightcuts, else nowhere.
+std::filesystem::path spirv_cache_dir();
 
 }  // namespace lc::vk

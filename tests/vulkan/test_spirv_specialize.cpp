@@ -2,8 +2,13 @@
 // module SPIRV-Tools returns is valid, has nothing left to specialize, has
 // lost the code the values switch off, and renders the images the driver's
 // own specialization renders, bit for bit.
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cstdint>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -94,6 +99,66 @@ TEST(SpirvSpecialize, DropsTheCodeOfSwitchedOffFeatures) {
                 kLightcutsWords, all, none);
     EXPECT_LT(all, kLightcutsWords);
     EXPECT_LT(double(none), 0.8 * double(all)) << none << " words against " << all;
+}
+
+// The cache between runs (specialize_spirv_cached): it gives the module
+// specialize_spirv gives; a second call reads the file the first wrote
+// (the same file, not written again); a file cut short or with a changed
+// word is not used but made afresh; other values get a file of their own;
+// and a folder that cannot be written only means no cache.
+TEST(SpirvSpecialize, CacheGivesTheSameModuleAndNeverUsesABadFile) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("lc-spirv-cache-test-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const vk::SpecValues values = lightcuts_values(false);
+    const std::vector<std::uint32_t> fresh =
+        vk::specialize_spirv(lc_spirv_lightcuts, kLightcutsWords, values, "lightcuts.comp");
+    auto cached = [&](const vk::SpecValues& v, const fs::path& d) {
+        return vk::specialize_spirv_cached(lc_spirv_lightcuts, kLightcutsWords, v, "lightcuts.comp", d);
+    };
+    auto inode = [](const fs::path& f) {
+        struct stat st {};
+        return ::stat(f.c_str(), &st) == 0 ? st.st_ino : ino_t(0);
+    };
+
+    EXPECT_EQ(cached(values, dir), fresh);
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(dir)) files.push_back(e.path());
+    ASSERT_EQ(files.size(), 1u);
+    const fs::path file = files[0];
+    const auto size = fs::file_size(file);
+    const ino_t first = inode(file);
+    EXPECT_EQ(cached(values, dir), fresh);
+    EXPECT_EQ(inode(file), first) << "a good file was made again";
+
+    // One changed word of the module: not used, made again.
+    {
+        std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(std::streamoff(size - 8));
+        const char junk[4] = {'\x5a', '\x5a', '\x5a', '\x5a'};
+        f.write(junk, sizeof junk);
+    }
+    EXPECT_EQ(cached(values, dir), fresh);
+    EXPECT_NE(inode(file), first);
+    EXPECT_EQ(fs::file_size(file), size);
+    // Cut short: the same.
+    fs::resize_file(file, size / 2);
+    EXPECT_EQ(cached(values, dir), fresh);
+    EXPECT_EQ(fs::file_size(file), size);
+
+    // Other values: their own file and module.
+    const vk::SpecValues others = lightcuts_values(true);
+    EXPECT_EQ(cached(others, dir), vk::specialize_spirv(lc_spirv_lightcuts, kLightcutsWords, others, "lightcuts.comp"));
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 2);
+    fs::remove_all(dir);
+
+    // A folder that cannot be made (under a file): no cache, the same module.
+    const fs::path blocker = dir.string() + "-file";
+    std::ofstream(blocker) << "not a folder";
+    EXPECT_EQ(cached(values, blocker / "cache"), fresh);
+    fs::remove(blocker);
+    // No folder: no cache.
+    EXPECT_EQ(cached(values, fs::path()), fresh);
 }
 
 TEST(SpirvSpecialize, RefusesAModuleItCannotReadNamingTheKernel) {
