@@ -16,6 +16,7 @@
 
 #include "lightcuts/error.h"
 #include "lightcuts/image.h"
+#include "lightcuts/output_set.h"
 
 namespace lc {
 
@@ -29,6 +30,7 @@ namespace {
 template <class Write>
 void write_via_temp(const fs::path& file, Write&& write) {
     const fs::path tmp = temporary_path_for(file);
+    const int tracked = track_temporary(tmp);  // a signal removes it (remove_temporaries_on_signal)
     std::string problem;
     try {
         problem = write(tmp);
@@ -38,11 +40,15 @@ void write_via_temp(const fs::path& file, Write&& write) {
     if (problem.empty()) {
         std::error_code ec;
         fs::rename(tmp, file, ec);
-        if (!ec) return;
+        if (!ec) {
+            untrack_temporary(tracked);
+            return;
+        }
         problem = "cannot rename temporary file into place: " + ec.message();
     }
     std::error_code ignored;
     fs::remove(tmp, ignored);
+    untrack_temporary(tracked);
     throw std::runtime_error(file.string() + ": " + problem);
 }
 

@@ -256,6 +256,8 @@ int main(int argc, char** argv) {
     info->add_option("--camera", info_options.camera, "glTF scenes: the perspective camera of this name");
 
     CLI11_PARSE(app, argc, argv);
+    // Ctrl-C or a kill during a render leaves no temporary beside its outputs.
+    lc::remove_temporaries_on_signal();
     try {
         if (*render) return run_render(r);
         if (*compare) return run_compare(cmp_image, cmp_ref, cmp_heatmap, cmp_json);

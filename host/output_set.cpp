@@ -2,9 +2,12 @@
 #include "lightcuts/output_set.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstring>
 #include <fstream>
+#include <new>
 #include <stdexcept>
 #include <system_error>
 
@@ -25,6 +28,26 @@ struct Placement {
     fs::path backup;   // where the file the output replaces was moved; "" if none
     bool placed = false;
 };
+
+// The temporaries remove_temporaries_on_signal's handler removes: copies of
+// their names in a fixed table it can read without locks or allocation.
+// A name is freed by untrack_temporary only while no handler runs: the
+// handler counts itself in before it reads the table, and untrack clears the
+// slot before it reads the count (sequentially consistent atomics, so one of
+// the two sees the other). A name a handler may still read is left alone;
+// the process is ending then anyway.
+constexpr int kTrackedSlots = 64;
+std::atomic<char*> g_tracked[kTrackedSlots];
+std::atomic<int> g_handlers_running{0};
+
+extern "C" void remove_temporaries_and_reraise(int signal_number) {
+    g_handlers_running.fetch_add(1);
+    for (std::atomic<char*>& slot : g_tracked)
+        if (const char* name = slot.load()) ::unlink(name);
+    // SA_RESETHAND put back the default action: this ends the process as
+    // the signal would have, with the status a shell reports for it.
+    ::raise(signal_number);
+}
 
 fs::path identity_of(const fs::path& file) {
     std::error_code ec;
@@ -88,6 +111,37 @@ fs::path preview_path(const fs::path& image) { return fs::path(image).replace_ex
 
 }  // namespace
 
+int track_temporary(const fs::path& file) noexcept {
+    const std::string& name = file.native();
+    char* copy = new (std::nothrow) char[name.size() + 1];
+    if (copy == nullptr) return -1;
+    std::memcpy(copy, name.c_str(), name.size() + 1);
+    for (int i = 0; i < kTrackedSlots; ++i) {
+        char* expected = nullptr;
+        if (g_tracked[i].compare_exchange_strong(expected, copy)) return i;
+    }
+    delete[] copy;
+    return -1;
+}
+
+void untrack_temporary(int handle) noexcept {
+    if (handle < 0 || handle >= kTrackedSlots) return;
+    char* name = g_tracked[handle].exchange(nullptr);
+    if (g_handlers_running.load() == 0) delete[] name;
+}
+
+void remove_temporaries_on_signal() {
+    for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+        struct sigaction current {};
+        if (::sigaction(signal_number, nullptr, &current) != 0 || current.sa_handler == SIG_IGN) continue;
+        struct sigaction action {};
+        action.sa_handler = remove_temporaries_and_reraise;
+        sigemptyset(&action.sa_mask);
+        action.sa_flags = SA_RESETHAND;
+        ::sigaction(signal_number, &action, nullptr);
+    }
+}
+
 OutputSet::OutputSet(OutputSet&& other) noexcept
     : inputs_(std::move(other.inputs_)), outputs_(std::move(other.outputs_)), committed_(other.committed_) {
     other.outputs_.clear();
@@ -98,6 +152,7 @@ OutputSet::~OutputSet() {
     for (const Output& out : outputs_) {
         std::error_code ignored;
         fs::remove(out.temporary, ignored);
+        untrack_temporary(out.tracked);
     }
 }
 
@@ -119,8 +174,15 @@ fs::path OutputSet::add(const fs::path& file, std::string_view what) {
         if (same_file(name.identity, out.name.identity))
             throw std::invalid_argument(label + ": is also the " + out.name.what);
     fs::path temporary = temporary_path_for(file);
-    create_empty(temporary, label);
-    outputs_.push_back({std::move(name), temporary});
+    // Tracked before it exists, so no signal can come between the two.
+    const int tracked = track_temporary(temporary);
+    try {
+        create_empty(temporary, label);
+    } catch (...) {
+        untrack_temporary(tracked);
+        throw;
+    }
+    outputs_.push_back({std::move(name), temporary, tracked});
     return temporary;
 }
 
@@ -142,6 +204,7 @@ void OutputSet::commit() {
         throw std::runtime_error(files[i].string() + ": " + problem);
     }
     committed_ = true;
+    for (const Output& out : outputs_) untrack_temporary(out.tracked);
     for (const Placement& step : steps) {
         std::error_code ignored;
         if (!step.backup.empty()) fs::remove(step.backup, ignored);

@@ -182,5 +182,18 @@ printf old | cmp -s - "$tmp/late.exr" || fail "the failed render did not put the
 rmdir "$tmp/late.json" && rm "$tmp/late.exr"
 no_output late "a rename that failed after the render"
 
+# A render ended by a signal (SIGTERM: a kill, or the end of a CI job; the
+# same handler takes SIGINT and SIGHUP) removes its temporaries and exits as
+# the signal would have (status 128 + 15). The render would run for a minute.
+"$exe" render "$root/scenes/room/room.json" -o "$tmp/killed.exr" --width 512 --height 512 --device cpu \
+  --method brute --threads 1 --stats "$tmp/killed.json" >"$tmp/log_killed.txt" 2>&1 &
+pid=$!
+for _ in $(seq 1000); do compgen -G "$tmp/killed.json.tmp-*" >/dev/null && break; sleep 0.01; done
+compgen -G "$tmp/killed.json.tmp-*" >/dev/null || fail "the render to be killed reserved no outputs"
+kill -TERM "$pid"
+status=0; wait "$pid" || status=$?
+[ "$status" -eq 143 ] || fail "a render ended by SIGTERM exited with status $status, not 143"
+no_output killed "a render ended by SIGTERM"
+
 echo "$(( failures == 0 ? 1 : 0 )) passed, $failures failed"
 [ "$failures" -eq 0 ]

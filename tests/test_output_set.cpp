@@ -2,11 +2,13 @@
 // work, and after any failure no output and no temporary is left and the
 // files the outputs would have replaced are as they were.
 #include <algorithm>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <unistd.h>
 
@@ -82,6 +84,41 @@ TEST_F(OutputSetTest, UncommittedSetLeavesNothing) {
     }
     EXPECT_EQ(entries(), (std::set<std::string>{"b.txt"}));
     EXPECT_EQ(read(at("b.txt")), "old");
+}
+
+// A signal that ends the process mid-render: with remove_temporaries_on_signal
+// nothing is left but the file that was there before; without it (the
+// control) the temporaries stay, so the test sees the difference.
+TEST_F(OutputSetTest, SignalLeavesNoTemporaries) {
+    // The "fast" style forks here, so the child writes in this test's folder
+    // (the "threadsafe" one would run the test again, in a folder of its own).
+    GTEST_FLAG_SET(death_test_style, "fast");
+    write(at("b.txt"), "old");
+    auto render_then_signal = [&](bool handled) {
+        if (handled) remove_temporaries_on_signal();
+        OutputSet set;
+        write(set.add(at("a.txt"), "first"), "A");
+        set.add(at("b.txt"), "second");
+        std::raise(SIGTERM);
+    };
+    EXPECT_EXIT(render_then_signal(true), ::testing::KilledBySignal(SIGTERM), "");
+    EXPECT_EQ(entries(), (std::set<std::string>{"b.txt"}));
+    EXPECT_EQ(read(at("b.txt")), "old");
+
+    EXPECT_EXIT(render_then_signal(false), ::testing::KilledBySignal(SIGTERM), "");
+    EXPECT_EQ(entries().size(), 3u) << "without the handler the two temporaries stay";
+}
+
+// The table of tracked temporaries is bounded; a full table refuses (-1),
+// and untracking frees its slots for reuse.
+TEST(TrackTemporary, FullTableRefusesAndFreedSlotsAreReused) {
+    std::vector<int> handles;
+    for (int i = 0; i < 70; ++i) handles.push_back(track_temporary("/nonexistent/lc_tracked_" + std::to_string(i)));
+    EXPECT_EQ(std::count(handles.begin(), handles.end(), -1), 6);
+    for (int handle : handles) untrack_temporary(handle);
+    const int again = track_temporary("/nonexistent/lc_tracked_again");
+    EXPECT_GE(again, 0);
+    untrack_temporary(again);
 }
 
 TEST_F(OutputSetTest, RefusesWhatCannotBeWrittenBeforeTheWork) {

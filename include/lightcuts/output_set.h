@@ -2,7 +2,8 @@
 // from one long computation (an image, its preview, a stats file) names them
 // all before the computation, so every refusal comes before the work, writes
 // each to the temporary it is given, then commits: either every file is in
-// place or none is changed, and no temporary is left behind.
+// place or none is changed, and no temporary is left behind; also when a
+// signal ends the program, once it has called remove_temporaries_on_signal.
 #pragma once
 
 #include <filesystem>
@@ -54,11 +55,28 @@ private:
     struct Output {
         Named name;
         std::filesystem::path temporary;
+        int tracked = -1;  // track_temporary's handle
     };
     std::vector<Named> inputs_;
     std::vector<Output> outputs_;
     bool committed_ = false;
 };
+
+// Makes SIGINT, SIGTERM and SIGHUP remove the temporaries of every
+// uncommitted OutputSet (and those of the image writers of lightcuts/image.h
+// while they write) before the signal ends the process as it would have. A signal the
+// process ignores (SIGHUP under nohup, say) stays ignored. For programs, not
+// libraries: it replaces the signals' handlers. At most 64 temporaries are
+// tracked at a time; more are still removed on every other way out.
+void remove_temporaries_on_signal();
+
+// Tracks a temporary this process is writing, for remove_temporaries_on_signal.
+// Returns a handle for untrack_temporary; -1 when the table is full. Never
+// track a file that must survive: the handler removes it.
+int track_temporary(const std::filesystem::path& file) noexcept;
+// Stops tracking (handle -1: nothing). Call after the temporary was removed
+// or renamed, so a signal between the two finds nothing left behind.
+void untrack_temporary(int handle) noexcept;
 
 // The files of one render.
 struct RenderOutputs {
