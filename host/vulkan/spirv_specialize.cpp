@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -116,11 +117,36 @@ void write_cached(const std::filesystem::path& dir, const std::filesystem::path&
     if (error) std::filesystem::remove(temporary, error);
 }
 
+// Removes the cache's modules beyond the `keep` used last, and temporaries
+// older than an hour (a writer killed between writing and renaming).
+// Another process may be removing the same files: every error is ignored.
+void prune_cache(const std::filesystem::path& dir, std::size_t keep) {
+    namespace fs = std::filesystem;
+    std::error_code error;
+    const auto now = fs::file_time_type::clock::now();
+    std::vector<std::pair<fs::file_time_type, fs::path>> modules;
+    for (fs::directory_iterator it(dir, error), end; !error && it != end; it.increment(error)) {
+        const std::string file = it->path().filename().string();
+        if (file.rfind("spirv-", 0) != 0) continue;
+        std::error_code time_error;
+        const fs::file_time_type time = fs::last_write_time(it->path(), time_error);
+        if (time_error) continue;
+        if (file.find(".bin.tmp-") != std::string::npos) {
+            if (now - time > std::chrono::hours(1)) fs::remove(it->path(), time_error);
+        } else if (file.size() > 4 && file.compare(file.size() - 4, 4, ".bin") == 0) {
+            modules.emplace_back(time, it->path());
+        }
+    }
+    if (modules.size() <= keep) return;
+    std::sort(modules.begin(), modules.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (std::size_t i = keep; i < modules.size(); ++i) fs::remove(modules[i].second, error);
+}
+
 }  // namespace
 
 std::vector<std::uint32_t> specialize_spirv_cached(const std::uint32_t* words, std::size_t word_count,
                                                    const SpecValues& values, const std::string& name,
-                                                   const std::filesystem::path& cache_dir) {
+                                                   const std::filesystem::path& cache_dir, std::size_t keep_files) {
     if (cache_dir.empty()) return specialize_spirv(words, word_count, values, name);
     const std::string text = values_text(values);
     CacheHeader header{};
@@ -133,9 +159,14 @@ std::vector<std::uint32_t> specialize_spirv_cached(const std::uint32_t* words, s
                   static_cast<unsigned long long>(fnv1a(text.data(), text.size(), header.input_hash)));
     const std::filesystem::path file = cache_dir / ("spirv-" + std::string(key) + ".bin");
     std::vector<std::uint32_t> cached = read_cached(file, header, text);
-    if (!cached.empty()) return cached;
+    if (!cached.empty()) {
+        std::error_code ignored;  // marks it used, for prune_cache
+        std::filesystem::last_write_time(file, std::filesystem::file_time_type::clock::now(), ignored);
+        return cached;
+    }
     std::vector<std::uint32_t> specialized = specialize_spirv(words, word_count, values, name);
     write_cached(cache_dir, file, header, text, specialized);
+    prune_cache(cache_dir, std::max<std::size_t>(keep_files, 1));
     return specialized;
 }
 

@@ -39,9 +39,14 @@ std::vector<std::uint32_t> specialize_spirv(const std::uint32_t* words, std::siz
 // (docs/results/lavapipe.md, section 11). Files are written to a temporary
 // name and renamed, so concurrent renders share the folder safely. An empty
 // `cache_dir`, or one that cannot be read or written, only means no cache.
+// The folder keeps the `keep_files` modules used last (a file's time is
+// brought up to date when it is used): each new file removes the oldest
+// beyond that, and temporaries a killed writer left an hour or more ago.
+// Each file is 50-80 KiB for the Lightcuts kernel.
 std::vector<std::uint32_t> specialize_spirv_cached(const std::uint32_t* words, std::size_t word_count,
                                                    const SpecValues& values, const std::string& name,
-                                                   const std::filesystem::path& cache_dir);
+                                                   const std::filesystem::path& cache_dir,
+                                                   std::size_t keep_files = 64);
 
 // Where specialize_spirv_cached keeps modules: LC_SPIRV_CACHE if set ("off"
 // or empty: nowhere), else $XDG_CACHE_HOME/lightcuts, else

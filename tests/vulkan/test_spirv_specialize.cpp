@@ -5,10 +5,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -159,6 +161,59 @@ TEST(SpirvSpecialize, CacheGivesTheSameModuleAndNeverUsesABadFile) {
     fs::remove(blocker);
     // No folder: no cache.
     EXPECT_EQ(cached(values, fs::path()), fresh);
+}
+
+// The folder keeps the modules used last: a new file removes the least
+// recently used beyond keep_files, and old temporaries, never anything else.
+TEST(SpirvSpecialize, CacheKeepsTheModulesUsedLast) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / ("lc-spirv-prune-test-" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    auto with_heap = [](const char* slots) {
+        vk::SpecValues v = lightcuts_values(false);
+        v[gpu::kSpecHeapSlots] = slots;
+        return v;
+    };
+    auto cached = [&](const char* slots) {
+        return vk::specialize_spirv_cached(lc_spirv_lightcuts, kLightcutsWords, with_heap(slots), "lightcuts.comp",
+                                           dir, 2);
+    };
+    auto files = [&] {
+        std::set<std::string> names;
+        for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
+        return names;
+    };
+    cached("8");
+    const std::set<std::string> first = files();
+    ASSERT_EQ(first.size(), 1u);
+    // File times are set explicitly: two files written within one tick of
+    // the file system's clock would otherwise tie.
+    const auto past = fs::file_time_type::clock::now() - std::chrono::hours(2);
+    fs::last_write_time(dir / *first.begin(), past);
+    std::ofstream(dir / "spirv-0.bin.tmp-1") << "left by a killed writer";
+    fs::last_write_time(dir / "spirv-0.bin.tmp-1", past);
+    std::ofstream(dir / "spirv-0.bin.tmp-2") << "being written";
+    std::ofstream(dir / "notes.txt") << "not the cache's";
+    cached("16");
+    std::set<std::string> second = files();
+    EXPECT_EQ(second.size(), 4u) << "two modules, the fresh temporary and notes.txt";
+    EXPECT_EQ(second.count("spirv-0.bin.tmp-1"), 0u) << "an old temporary was kept";
+    EXPECT_EQ(second.count("notes.txt"), 1u);
+    std::string module16;
+    for (const std::string& f : second)
+        if (f != *first.begin() && f.rfind("spirv-", 0) == 0 && f.find(".tmp-") == std::string::npos) module16 = f;
+    ASSERT_FALSE(module16.empty());
+    // "8" used again (its time brought up to date), then a third module: the
+    // module of "16" is the one used longest ago, and goes.
+    fs::last_write_time(dir / *first.begin(), past);
+    fs::last_write_time(dir / module16, past + std::chrono::minutes(1));
+    cached("8");
+    cached("32");
+    std::set<std::string> third = files();
+    EXPECT_EQ(third.size(), 4u);
+    EXPECT_EQ(third.count(*first.begin()), 1u) << "the module used last but one was removed";
+    EXPECT_EQ(third.count(module16), 0u) << "the module used longest ago was kept";
+    fs::remove_all(dir);
 }
 
 TEST(SpirvSpecialize, RefusesAModuleItCannotReadNamingTheKernel) {
