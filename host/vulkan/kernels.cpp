@@ -133,11 +133,12 @@ Kernels::Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMetho
     spec.texel_reads = switches.texel_reads;
     spec.heap_private = switches.heap_private;
     for (std::uint32_t b = 0; b < gpu::kSceneArrayCount; ++b) spec.chunk_shift[b] = switches.chunks.shift[b];
-    // Both pipelines at once: a driver that compiles on the host (lavapipe,
-    // when it specialized the kernels itself: about 0.17 s for the
-    // camera-ray kernel, 0.86 s for Lightcuts') gets a core for each, and
-    // so does the host's specialization. vkCreateComputePipelines may run
-    // on several threads without a pipeline cache.
+    // Both pipelines at once: a driver that compiles on the host (lavapipe:
+    // about 0.20 s for Lightcuts' kernel once the host has specialized it,
+    // 0.86 s when the driver specializes it, LC_VK_SPECIALIZE_ON_HOST=off)
+    // gets a core for each, and so does the host's specialization.
+    // vkCreateComputePipelines may run on several threads without a
+    // pipeline cache.
     std::future<Pipeline> primary = std::async(std::launch::async, [&] {
         return compute_pipeline(ctx, layout,
                                 {lc_spirv_primary, sizeof lc_spirv_primary, "primary.comp (camera rays)"}, spec,
