@@ -92,6 +92,7 @@ TEST_F(OutputSetTest, UncommittedSetLeavesNothing) {
 TEST_F(OutputSetTest, SignalLeavesNoTemporaries) {
     // The "fast" style forks here, so the child writes in this test's folder
     // (the "threadsafe" one would run the test again, in a folder of its own).
+    const std::string style = GTEST_FLAG_GET(death_test_style);
     GTEST_FLAG_SET(death_test_style, "fast");
     write(at("b.txt"), "old");
     auto render_then_signal = [&](bool handled) {
@@ -107,6 +108,7 @@ TEST_F(OutputSetTest, SignalLeavesNoTemporaries) {
 
     EXPECT_EXIT(render_then_signal(false), ::testing::KilledBySignal(SIGTERM), "");
     EXPECT_EQ(entries().size(), 3u) << "without the handler the two temporaries stay";
+    GTEST_FLAG_SET(death_test_style, style);
 }
 
 // The table of tracked temporaries is bounded; a full table refuses (-1),

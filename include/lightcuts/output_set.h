@@ -64,10 +64,11 @@ private:
 
 // Makes SIGINT, SIGTERM and SIGHUP remove the temporaries of every
 // uncommitted OutputSet (and those of the image writers of lightcuts/image.h
-// while they write) before the signal ends the process as it would have. A signal the
-// process ignores (SIGHUP under nohup, say) stays ignored. For programs, not
-// libraries: it replaces the signals' handlers. At most 64 temporaries are
-// tracked at a time; more are still removed on every other way out.
+// while they write) before the signal ends the process as it would have.
+// A signal the process ignores (SIGHUP under nohup, say) stays ignored. For
+// programs, not libraries: it replaces the signals' handlers. At most 64
+// temporaries are tracked at a time; more are still removed on every other
+// way out.
 void remove_temporaries_on_signal();
 
 // Tracks a temporary this process is writing, for remove_temporaries_on_signal.
