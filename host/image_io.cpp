@@ -16,7 +16,7 @@
 
 #include "lightcuts/error.h"
 #include "lightcuts/image.h"
-#include "lightcuts/output_set.h"
+#include "lightcuts/temporaries.h"
 
 namespace lc {
 

@@ -3,7 +3,8 @@
 // all before the computation, so every refusal comes before the work, writes
 // each to the temporary it is given, then commits: either every file is in
 // place or none is changed, and no temporary is left behind; also when a
-// signal ends the program, once it has called remove_temporaries_on_signal.
+// signal ends the program, once it has called remove_temporaries_on_signal
+// (temporaries.h).
 #pragma once
 
 #include <filesystem>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "render.h"
+#include "temporaries.h"
 
 namespace lc {
 
@@ -61,23 +63,6 @@ private:
     std::vector<Output> outputs_;
     bool committed_ = false;
 };
-
-// Makes SIGINT, SIGTERM and SIGHUP remove the temporaries of every
-// uncommitted OutputSet (and those of the image writers of lightcuts/image.h
-// while they write) before the signal ends the process as it would have.
-// A signal the process ignores (SIGHUP under nohup, say) stays ignored. For
-// programs, not libraries: it replaces the signals' handlers. At most 64
-// temporaries are tracked at a time; more are still removed on every other
-// way out.
-void remove_temporaries_on_signal();
-
-// Tracks a temporary this process is writing, for remove_temporaries_on_signal.
-// Returns a handle for untrack_temporary; -1 when the table is full. Never
-// track a file that must survive: the handler removes it.
-int track_temporary(const std::filesystem::path& file) noexcept;
-// Stops tracking (handle -1: nothing). Call after the temporary was removed
-// or renamed, so a signal between the two finds nothing left behind.
-void untrack_temporary(int handle) noexcept;
 
 // The files of one render.
 struct RenderOutputs {

@@ -1,0 +1,70 @@
+// Temporaries removed on a signal (include/lightcuts/temporaries.h).
+#include "lightcuts/temporaries.h"
+
+#include <atomic>
+#include <csignal>
+#include <filesystem>
+#include <cstring>
+#include <new>
+#include <string>
+
+#include <unistd.h>
+
+namespace lc {
+
+namespace {
+
+// The temporaries remove_temporaries_on_signal's handler removes: copies of
+// their names in a fixed table it can read without locks or allocation.
+// A name is freed by untrack_temporary only while no handler runs: the
+// handler counts itself in before it reads the table, and untrack clears the
+// slot before it reads the count (sequentially consistent atomics, so one of
+// the two sees the other). A name a handler may still read is left alone;
+// the process is ending then anyway.
+constexpr int kTrackedSlots = 64;
+std::atomic<char*> g_tracked[kTrackedSlots];
+std::atomic<int> g_handlers_running{0};
+
+extern "C" void remove_temporaries_and_reraise(int signal_number) {
+    g_handlers_running.fetch_add(1);
+    for (std::atomic<char*>& slot : g_tracked)
+        if (const char* name = slot.load()) ::unlink(name);
+    // SA_RESETHAND put back the default action: this ends the process as
+    // the signal would have, with the status a shell reports for it.
+    ::raise(signal_number);
+}
+
+}  // namespace
+
+int track_temporary(const std::filesystem::path& file) noexcept {
+    const std::string& name = file.native();
+    char* copy = new (std::nothrow) char[name.size() + 1];
+    if (copy == nullptr) return -1;
+    std::memcpy(copy, name.c_str(), name.size() + 1);
+    for (int i = 0; i < kTrackedSlots; ++i) {
+        char* expected = nullptr;
+        if (g_tracked[i].compare_exchange_strong(expected, copy)) return i;
+    }
+    delete[] copy;
+    return -1;
+}
+
+void untrack_temporary(int handle) noexcept {
+    if (handle < 0 || handle >= kTrackedSlots) return;
+    char* name = g_tracked[handle].exchange(nullptr);
+    if (g_handlers_running.load() == 0) delete[] name;
+}
+
+void remove_temporaries_on_signal() {
+    for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+        struct sigaction current {};
+        if (::sigaction(signal_number, nullptr, &current) != 0 || current.sa_handler == SIG_IGN) continue;
+        struct sigaction action {};
+        action.sa_handler = remove_temporaries_and_reraise;
+        sigemptyset(&action.sa_mask);
+        action.sa_flags = SA_RESETHAND;
+        ::sigaction(signal_number, &action, nullptr);
+    }
+}
+
+}  // namespace lc
