@@ -74,22 +74,6 @@ struct Trace4Kernel {
 #undef LC_ON_TRIP
 };
 
-// The Vulkan kernels' light-node decoder (shared/light_node.h) over the
-// packed words (LightTree::words), run on the CPU: the tests check that
-// every node decodes to LightTree::nodes, which the CPU path reads.
-struct LightNodeDecoder {
-    const LightNodeWord* words = nullptr;
-    LightNodeFrame frame{};
-
-    uvec4 word(uint k) const { return uvec4(words[k].x, words[k].y, words[k].z, words[k].w); }
-
-#define LC_LIGHT_NODE_WORD(k) word(k)
-#define LC_LIGHT_NODE_FRAME frame
-#include "shared/light_node.h"
-#undef LC_LIGHT_NODE_WORD
-#undef LC_LIGHT_NODE_FRAME
-};
-
 // Texture lookups and materials at a point only (shared/textures.h): what
 // the host needs to sample textured emitters.
 struct TextureKernel {

@@ -71,15 +71,7 @@ static_assert(offsetof(GBufferTexel, v) == 44);
 static_assert(sizeof(CutEntry) == 8);
 static_assert(offsetof(CutEntry, error) == 4);
 
-static_assert(sizeof(LightNodeFrame) == 144);
-static_assert(offsetof(LightNodeFrame, step) == 60);
-static_assert(offsetof(LightNodeFrame, node_count) == 120);
-static_assert(offsetof(LightNodeFrame, everywhere_axis_oct) == 128);
-static_assert(offsetof(LightNodeFrame, everywhere_falloff_width) == 140);
-static_assert(sizeof(LightNodeWord) == 16);
-
-static_assert(sizeof(FrameParams) == 272);
-static_assert(offsetof(FrameParams, light_frame) == 128);
+static_assert(sizeof(FrameParams) == 128);
 static_assert(offsetof(FrameParams, light_samples) == 112);
 static_assert(offsetof(FrameParams, env_width) == 104);
 static_assert(offsetof(FrameParams, vpl_min_distance2) == 120);

@@ -20,15 +20,10 @@
 
 #include <algorithm>
 #include <atomic>
-#include <bit>
-#include <cfloat>
-#include <cstring>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <stdexcept>
-#include <string>
 #include <thread>
 #include <type_traits>
 
@@ -617,115 +612,7 @@ void flatten(const UninitializedVector<Cluster>& all, std::size_t leaf_count, st
     });
 }
 
-// A box plane quantized as pack_light_nodes stores it: origin + q * step
-// in float, as the kernels decode it (q * step is exact).
-float plane(float origin, float step, std::uint32_t q) { return origin + float(q) * step; }
-
-// The largest q whose plane is at most x (x >= origin).
-std::uint32_t plane_below(float x, float origin, float step) {
-    const double t = std::floor((double(x) - double(origin)) / double(step));
-    auto q = std::uint32_t(std::clamp(t, 0.0, double(gpu::kLightNodePlaneSteps)));
-    while (q > 0 && plane(origin, step, q) > x) --q;
-    return q;
-}
-
-// The smallest q whose plane is at least x (x at most the frame's top).
-std::uint32_t plane_above(float x, float origin, float step) {
-    const double t = std::ceil((double(x) - double(origin)) / double(step));
-    auto q = std::uint32_t(std::clamp(t, 0.0, double(gpu::kLightNodePlaneSteps)));
-    while (q < gpu::kLightNodePlaneSteps && plane(origin, step, q) < x) ++q;
-    return q;
-}
-
-// The smallest power of two (at least FLT_MIN) whose kLightNodePlaneSteps
-// steps from lo reach hi in float; 0 if none is finite.
-float plane_step(float lo, float hi) {
-    const double needed = (double(hi) - double(lo)) / gpu::kLightNodePlaneSteps;
-    int exponent = 0;
-    std::frexp(needed, &exponent);  // needed <= 2^exponent
-    float step = needed > 0.0 ? std::max(std::ldexp(1.0f, exponent - 1), FLT_MIN) : FLT_MIN;
-    while (std::isfinite(step) && !(plane(lo, step, gpu::kLightNodePlaneSteps) >= hi)) step *= 2.0f;
-    return std::isfinite(step) && std::isfinite(plane(lo, step, gpu::kLightNodePlaneSteps)) ? step : 0.0f;
-}
-
-constexpr const char* kLightTypeNames[gpu::kLightTypeCount] = {"point", "directional", "spot", "oriented", "VPL"};
-
-bool same_bits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
-
 }  // namespace
-
-void pack_light_nodes(LightTree& tree) {
-    const std::size_t count = tree.nodes.size();
-    if (count >= gpu::kLightNodeNoChild)
-        throw std::invalid_argument("light tree: " + std::to_string(count) + " nodes, more than the " +
-                                    std::to_string(gpu::kLightNodeNoChild - 1) + " a scene may have");
-    gpu::LightNodeFrame& f = tree.frame;
-    f = gpu::LightNodeFrame{};
-    f.node_count = std::uint32_t(count);
-    f.cone_base = std::uint32_t(count);
-    // The cone of every point and directional node, as flatten() writes it.
-    const EmissionCone everywhere = quantized(EmissionCone::everywhere(), f.everywhere_axis_oct);
-    f.everywhere_cos_theta_o = -1.0f;
-    f.everywhere_cos_theta_e = std::cos(everywhere.theta_e);
-    f.everywhere_falloff_width = everywhere.falloff_width;
-    for (std::uint32_t type = 0; type < gpu::kLightTypeCount; ++type) {
-        const std::uint32_t root = tree.roots[type];
-        if (root == gpu::kInvalidIndex) continue;
-        if (type >= gpu::kLightSpot) f.cone_base = std::min(f.cone_base, root);
-        const gpu::LightNode& r = tree.nodes[root];
-        const float lo[3] = {r.min_x, r.min_y, r.min_z}, hi[3] = {r.max_x, r.max_y, r.max_z};
-        for (int a = 0; a < 3; ++a) {
-            const float step = plane_step(lo[a], hi[a]);
-            if (step == 0.0f)
-                throw std::invalid_argument("light tree: the box of the " + std::string(kLightTypeNames[type]) +
-                                            " lights is too large to store (" + std::to_string(lo[a]) + " to " +
-                                            std::to_string(hi[a]) + ")");
-            f.origin[3 * type + a] = lo[a];
-            f.step[3 * type + a] = step;
-        }
-    }
-    tree.words.resize(gpu::kLightNodeWords * count + (count - f.cone_base));
-    std::atomic<bool> bad_cone{false};
-    parallel_for(count, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) {
-            gpu::LightNode& n = tree.nodes[i];
-            const std::uint32_t type = (n.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask;
-            const float* origin = f.origin + 3 * type;
-            const float* step = f.step + 3 * type;
-            const bool leaf = (n.flags & gpu::kNodeLeaf) != 0u;
-            const std::uint32_t link = (leaf ? gpu::kLightNodeNoChild : n.left) | type << gpu::kLightNodeTypeShift |
-                                       ((n.flags & gpu::kNodeRepFromRight) != 0u ? gpu::kLightNodeRepFromRight : 0u) |
-                                       ((n.flags & gpu::kNodeTwoSided) != 0u ? gpu::kLightNodeTwoSided : 0u);
-            tree.words[gpu::kLightNodeWords * i] = {std::bit_cast<std::uint32_t>(n.intensity_r),
-                                                    std::bit_cast<std::uint32_t>(n.intensity_g),
-                                                    std::bit_cast<std::uint32_t>(n.intensity_b), n.rep_light};
-            const std::uint32_t q[6] = {plane_below(n.min_x, origin[0], step[0]),
-                                        plane_below(n.min_y, origin[1], step[1]),
-                                        plane_below(n.min_z, origin[2], step[2]),
-                                        plane_above(n.max_x, origin[0], step[0]),
-                                        plane_above(n.max_y, origin[1], step[1]),
-                                        plane_above(n.max_z, origin[2], step[2])};
-            tree.words[gpu::kLightNodeWords * i + 1] = {link, q[0] | q[1] << 16, q[2] | q[3] << 16, q[4] | q[5] << 16};
-            // The CPU path reads `nodes`: the same boxes as the kernels decode.
-            n.min_x = plane(origin[0], step[0], q[0]);
-            n.min_y = plane(origin[1], step[1], q[1]);
-            n.min_z = plane(origin[2], step[2], q[2]);
-            n.max_x = plane(origin[0], step[0], q[3]);
-            n.max_y = plane(origin[1], step[1], q[4]);
-            n.max_z = plane(origin[2], step[2], q[5]);
-            if (i >= f.cone_base) {
-                tree.words[gpu::kLightNodeWords * count + (i - f.cone_base)] = {
-                    n.axis_oct, std::bit_cast<std::uint32_t>(n.cos_theta_o),
-                    std::bit_cast<std::uint32_t>(n.cos_theta_e), std::bit_cast<std::uint32_t>(n.falloff_width)};
-            } else if (n.axis_oct != f.everywhere_axis_oct || !same_bits(n.cos_theta_o, f.everywhere_cos_theta_o) ||
-                       !same_bits(n.cos_theta_e, f.everywhere_cos_theta_e) ||
-                       !same_bits(n.falloff_width, f.everywhere_falloff_width)) {
-                bad_cone = true;
-            }
-        }
-    });
-    if (bad_cone) throw std::logic_error("pack_light_nodes: a point or directional node without the everywhere cone");
-}
 
 std::uint32_t LightTree::root_count() const {
     std::uint32_t n = 0;
@@ -854,7 +741,6 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
         // The light indices of each tree follow those of the one before.
         flatten(all, leaf_count, lights, root, type, base, base_light, tree);
     }
-    pack_light_nodes(tree);
     tree.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return tree;
 }

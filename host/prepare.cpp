@@ -122,7 +122,6 @@ gpu::FrameParams make_frame_params(const PreparedScene& prepared, const RenderOp
     f.seed = options.seed;
     f.light_count = static_cast<std::uint32_t>(prepared.tree.lights.size());
     for (std::uint32_t t = 0; t < gpu::kLightTypeCount; ++t) f.roots[t] = prepared.tree.roots[t];
-    f.light_frame = prepared.tree.frame;
     f.loop_probe_rounds = 2;
     f.env_width = prepared.scene.environment.width;
     f.env_height = prepared.scene.environment.height;
@@ -152,8 +151,7 @@ std::vector<SceneArray> scene_arrays(const PreparedScene& p) {
         array("textures", p.scene.textures),
         array("texels", p.scene.texels),
         array("lights", p.tree.lights),
-        // 16-byte words: kLightNodeWords a node, then the cones (types.h).
-        array("light_tree_nodes", p.tree.words),
+        array("light_tree_nodes", p.tree.nodes),
         array("environment", p.scene.environment.rgb),
         // kBvh4NodeWords 16-byte words a node, as the kernels declare it.
         SceneArray{"wide_bvh_nodes", p.bvh.kernel_nodes.data(), sizeof(gpu::Bvh4Node) / gpu::kBvh4NodeWords,

@@ -57,7 +57,7 @@ LC_SCENE_ARRAY(Material, materials, kBindingMaterials)
 LC_SCENE_ARRAY(TextureInfo, textures, kBindingTextures)
 LC_SCENE_ARRAY(uint, texels, kBindingTexels)
 LC_SCENE_ARRAY(Light, lights, kBindingLights)
-LC_SCENE_ARRAY(uvec4, light_nodes, kBindingLightNodes)
+LC_SCENE_ARRAY(LightNode, light_nodes, kBindingLightNodes)
 LC_SCENE_ARRAY(float, environment, kBindingEnvironment)
 LC_SCENE_ARRAY(uvec4, wide_bvh_nodes, kBindingWideBvhNodes)
 layout(std430, binding = kBindingGBuffer) buffer GBuffer { GBufferTexel gbuffer[]; };
@@ -107,11 +107,14 @@ Light lc_light(uint i) {
                  uintBitsToFloat(c.z), c.w);
 }
 
-// Word k (16 bytes) of the light-tree nodes (types.h; decoded by
-// lc_light_node, shared/light_node.h).
-uvec4 lc_light_node_word(uint k) {
-    if (!kTexelReads) return lc_light_nodes(k);
-    return texelFetch(light_node_texels, int(k));
+LightNode lc_light_node(uint i) {
+    if (!kTexelReads) return lc_light_nodes(i);
+    const vec4 a = uintBitsToFloat(texelFetch(light_node_texels, int(4u * i)));
+    const vec4 b = uintBitsToFloat(texelFetch(light_node_texels, int(4u * i + 1u)));
+    const uvec4 c = texelFetch(light_node_texels, int(4u * i + 2u));
+    const uvec4 d = texelFetch(light_node_texels, int(4u * i + 3u));
+    return LightNode(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, uintBitsToFloat(c.x), c.y, c.z, c.w, d.x,
+                     uintBitsToFloat(d.y), uintBitsToFloat(d.z), uintBitsToFloat(d.w));
 }
 
 #define LC_BVH_NODE(i) lc_bvh_node(i)
@@ -122,8 +125,6 @@ uvec4 lc_light_node_word(uint k) {
 #define LC_TEXTURE(i) lc_textures(i)
 #define LC_TEXEL(i) lc_texels(i)
 #define LC_NORMALS(i) lc_normals(i)
-#define LC_LIGHT_NODE_WORD(k) lc_light_node_word(k)
-#define LC_LIGHT_NODE_FRAME frame.light_frame
 #define LC_LIGHT_NODE(i) lc_light_node(i)
 #define LC_VPL_MIN_DISTANCE2 frame.vpl_min_distance2
 #define LC_ENVIRONMENT_TEXEL(i) vec3(lc_environment(3u * (i)), lc_environment(3u * (i) + 1u), lc_environment(3u * (i) + 2u))
@@ -133,7 +134,6 @@ uvec4 lc_light_node_word(uint k) {
 #include "shared/color.h"
 #include "shared/octahedral.h"
 #include "shared/trace.h"
-#include "shared/light_node.h"
 #include "shared/textures.h"
 #include "shared/shading.h"
 

@@ -36,7 +36,7 @@ constexpr SceneBinding kSceneBindings[] = {
     {gpu::kBindingTextures, "textures", sizeof(gpu::TextureInfo)},
     {gpu::kBindingTexels, "texels", sizeof(std::uint32_t)},
     {gpu::kBindingLights, "lights", sizeof(gpu::Light)},
-    {gpu::kBindingLightNodes, "light_tree_nodes", sizeof(gpu::LightNodeWord)},
+    {gpu::kBindingLightNodes, "light_tree_nodes", sizeof(gpu::LightNode)},
     {gpu::kBindingEnvironment, "environment", sizeof(float)},
     {gpu::kBindingWideBvhNodes, "wide_bvh_nodes", sizeof(gpu::Bvh4Node) / gpu::kBvh4NodeWords},
     {gpu::kBindingFrame, "frame", sizeof(gpu::FrameParams)},  // appended by RenderSetup
@@ -76,7 +76,7 @@ static_assert(std::size(kTexelArrays) == gpu::kTexelBindingCount &&
               gpu::kBindingBvhNodeTexels == gpu::kBindingCount &&
               gpu::kBindingWideBvhNodeTexels == gpu::kBindingCount + gpu::kTexelBindingCount - 1);
 static_assert(sizeof(gpu::BvhNode) == 2 * kTexelBytes && sizeof(gpu::Triangle) == 3 * kTexelBytes &&
-              sizeof(gpu::Light) == 3 * kTexelBytes && sizeof(gpu::LightNodeWord) == kTexelBytes &&
+              sizeof(gpu::Light) == 3 * kTexelBytes && sizeof(gpu::LightNode) == 4 * kTexelBytes &&
               sizeof(gpu::Bvh4Node) == gpu::kBvh4NodeWords * kTexelBytes,
               "shaders/kernel.glsl unpacks these structs from whole texels");
 

@@ -70,12 +70,6 @@ struct LightTree {
     // rep_light index into `lights`.
     UninitializedVector<gpu::LightNode> nodes;
     UninitializedVector<gpu::Light> lights;
-    // The nodes as the Vulkan kernels read them (types.h, "A LightNode as
-    // the kernels read it"; pack_light_nodes): 32 bytes a node, and 16
-    // more for each node of a tree with cones. The CPU path reads `nodes`,
-    // whose boxes pack_light_nodes rounds to the same planes.
-    UninitializedVector<gpu::LightNodeWord> words;
-    gpu::LightNodeFrame frame{};
     std::array<std::uint32_t, gpu::kLightTypeCount> roots;
     // Lights with zero intensity: left out of the tree (they would only
     // widen the boxes of bright clusters) and out of `lights`.
@@ -111,15 +105,5 @@ enum class TreeBuilder {
 LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t seed,
                            TreeBuilder builder = TreeBuilder::kFast, double cone_scale = 1.0,
                            unsigned threads = 0);
-
-// Fills tree.words and tree.frame from tree.nodes and tree.roots (which
-// build_light_tree does; call it again after changing nodes): each tree's
-// boxes against its root's, planes rounded outwards with the kernels'
-// arithmetic (shared/light_node.h), and sets every box of tree.nodes to
-// its rounded planes, so that both paths bound the same boxes. Throws std::invalid_argument when a tree's box is too
-// large to quantize (more than half the float range) or there are more
-// nodes than kLightNodeNoChild, std::logic_error when a point or
-// directional node does not have the everywhere cone.
-void pack_light_nodes(LightTree& tree);
 
 }  // namespace lc

@@ -202,46 +202,6 @@ struct LightNode {
     float falloff_width;
 };
 
-// A LightNode as the kernels read it: 32 bytes, two 16-byte words,
-// decoded by lc_light_node (shared/light_node.h):
-//   word 0: intensity_r, intensity_g, intensity_b (float bits), rep_light;
-//   word 1: the link (bits 0-26 `left`, kLightNodeNoChild in a leaf; bits
-//           27-29 the light type; kLightNodeRepFromRight;
-//           kLightNodeTwoSided), then the box as 16-bit steps of its tree's
-//           frame (LightNodeFrame): lo_x | lo_y << 16, lo_z | hi_x << 16,
-//           hi_y | hi_z << 16. Every plane is rounded outwards, so the
-//           decoded box holds the cluster's.
-// Nodes i >= LightNodeFrame.cone_base (the trees of spot, oriented and VPL
-// lights, which come last) have one more word, their cone (axis_oct,
-// cos_theta_o, cos_theta_e, falloff_width), at kLightNodeWords *
-// node_count + (i - cone_base). The nodes of point and directional trees
-// all have the cone of lights that emit everywhere, LightNodeFrame.everywhere.
-LC_CONST uint kLightNodeWords = 2u;
-LC_CONST uint kLightNodeNoChild = 0x07FFFFFFu;  // a leaf's `left`; also the most nodes a scene may have
-LC_CONST uint kLightNodeTypeShift = 27u;
-LC_CONST uint kLightNodeTypeBits = 7u;
-LC_CONST uint kLightNodeRepFromRight = 0x40000000u;
-LC_CONST uint kLightNodeTwoSided = 0x80000000u;
-LC_CONST uint kLightNodePlaneSteps = 65535u;  // a box plane is 0..65535 steps from its tree's origin
-
-// What decoding a light node needs besides its words: per light type, the
-// origin and the step (a power of two) of its tree's box planes, axis by
-// axis; where the cones start; the cone of nodes without one (144 bytes).
-struct LightNodeFrame {
-    float origin[3u * kLightTypeCount];
-    float step[3u * kLightTypeCount];
-    uint node_count;
-    uint cone_base;       // the first node with a cone word: node_count if none
-    uint everywhere_axis_oct;
-    float everywhere_cos_theta_o, everywhere_cos_theta_e, everywhere_falloff_width;
-};
-
-// One 16-byte word of the light-node array, on the host (the kernels read
-// uvec4s).
-struct LightNodeWord {
-    uint x, y, z, w;
-};
-
 // Per-pixel surface record written by the camera-ray kernel (48 bytes).
 // material == kInvalidIndex means the ray left the scene (black).
 struct GBufferTexel {
@@ -272,7 +232,7 @@ LC_CONST uint kLightPickTree = 0u;
 LC_CONST uint kLightPickUniform = 1u;
 LC_CONST uint kLightPickPower = 2u;
 
-// Everything a frame's kernels need besides the buffers (272 bytes); one
+// Everything a frame's kernels need besides the buffers (128 bytes); one
 // storage buffer on the GPU, the same for every tile and sample. The camera
 // basis vectors are pre-scaled by tan(fov/2) (and aspect for right).
 struct FrameParams {
@@ -292,7 +252,6 @@ struct FrameParams {
     uint light_pick;              // --method sampled: kLightPick*
     float vpl_min_distance2;      // VPLs' inverse-square clamp: min_distance2 or render.indirect.clamp^2
     uint pad0;
-    LightNodeFrame light_frame;   // how the light-tree nodes decode (lc_light_node)
 };
 
 #ifdef __cplusplus

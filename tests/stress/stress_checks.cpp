@@ -68,10 +68,7 @@ std::vector<NodeRange> check_tree(const PreparedScene& p) {
         }
         if (n.flags & gpu::kNodeLeaf) {
             const gpu::Light& l = tree.lights[n.rep_light];
-            // Its box holds its light (planes rounded outwards, light_tree.h).
-            const glm::vec3 at(l.x, l.y, l.z);
-            if (!glm::all(glm::lessThanEqual(lo, at)) || !glm::all(glm::lessThanEqual(at, hi)))
-                fail(i, "leaf box does not hold its light");
+            if (lo != glm::vec3(l.x, l.y, l.z) || hi != lo) fail(i, "leaf box is not its light");
             if (intensity != glm::vec3(l.r, l.g, l.b)) fail(i, "leaf intensity is not its light's");
             ranges[i] = {n.rep_light, 1};
             continue;
