@@ -2,13 +2,17 @@
 // libraries (libtinyexr, libstb): no *_IMPLEMENTATION macro here.
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <system_error>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <stb_image_write.h>
@@ -23,6 +27,27 @@ namespace lc {
 namespace fs = std::filesystem;
 
 namespace {
+
+// write_file's work: "" when every byte is written and the file closed,
+// else the reason.
+std::string write_bytes(const fs::path& file, std::string_view bytes) {
+    const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd < 0) return std::string("cannot write: ") + std::strerror(errno);
+    std::size_t done = 0;
+    while (done < bytes.size()) {
+        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+            const std::string why = n < 0 ? std::strerror(errno) : "no byte written";
+            ::close(fd);
+            return "cannot write: " + why;
+        }
+        done += std::size_t(n);
+    }
+    // Some file systems (NFS, say) report a failed write only here.
+    if (::close(fd) != 0) return std::string("cannot write: ") + std::strerror(errno);
+    return {};
+}
 
 // Runs `write(tmp)`, which returns an empty string on success or the reason
 // it failed, then renames the temporary over `file`. On any failure the
@@ -94,6 +119,11 @@ float auto_exposure(const Image& image) {
 
 }  // namespace
 
+void write_file(const fs::path& file, std::string_view bytes) {
+    const std::string problem = write_bytes(file, bytes);
+    if (!problem.empty()) throw std::runtime_error(file.string() + ": " + problem);
+}
+
 // Concurrent writers (threads or processes) never share a temporary.
 fs::path temporary_path_for(const fs::path& file) {
     static std::atomic<unsigned> counter{0};
@@ -146,12 +176,18 @@ void write_exr(const fs::path& file, const Image& image) {
     exr.width = int(image.width);
     exr.height = int(image.height);
 
-    write_via_temp(file, [&](const fs::path& tmp) -> std::string {
-        const char* err = nullptr;
-        if (SaveEXRImageToFile(&exr, &header, tmp.c_str(), &err) != TINYEXR_SUCCESS)
-            return exr_message(err, "cannot write OpenEXR file");
-        return {};
-    });
+    // Encoded in memory and written by write_file: tinyexr's own file writer
+    // does not check its writes, and on a full disk left a truncated file
+    // behind a successful return.
+    const char* err = nullptr;
+    unsigned char* encoded = nullptr;
+    const std::size_t size = SaveEXRImageToMemory(&exr, &header, &encoded, &err);
+    std::unique_ptr<unsigned char, decltype(&std::free)> owned(encoded, &std::free);
+    if (size == 0 || encoded == nullptr)
+        throw std::runtime_error(file.string() + ": " + exr_message(err, "cannot encode OpenEXR image"));
+    if (err) FreeEXRErrorMessage(err);
+    const std::string_view bytes(reinterpret_cast<const char*>(encoded), size);
+    write_via_temp(file, [&](const fs::path& tmp) { return write_bytes(tmp, bytes); });
 }
 
 Image read_exr(const fs::path& file) {
@@ -230,11 +266,15 @@ void write_png_rgb8(const fs::path& file, std::uint32_t width, std::uint32_t hei
         height > std::uint32_t(std::numeric_limits<int>::max()))
         throw std::runtime_error(file.string() + ": cannot write a PNG of size " + std::to_string(width) +
                                  "x" + std::to_string(height));
-    write_via_temp(file, [&](const fs::path& tmp) -> std::string {
-        if (stbi_write_png(tmp.c_str(), int(width), int(height), 3, rgb8.data(), int(width * 3)) == 0)
-            return "cannot write PNG file";
-        return {};
-    });
+    // Encoded in memory, then written by write_file (stb's file writer does
+    // not check its writes either).
+    std::string encoded;
+    auto append = [](void* context, void* data, int size) {
+        static_cast<std::string*>(context)->append(static_cast<const char*>(data), std::size_t(size));
+    };
+    if (stbi_write_png_to_func(append, &encoded, int(width), int(height), 3, rgb8.data(), int(width * 3)) == 0)
+        throw std::runtime_error(file.string() + ": cannot encode PNG image");
+    write_via_temp(file, [&](const fs::path& tmp) { return write_bytes(tmp, encoded); });
 }
 
 void write_png_tonemapped(const fs::path& file, const Image& image, float exposure) {

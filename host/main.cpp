@@ -6,9 +6,11 @@
 // SCENE is a scene JSON or a glTF 2.0 file (.gltf, .glb).
 #include <charconv>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <optional>
+#include <utility>
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
@@ -120,6 +122,20 @@ int run_compare(const std::string& image, const std::string& reference, const st
         throw lc::InputError(image, "", "size " + std::to_string(a.width) + "x" + std::to_string(a.height) +
                                             " differs from the reference's " + std::to_string(r.width) + "x" +
                                             std::to_string(r.height));
+    // A NaN or infinite pixel makes every metric NaN or infinite: refused,
+    // naming the first such pixel, rather than reported as a number.
+    for (const auto& [img, file] : {std::pair<const lc::Image&, const std::string&>{a, image}, {r, reference}}) {
+        std::size_t bad = 0, first = 0;
+        for (std::size_t i = 0; i < img.rgb.size(); ++i)
+            if (!std::isfinite(img.rgb[i]) && bad++ == 0) first = i;
+        if (bad == 0) continue;
+        const std::size_t pixel = first / 3;
+        throw lc::InputError(file, "pixel (" + std::to_string(pixel % img.width) + ", " +
+                                       std::to_string(pixel / img.width) + ")." + "RGB"[first % 3],
+                             std::string(std::isnan(img.rgb[first]) ? "is NaN" : "is infinite") + " (" +
+                                 std::to_string(bad) + " of the image's " + std::to_string(img.rgb.size()) +
+                                 " values are not finite)");
+    }
     lc::CompareResult c = lc::compare_images(a, r);
     if (as_json) {
         nlohmann::json j = {{"relative_rmse", c.relative_rmse},

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 #include <stdexcept>
 #include <system_error>
 
@@ -73,14 +72,17 @@ void roll_back(const std::vector<fs::path>& files, const std::vector<Placement>&
     }
 }
 
-void write_text(const fs::path& file, std::string_view text) {
-    errno = 0;
-    std::ofstream out(file, std::ios::binary | std::ios::trunc);
-    out.write(text.data(), std::streamsize(text.size()));
-    out.close();
-    if (!out) {
-        const std::string why = errno ? std::string(": ") + std::strerror(errno) : "";
-        throw std::runtime_error(file.string() + ": cannot write" + why);
+// Runs `write(temporary)`; a failure names `file`, the output the user
+// asked for, and not the temporary the writer was given.
+template <class Write>
+void write_output(const fs::path& temporary, const fs::path& file, Write&& write) {
+    try {
+        write(temporary);
+    } catch (const std::runtime_error& e) {
+        std::string message = e.what();
+        const std::string prefix = temporary.string() + ": ";
+        if (message.compare(0, prefix.size(), prefix) == 0) message = message.substr(prefix.size());
+        throw std::runtime_error(file.string() + ": " + message);
     }
 }
 
@@ -174,15 +176,21 @@ OutputSet reserve_render_outputs(const RenderOutputs& outputs, const fs::path& s
 
 void write_render_outputs(OutputSet& set, const RenderOutputs& outputs, const RenderResult& result,
                           std::string_view stats_json) {
-    write_exr(set.temporary(outputs.image), result.image);
-    if (outputs.png_preview) write_png_tonemapped(set.temporary(preview_path(outputs.image)), result.image);
-    if (!outputs.stats.empty()) write_text(set.temporary(outputs.stats), stats_json);
+    const fs::path& image = outputs.image;
+    write_output(set.temporary(image), image, [&](const fs::path& t) { write_exr(t, result.image); });
+    if (outputs.png_preview) {
+        const fs::path preview = preview_path(image);
+        write_output(set.temporary(preview), preview, [&](const fs::path& t) { write_png_tonemapped(t, result.image); });
+    }
+    if (!outputs.stats.empty())
+        write_output(set.temporary(outputs.stats), outputs.stats, [&](const fs::path& t) { write_file(t, stats_json); });
     if (!outputs.cut_heatmap.empty()) {
         const std::vector<float>& cuts = result.stats.cut_size;
         // The scale runs from 0 to the largest cut, so the map uses its whole range.
         const float largest = cuts.empty() ? 1.0f : *std::max_element(cuts.begin(), cuts.end());
-        write_heatmap_png(set.temporary(outputs.cut_heatmap), result.image.width, result.image.height, cuts,
-                          std::max(1.0f, largest));
+        write_output(set.temporary(outputs.cut_heatmap), outputs.cut_heatmap, [&](const fs::path& t) {
+            write_heatmap_png(t, result.image.width, result.image.height, cuts, std::max(1.0f, largest));
+        });
     }
     set.commit();
 }

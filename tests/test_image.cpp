@@ -1,8 +1,10 @@
 // Image files (EXR, PNG, heat map) and the comparison metrics.
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <set>
 #include <string>
@@ -178,6 +180,29 @@ TEST_F(ImageFiles, WritingIntoAMissingFolderThrowsAndLeavesNothing) {
     }
     EXPECT_FALSE(fs::exists(missing));
     EXPECT_TRUE(entries().empty());
+}
+
+// A full disk: every write to /dev/full fails with ENOSPC. tinyexr's and
+// stb's own file writers ignored that and returned success with a file cut
+// short; the writers now encode in memory and write through write_file.
+TEST(WriteFile, AFullDiskThrowsNamingTheFileAndTheReason) {
+    if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full on this system";
+    try {
+        lc::write_file("/dev/full", std::string(100000, 'x'));
+        FAIL() << "expected std::runtime_error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("/dev/full: cannot write: "), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(std::strerror(ENOSPC)), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(ImageFiles, WriteFileWritesEveryByte) {
+    std::string bytes(1 << 20, '\0');
+    for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = char(i * 7u);
+    lc::write_file(dir_ / "bytes.bin", bytes);
+    std::ifstream in(dir_ / "bytes.bin", std::ios::binary);
+    const std::string back((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(back, bytes);
 }
 
 TEST_F(ImageFiles, FailedRenameRemovesTheTemporary) {

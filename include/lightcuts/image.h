@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -42,6 +43,12 @@ void write_png_rgb8(const std::filesystem::path& file, std::uint32_t width, std:
 // Tone-mapped sRGB preview: exposure * value, clamped to [0,1], sRGB-encoded.
 // exposure <= 0 picks one that maps the 99th percentile luminance to 1.
 void write_png_tonemapped(const std::filesystem::path& file, const Image& image, float exposure = 0.0f);
+
+// Writes `bytes` to `file` (created or truncated), every byte or an error:
+// a short write, a full disk or a failing close throws std::runtime_error
+// naming the file and the system's reason. The writers above and OutputSet
+// write through it.
+void write_file(const std::filesystem::path& file, std::string_view bytes);
 
 // The temporary the writers write before renaming onto `file`:
 // "<file>.tmp-<pid>-<n>", in the same folder so the rename stays within one
