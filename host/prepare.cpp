@@ -10,6 +10,8 @@
 #include "area_lights.h"
 #include "environment_lights.h"
 #include "vpls.h"
+#include "scene/float_limits.h"
+#include "lightcuts/error.h"
 #include "lightcuts/render.h"
 
 namespace lc {
@@ -42,6 +44,18 @@ bool all_coplanar(const std::vector<gpu::Triangle>& tris) {
     return true;
 }
 
+// Adds `lights` to the running totals; an InputError naming the scene file
+// and `field` where a per-type total leaves the float range. Positions
+// are not checked: these lights lie on the geometry or have none.
+void check_generated_totals(const Scene& scene, loader::LightLimits& limits, const std::vector<gpu::Light>& lights,
+                            const char* field, const char* what) {
+    for (const gpu::Light& l : lights) {
+        const loader::LightLimits::Problem problem = limits.add(l);
+        if (problem.fault == loader::LightLimits::Fault::total)
+            throw InputError(scene.file.string(), field, problem.text + ", with " + what);
+    }
+}
+
 }  // namespace
 
 PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
@@ -59,6 +73,16 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
     const std::vector<gpu::Light> sky = environment_lights(scene.environment, scene.environment.directions);
     lights.insert(lights.end(), area.begin(), area.end());
     lights.insert(lights.end(), sky.begin(), sky.end());
+    // The loader checked the scene's own lights' totals; the lights made
+    // from emissive surfaces and the environment join the same per-type
+    // sums, which must stay finite as floats too (two skies of 3e37 made an
+    // infinite root intensity, and lightcuts infinite or NaN pixels).
+    loader::LightLimits limits;
+    for (const gpu::Light& l : scene.lights) limits.add(l);
+    check_generated_totals(scene, limits, area, "emission",
+                           "the lights sampled on the emissive surfaces (emission times area)");
+    check_generated_totals(scene, limits, sky, "environment",
+                           "the environment's directional lights (radiance times solid angle)");
     prepared.area_lights = area.size();
     prepared.environment_lights = sky.size();
     prepared.light_sampling_seconds =
@@ -67,6 +91,7 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
     if (scene.render.indirect.vpls > 0) {
         const auto vpl_start = std::chrono::steady_clock::now();
         VplSet vpls = trace_vpls(scene, prepared.bvh, lights, scene.render.indirect, seed);
+        check_generated_totals(scene, limits, vpls.lights, "render.indirect", "the virtual point lights");
         prepared.vpls = vpls.lights.size();
         prepared.vpl_paths = vpls.paths;
         lights.insert(lights.end(), vpls.lights.begin(), vpls.lights.end());

@@ -11,6 +11,8 @@
 #include "light_bounds.h"
 #include "environment_lights.h"
 #include "test_util.h"
+#include "lightcuts/error.h"
+#include "lightcuts/render.h"
 
 namespace lc {
 namespace {
@@ -272,6 +274,48 @@ TEST(EnvironmentLight, SingleTexelIsADirectionalLight) {
         // The samples spread over the texel (1.4 x 1.4 degrees): cosines differ by that much.
         EXPECT_NEAR(got, expected, 0.02 * expected + 1e-9) << n.x << "," << n.y << "," << n.z;
     }
+}
+
+
+// The lights made from an environment or from emissive surfaces join the
+// per-type intensity sums of the light tree, which must stay finite floats:
+// a sky whose total irradiance, or emitters whose total intensity, passes
+// FLT_MAX is refused naming the field (infinite root intensities gave
+// lightcuts infinite and NaN pixels where brute force stayed finite).
+TEST(GeneratedLights, TotalsPastTheFloatRangeAreRefused) {
+    auto expect_refused = [](Scene s, const std::string& field) {
+        try {
+            (void)prepare_scene(std::move(s), 1);
+            FAIL() << "expected an InputError naming " << field;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("room.json: " + field + ": total red"), std::string::npos)
+                << e.what();
+        }
+    };
+    Scene sky = test::room_scene({test::point_light({0, 1, 0}, glm::vec3(1.0f))}, 8);
+    sky.file = "room.json";
+    sky.environment.width = 8;
+    sky.environment.height = 4;
+    // 3e37 over 4 pi steradians: 3.8e38 in all, past FLT_MAX (3.4e38).
+    sky.environment.rgb.assign(8 * 4 * 3, 3e37f);
+    Scene dimmer_sky = sky;
+    expect_refused(std::move(sky), "environment");
+    // A tenth of it renders.
+    for (float& v : dimmer_sky.environment.rgb) v = 3e36f;
+    EXPECT_NO_THROW((void)prepare_scene(std::move(dimmer_sky), 1));
+
+    Scene glow = test::room_scene({test::point_light({0, 1, 0}, glm::vec3(1.0f))}, 8);
+    glow.file = "room.json";
+    glow.render.area_light_samples = 64;
+    gpu::Material emitter = test::lambert(glm::vec3(0.0f));
+    emitter.emission_r = emitter.emission_g = emitter.emission_b = 1e38f;
+    emitter.flags |= gpu::kMaterialEmissive;
+    glow.materials.push_back(emitter);
+    // Four units of area at 1e38 each: 4e38 in all.
+    test::add_quad(glow, {-1, 1.9f, -1}, {1, 1.9f, -1}, {1, 1.9f, 1}, {-1, 1.9f, 1},
+                   std::uint32_t(glow.materials.size() - 1));
+    update_bounds(glow);
+    expect_refused(std::move(glow), "emission");
 }
 
 }  // namespace
