@@ -202,6 +202,57 @@ TEST(SceneLoader, MtlMaterialsGiveLambertAndGgx) {
                 glm::vec3(0.8f));
 }
 
+// tinyobjloader reads a number it cannot parse as 0 and says nothing: a
+// NaN, an infinity or a typo in a vertex or an MTL value is refused naming
+// the file, the line and the key, and a vertex line short of numbers too
+// (the OBJs' lines count from their mtllib line, line 1).
+TEST(SceneLoader, ObjAndMtlNumbersThatAreNotNumbersAreRefused) {
+    struct Bad {
+        const char* vertices;  // the OBJ's lines before its face
+        const char* mtl;       // the MTL's text
+        const char* file;      // the file the error names
+        const char* start;     // what follows "FILE: "
+    };
+    const char* kVertices = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    const char* kMtl = "newmtl m\nKd 0.5 0.5 0.5\n";
+    for (const Bad& b : {Bad{"v 0 0 0\nv 1 nan 0\nv 0 1 0\n", kMtl, "m.obj", "line 3 (v): 'nan' is not a number"},
+                         Bad{"v 0 0 0\nv 1 0 0\nv 0 1 inf\n", kMtl, "m.obj", "line 4 (v): 'inf' is not a number"},
+                         Bad{"v 0 0 0\nv 1,5 0 0\nv 0 1 0\n", kMtl, "m.obj", "line 3 (v): '1,5' is not a number"},
+                         Bad{"v 0 0 0\nv 1 0\nv 0 1 0\n", kMtl, "m.obj", "line 3 (v): needs 3 numbers, has 2"},
+                         Bad{"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 abc\n", kMtl, "m.obj", "line 5 (vn): 'abc'"},
+                         Bad{"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt NaN 0\n", kMtl, "m.obj", "line 5 (vt): 'NaN'"},
+                         // tinyobjloader converts indices and joint ids with int(): they wrapped.
+                         Bad{"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -99999999999\n", kMtl, "m.obj",
+                             "line 5 (f): corner '-99999999999': index '-99999999999' is not a whole number"},
+                         Bad{"v 0 0 0\nv 1 0 0\nv 0 1 0\nvw 1 44444444444 0.5\n", kMtl, "m.obj",
+                             "line 5 (vw): '44444444444' is not a whole number within 2^31"},
+                         Bad{kVertices, "newmtl m\nKd nan 0.5 0.5\n", "m.mtl", "line 2 (Kd): 'nan' is not a number"},
+                         Bad{kVertices, "newmtl m\nKd 0.5\n", "m.mtl", "line 2 (Kd): needs 3 numbers, has 1"},
+                         Bad{kVertices, "newmtl m\nKd 0.5 0.5 0.5\nNs inf\n", "m.mtl", "line 3 (Ns): 'inf'"},
+                         Bad{kVertices, "newmtl m\n\tPm 0.5x\n", "m.mtl", "line 2 (Pm): '0.5x'"}}) {
+        TempDir dir;
+        dir.write("m.obj", std::string("mtllib m.mtl\n") + b.vertices + "usemtl m\nf 1 2 3\n");
+        dir.write("m.mtl", b.mtl);
+        const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "m.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+        const std::string message = input_error_of([&] { load_scene(scene); });
+        const std::string start = (dir.path() / b.file).lexically_normal().string() + ": " + b.start;
+        EXPECT_EQ(message.rfind(start, 0), 0u) << message << "\n  wanted: " << start;
+    }
+    // What the check lets through: signs, exponents, comments, tabs, CRLF,
+    // a vertex with a w or a colour, the MTL's "d -halo".
+    TempDir dir;
+    dir.write("m.obj", "mtllib m.mtl\r\nv -0 +0 0.0 # a comment\r\nv\t1.e0 0 0 1\nv .5 1E+0 -0e-3 1 0.5 0\n"
+                       "vt 0.5\nusemtl m\nf 1 2 3\n");
+    dir.write("m.mtl", "newmtl m\nKd 0.5 0.5 0.5\nd -halo 1\nNs 10\n");
+    const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "m.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+    const Scene loaded = load_scene(scene);
+    ASSERT_EQ(loaded.triangles.size(), 1u);
+    EXPECT_EQ(loaded.triangles[0].v2_y, 1.0f);
+    EXPECT_NEAR(loaded.materials.at(loaded.triangles[0].material).kd_g, 0.5f, 1e-6f);
+}
+
 TEST(SceneLoader, MaterialOverrideReplacesMtlForWholeMesh) {
     const Scene scene = load_scene(kFixtures / "override.json");
     ASSERT_EQ(scene.materials.size(), 2u);  // one per overridden mesh, none from the MTL

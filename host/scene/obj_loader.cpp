@@ -11,6 +11,7 @@
 #include "input_file.h"
 #include "lightcuts/error.h"
 #include "materials.h"
+#include "obj_numbers.h"
 #include "textures.h"
 
 namespace lc::loader {
@@ -43,6 +44,12 @@ void check_material_warnings(const std::string& warning, const std::string& obj_
 
 void read_obj(const std::filesystem::path& file, const std::string& obj_name, bool uses_mtl,
               tinyobj::ObjReader& reader) {
+    // tinyobjloader reads a number it cannot parse as 0: checked first.
+    const std::string text = read_input_file(file);
+    check_obj_numbers(text, obj_name);
+    if (uses_mtl)
+        for (const std::filesystem::path& library : material_libraries(text, file.parent_path()))
+            check_mtl_numbers(read_input_file(library), display(library));
     tinyobj::ObjReaderConfig config;
     config.triangulate = true;
     config.vertex_color = false;

@@ -1,0 +1,161 @@
+// Number checks of OBJ and MTL text ahead of tinyobjloader (obj_numbers.h).
+#include "obj_numbers.h"
+
+#include <cctype>
+
+#include "lightcuts/error.h"
+
+namespace lc::loader {
+namespace {
+
+struct Line {
+    std::size_t number;                   // from 1
+    std::vector<std::string_view> words;  // up to a '#' comment
+};
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+// Calls visit(Line) for each line that has a word.
+template <class Visit>
+void for_each_line(std::string_view text, Visit&& visit) {
+    Line line{0, {}};
+    std::size_t at = 0;
+    while (at <= text.size()) {
+        const std::size_t end = std::min(text.find('\n', at), text.size());
+        ++line.number;
+        line.words.clear();
+        std::size_t i = at;
+        while (i < end) {
+            while (i < end && is_space(text[i])) ++i;
+            if (i == end || text[i] == '#') break;
+            const std::size_t start = i;
+            while (i < end && !is_space(text[i])) ++i;
+            line.words.push_back(text.substr(start, i - start));
+        }
+        if (!line.words.empty()) visit(line);
+        at = end + 1;
+    }
+}
+
+// A decimal number as tinyobjloader parses one: [+-] digits [. digits]
+// [(e|E) [+-] digits], with at least one digit before the exponent.
+bool is_number(std::string_view w) {
+    std::size_t i = 0;
+    auto digits = [&] {
+        const std::size_t start = i;
+        while (i < w.size() && std::isdigit(static_cast<unsigned char>(w[i]))) ++i;
+        return i - start;
+    };
+    if (i < w.size() && (w[i] == '+' || w[i] == '-')) ++i;
+    std::size_t mantissa = digits();
+    if (i < w.size() && w[i] == '.') {
+        ++i;
+        mantissa += digits();
+    }
+    if (mantissa == 0) return false;
+    if (i < w.size() && (w[i] == 'e' || w[i] == 'E')) {
+        ++i;
+        if (i < w.size() && (w[i] == '+' || w[i] == '-')) ++i;
+        if (digits() == 0) return false;
+    }
+    return i == w.size();
+}
+
+// Words 1.. of `line` are `least` or more numbers (all of them numbers).
+void check_numbers(const Line& line, std::size_t least, const std::string& name) {
+    const std::string field = "line " + std::to_string(line.number) + " (" + std::string(line.words[0]) + ")";
+    for (std::size_t k = 1; k < line.words.size(); ++k)
+        if (!is_number(line.words[k]))
+            throw InputError(name, field, "'" + std::string(line.words[k]) + "' is not a number");
+    if (line.words.size() - 1 < least)
+        throw InputError(name, field, "needs " + std::to_string(least) + " numbers, has " +
+                                          std::to_string(line.words.size() - 1));
+}
+
+// An integer within int's range, as tinyobjloader's indices and joint ids
+// must be: it converts them with int() (a larger one wraps, or is undefined
+// behaviour; the fuzzer found "vw 1 44444444444 0.5").
+bool is_int(std::string_view w) {
+    std::size_t i = w.size() > 0 && (w[0] == '+' || w[0] == '-') ? 1 : 0;
+    if (i == w.size() || w.size() - i > 10) return false;
+    long long value = 0;
+    for (; i < w.size(); ++i) {
+        if (!std::isdigit(static_cast<unsigned char>(w[i]))) return false;
+        value = value * 10 + (w[i] - '0');
+    }
+    return value <= 2147483647LL;
+}
+
+// A face's corners: v, v/vt, v//vn or v/vt/vn, each index an int.
+void check_face(const Line& line, const std::string& name) {
+    for (std::size_t k = 1; k < line.words.size(); ++k) {
+        std::string_view corner = line.words[k];
+        for (int part = 0; part < 3 && !corner.empty(); ++part) {
+            const std::size_t slash = corner.find('/');
+            const std::string_view index = corner.substr(0, slash);
+            if (!(index.empty() && part > 0) && !is_int(index))
+                throw InputError(name, "line " + std::to_string(line.number) + " (f)",
+                                 "corner '" + std::string(line.words[k]) + "': index '" + std::string(index) +
+                                     "' is not a whole number within 2^31");
+            corner = slash == std::string_view::npos ? std::string_view() : corner.substr(slash + 1);
+        }
+    }
+}
+
+// vw VERTEX JOINT WEIGHT [JOINT WEIGHT ...] (tinyobjloader's skin weights,
+// which the renderer ignores): numbers, the vertex and joints ints.
+void check_weights(const Line& line, const std::string& name) {
+    check_numbers(line, 1, name);
+    for (std::size_t k = 1; k < line.words.size(); k += k == 1 ? 1 : 2)
+        if (!is_int(line.words[k]))
+            throw InputError(name, "line " + std::to_string(line.number) + " (vw)",
+                             "'" + std::string(line.words[k]) + "' is not a whole number within 2^31");
+}
+
+}  // namespace
+
+void check_obj_numbers(std::string_view text, const std::string& name) {
+    for_each_line(text, [&](const Line& line) {
+        const std::string_view key = line.words[0];
+        if (key == "v" || key == "vn") check_numbers(line, 3, name);
+        else if (key == "vt") check_numbers(line, 1, name);
+        else if (key == "f") check_face(line, name);
+        else if (key == "vw") check_weights(line, name);
+    });
+}
+
+void check_mtl_numbers(std::string_view text, const std::string& name) {
+    for_each_line(text, [&](const Line& line) {
+        const std::string_view key = line.words[0];
+        if (key == "Ka" || key == "Kd" || key == "Ks" || key == "Ke" || key == "Kt" || key == "Tf") {
+            check_numbers(line, 3, name);
+        } else if (key == "d" && line.words.size() > 1 && line.words[1] == "-halo") {
+            // "d -halo 0.5": the halo option, then the number.
+            Line value = line;
+            value.words.erase(value.words.begin() + 1);
+            check_numbers(value, 1, name);
+        } else if (key == "Ns" || key == "Ni" || key == "d" || key == "Tr" || key == "illum" || key == "Pr" ||
+                   key == "Pm" || key == "Ps" || key == "Pc" || key == "Pcr" || key == "aniso" ||
+                   key == "anisor") {
+            check_numbers(line, 1, name);
+        }
+    });
+}
+
+std::vector<std::filesystem::path> material_libraries(std::string_view text, const std::filesystem::path& folder) {
+    std::vector<std::filesystem::path> found;
+    for_each_line(text, [&](const Line& line) {
+        if (line.words[0] != "mtllib") return;
+        for (std::size_t k = 1; k < line.words.size(); ++k) {
+            const std::filesystem::path file = folder / std::string(line.words[k]);
+            std::error_code ec;
+            if (std::filesystem::is_regular_file(file, ec)) {
+                found.push_back(file);
+                break;
+            }
+        }
+    });
+    return found;
+}
+
+}  // namespace lc::loader

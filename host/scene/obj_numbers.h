@@ -1,0 +1,30 @@
+// What tinyobjloader reads as 0 without a word: a number it cannot parse
+// ("nan", "inf", "1,5", a typo) in an OBJ vertex line or an MTL value. The
+// loader checks the text first, so that such a file is refused naming the
+// line, as a bad CSV line is.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace lc::loader {
+
+// Every number of every `v`, `vn` and `vt` line of `text` (an OBJ, shown as
+// `name` in errors) is a decimal number, and the line has as many as it
+// needs (3 for v and vn, 1 for vt); every index of an `f` line, and the
+// vertex and joints of a `vw` line, are whole numbers within int's range.
+// Throws InputError "NAME: line N (v): 'nan' is not a number".
+void check_obj_numbers(std::string_view text, const std::string& name);
+
+// The same for the MTL values the loader reads: the colours (Ka, Kd, Ks,
+// Ke, Kt, Tf: three numbers each) and the scalars (Ns, Ni, d, Tr, illum,
+// and the PBR extension's Pr, Pm, Ps, Pc, Pcr, aniso, anisor).
+void check_mtl_numbers(std::string_view text, const std::string& name);
+
+// The material libraries tinyobjloader reads for this OBJ text: of each
+// `mtllib` line, the first of its files that exists in `folder`.
+std::vector<std::filesystem::path> material_libraries(std::string_view text, const std::filesystem::path& folder);
+
+}  // namespace lc::loader
