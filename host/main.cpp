@@ -103,7 +103,7 @@ int run_render(RenderArgs a) {
     if (options.method == "path") scene.render.indirect.vpls = 0;
     lc::validate_render_options(options);
     // Every output is checked and reserved before the render; none is left if any fails.
-    lc::OutputSet outputs = lc::reserve_render_outputs(a.outputs, a.scene, options.method);
+    lc::OutputSet outputs = lc::reserve_render_outputs(a.outputs, a.scene, options.method, scene.input_files);
 
     const lc::PreparedScene prepared = lc::prepare_scene(std::move(scene), options.seed);
     a.device.note = [](const std::string& line) { std::fprintf(stderr, "note: %s\n", line.c_str()); };

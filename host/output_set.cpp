@@ -159,7 +159,8 @@ void OutputSet::commit() {
     }
 }
 
-OutputSet reserve_render_outputs(const RenderOutputs& outputs, const fs::path& scene_file, std::string_view method) {
+OutputSet reserve_render_outputs(const RenderOutputs& outputs, const fs::path& scene_file, std::string_view method,
+                                 const std::vector<fs::path>& inputs) {
     if (outputs.image.extension() != ".exr")
         throw std::invalid_argument("image " + outputs.image.string() + ": must end in .exr");
     if (!outputs.cut_heatmap.empty() && !method_selects_cuts(method))
@@ -167,6 +168,7 @@ OutputSet reserve_render_outputs(const RenderOutputs& outputs, const fs::path& s
                                     ": needs method lightcuts or stochastic, not " + std::string(method));
     OutputSet set;
     set.add_input(scene_file, "scene");
+    for (const fs::path& input : inputs) set.add_input(input, "file the scene reads (" + input.string() + ")");
     set.add(outputs.image, "image");
     if (outputs.png_preview) set.add(preview_path(outputs.image), "PNG preview");
     if (!outputs.stats.empty()) set.add(outputs.stats, "stats file");

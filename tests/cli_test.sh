@@ -61,6 +61,18 @@ expect_error "nope.exr" compare "$tmp/a.exr" "$tmp/nope.exr"
 expect_error "bad_env_nan.exr: pixel (1, 0)" compare "$root/tests/data/scenes/bad_env_nan.exr" "$root/tests/data/scenes/bad_env_nan.exr"
 [ -e "$tmp/c.exr" ] && fail "a failed render left c.exr behind"
 
+# No output may replace a file the scene reads (on a copy of the room, so
+# that a broken check cannot damage the repository's).
+mkdir -p "$tmp/inputs" && cp "$root"/scenes/room/{room.json,room.obj,room.mtl,torus.obj,room_lights.csv} "$tmp/inputs/" ||
+  fail "copying the room"
+before=$(md5sum "$tmp"/inputs/* | md5sum)
+expect_error "stats file $tmp/inputs/room.obj: is the file the scene reads" \
+  render "$tmp/inputs/room.json" -o "$tmp/c.exr" --stats "$tmp/inputs/room.obj" --width 8 --height 8
+expect_error "is the file the scene reads" \
+  render "$tmp/inputs/room.json" -o "$tmp/inputs/room_lights.exr" --cut-heatmap "$tmp/inputs/room.mtl" --width 8 --height 8
+[ "$(md5sum "$tmp"/inputs/* | md5sum)" = "$before" ] || fail "a refused render changed the scene's files"
+[ -e "$tmp/c.exr" ] && fail "a refused render left c.exr behind"
+
 # glTF: rendered directly (its camera, or the one --camera names), read by
 # info, its notes on stderr, and bad files refused naming the glTF path.
 gltf="$root/tests/data/gltf"

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <iterator>
 #include <random>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -251,6 +252,22 @@ TEST(SceneLoader, ObjAndMtlNumbersThatAreNotNumbersAreRefused) {
     ASSERT_EQ(loaded.triangles.size(), 1u);
     EXPECT_EQ(loaded.triangles[0].v2_y, 1.0f);
     EXPECT_NEAR(loaded.materials.at(loaded.triangles[0].material).kd_g, 0.5f, 1e-6f);
+}
+
+// Scene::input_files lists every file the loader read, so that no render
+// output can replace one of them (reserve_render_outputs).
+TEST(SceneLoader, InputFilesListEveryFileRead) {
+    auto names = [](const Scene& s) {
+        std::set<std::string> out;
+        for (const fs::path& f : s.input_files) out.insert(f.filename().string());
+        return out;
+    };
+    EXPECT_EQ(names(load_scene(kFixtures / "materials.json")),
+              (std::set<std::string>{"materials.json", "materials.obj", "materials.mtl"}));
+    EXPECT_EQ(names(load_scene(kScenes / "room" / "room.gltf")), (std::set<std::string>{"room.gltf", "room.bin"}));
+    const std::set<std::string> room = names(load_scene(kScenes / "room" / "room.json"));
+    for (const char* f : {"room.json", "room.obj", "room.mtl", "torus.obj", "room_lights.csv"})
+        EXPECT_EQ(room.count(f), 1u) << f;
 }
 
 TEST(SceneLoader, MaterialOverrideReplacesMtlForWholeMesh) {

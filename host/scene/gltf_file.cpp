@@ -81,6 +81,12 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
         ok = false;
     }
     if (!ok) throw InputError(name, "", "tinygltf: " + (err.empty() ? std::string("cannot parse the file") : trimmed(err)));
+    // The buffers and images tinygltf read from files beside this one.
+    auto note_uri = [&](const std::string& uri) {
+        if (!uri.empty() && uri.rfind("data:", 0) != 0) note_input_file(fs::path(base) / uri);
+    };
+    for (const tinygltf::Buffer& b : model.buffers) note_uri(b.uri);
+    for (const tinygltf::Image& i : model.images) note_uri(i.uri);
     warn = trimmed(warn);
     for (std::size_t from = 0; from < warn.size();) {
         const std::size_t end = std::min(warn.find('\n', from), warn.size());

@@ -1,6 +1,7 @@
 // Whole-file reads for the scene, CSV and (through tinyobjloader) OBJ inputs.
 #include "input_file.h"
 
+#include <algorithm>
 #include <fstream>
 
 #include "lightcuts/error.h"
@@ -10,6 +11,20 @@ namespace lc::loader {
 namespace fs = std::filesystem;
 
 std::string display(const fs::path& path) { return path.lexically_normal().string(); }
+
+namespace {
+thread_local std::vector<fs::path>* g_input_files = nullptr;
+}  // namespace
+
+InputFileLog::InputFileLog(std::vector<fs::path>& files) { g_input_files = &files; }
+InputFileLog::~InputFileLog() { g_input_files = nullptr; }
+
+void note_input_file(const fs::path& path) {
+    if (g_input_files == nullptr) return;
+    const fs::path normal = path.lexically_normal();
+    if (std::find(g_input_files->begin(), g_input_files->end(), normal) == g_input_files->end())
+        g_input_files->push_back(normal);
+}
 
 // One read is much faster than line-wise streams for the million-line CSV case.
 std::string read_input_file(const fs::path& path) {
@@ -21,6 +36,7 @@ std::string read_input_file(const fs::path& path) {
     in.seekg(0, std::ios::end);
     const std::streamoff size = in.tellg();
     if (size < 0) throw InputError(name, "", "cannot read file");
+    note_input_file(path);
     std::string text(static_cast<std::size_t>(size), '\0');
     in.seekg(0, std::ios::beg);
     in.read(text.data(), size);

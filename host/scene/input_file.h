@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace lc::loader {
 
@@ -10,7 +11,21 @@ namespace lc::loader {
 std::string display(const std::filesystem::path& path);
 
 // The whole file in memory. Throws InputError "FILE: file not found" or
-// "FILE: cannot read file".
+// "FILE: cannot read file". Notes the file (note_input_file).
 std::string read_input_file(const std::filesystem::path& path);
+
+// While an InputFileLog lives, every file read_input_file reads, and every
+// file given to note_input_file (those read by other means: an EXR through
+// tinyexr, a glTF's buffers through tinygltf), is appended to its list once;
+// load_scene keeps them in Scene::input_files, the files a render must not
+// write over. One per thread at a time.
+class InputFileLog {
+public:
+    explicit InputFileLog(std::vector<std::filesystem::path>& files);
+    ~InputFileLog();
+    InputFileLog(const InputFileLog&) = delete;
+    InputFileLog& operator=(const InputFileLog&) = delete;
+};
+void note_input_file(const std::filesystem::path& path);
 
 }  // namespace lc::loader

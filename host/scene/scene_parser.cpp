@@ -388,6 +388,7 @@ private:
         if (has_file) {
             const fs::path exr = existing_file(j, path, "file");
             const Image map = read_exr(exr);
+            loader::note_input_file(exr);
             env.width = map.width;
             env.height = map.height;
             env.rgb = map.rgb;
@@ -428,10 +429,21 @@ private:
 }  // namespace loader
 
 Scene load_scene(const std::filesystem::path& file, const SceneOptions& options) {
-    if (loader::is_gltf_path(file)) return loader::load_gltf_scene(file, options.camera);
-    if (!options.camera.empty())
-        throw InputError(loader::display(file), "", "--camera picks a camera of a glTF scene; a JSON scene has its own");
-    return loader::SceneParser(file).parse();
+    std::vector<std::filesystem::path> inputs;
+    Scene scene;
+    {
+        const loader::InputFileLog log(inputs);
+        if (loader::is_gltf_path(file)) {
+            scene = loader::load_gltf_scene(file, options.camera);
+        } else {
+            if (!options.camera.empty())
+                throw InputError(loader::display(file), "",
+                                 "--camera picks a camera of a glTF scene; a JSON scene has its own");
+            scene = loader::SceneParser(file).parse();
+        }
+    }
+    scene.input_files = std::move(inputs);
+    return scene;
 }
 
 }  // namespace lc

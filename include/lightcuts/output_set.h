@@ -75,9 +75,11 @@ struct RenderOutputs {
 // Refuses, before anything is rendered, every combination that could not be
 // written (std::invalid_argument): an image not ending in .exr, a cut heatmap
 // without a method that selects cuts (lightcuts, stochastic), and whatever
-// OutputSet::add refuses, the scene file being an input. Returns the set holding the temporaries.
+// OutputSet::add refuses: the scene file and every file of `inputs` (the
+// scene's meshes, light lists, textures, environment: Scene::input_files)
+// are inputs no output may replace. Returns the set holding the temporaries.
 OutputSet reserve_render_outputs(const RenderOutputs& outputs, const std::filesystem::path& scene_file,
-                                 std::string_view method);
+                                 std::string_view method, const std::vector<std::filesystem::path>& inputs = {});
 
 // Writes each of `outputs` to its temporary in `set` (reserved by
 // reserve_render_outputs), then commits. On any failure no output is left

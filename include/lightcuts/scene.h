@@ -71,6 +71,10 @@ struct Scene {
     Environment environment;
     RenderSettings render;
     std::filesystem::path file;                  // the scene file it came from
+    // Every file the loader read (the scene, meshes, material libraries,
+    // light lists, textures, the environment, glTF buffers and images):
+    // what a render's outputs may not replace.
+    std::vector<std::filesystem::path> input_files;
     std::size_t degenerate_triangles_dropped = 0;
     // What the loader read but left out or approximated (glTF features it
     // does not support), one "FILE: FIELD: TEXT" line each; the CLI prints them.
