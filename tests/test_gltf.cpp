@@ -308,6 +308,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_spot_cone.gltf", "extensions.KHR_lights_punctual.lights[0].spot.outerConeAngle"},
         BadCase{"bad_position_type.gltf", "accessors[0].componentType: is UNSIGNED_SHORT, expected FLOAT"},
         BadCase{"bad_json.gltf", "tinygltf: "},
+        BadCase{"bad_roughness_string.gltf",
+                "materials[0].pbrMetallicRoughness.roughnessFactor: must be a number, not a string"},
+        BadCase{"bad_negative_view.gltf", "accessors[0].bufferView: must be a whole number >= 0, not -5"},
+        BadCase{"bad_aspect_zero.gltf", "cameras[0].perspective.aspectRatio: must be above 0, not 0"},
+        BadCase{"bad_aspect_wide.gltf", "cameras[0].perspective.aspectRatio: makes the image 25600 pixels wide"},
+        BadCase{"bad_projective_matrix.gltf", "nodes[0].matrix: its last row (elements 3, 7, 11, 15) must be 0, 0, 0, 1"},
         BadCase{"missing.gltf", "file not found"}),
     [](const ::testing::TestParamInfo<BadCase>& info) {
         std::string name = info.param.file;

@@ -6,6 +6,7 @@
 #include <limits>
 #include <string_view>
 
+#include "gltf_types.h"
 #include "input_file.h"
 #include "lightcuts/error.h"
 
@@ -81,6 +82,7 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
         ok = false;
     }
     if (!ok) throw InputError(name, "", "tinygltf: " + (err.empty() ? std::string("cannot parse the file") : trimmed(err)));
+    check_gltf_types(json, name);
     // The buffers and images tinygltf read from files beside this one.
     auto note_uri = [&](const std::string& uri) {
         if (!uri.empty() && uri.rfind("data:", 0) != 0) note_input_file(fs::path(base) / uri);

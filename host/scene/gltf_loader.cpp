@@ -18,6 +18,7 @@
 #include "input_file.h"
 #include "light_records.h"
 #include "lightcuts/error.h"
+#include "lightcuts/settings.h"
 
 namespace lc::loader {
 namespace {
@@ -45,6 +46,11 @@ glm::dmat4 local_matrix(const tinygltf::Node& node, const std::string& name, con
                 throw InputError(name, field + ".matrix[" + std::to_string(i) + "]", "must be a finite float");
             m[i / 4][i % 4] = v;  // column-major, as glTF stores it
         }
+        // glTF 3.5.3: a node's matrix is a transform of translation,
+        // rotation and scale; its last row is 0, 0, 0, 1 (a projective one
+        // would send points to w = 0).
+        if (m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 || m[3][3] != 1.0)
+            throw InputError(name, field + ".matrix", "its last row (elements 3, 7, 11, 15) must be 0, 0, 0, 1");
         return m;
     }
     const glm::dvec3 t = finite_vec3(node.translation, 3, glm::dvec3(0.0), name, field + ".translation");
@@ -302,8 +308,14 @@ private:
         }
         const double yfov = cam.perspective.yfov * 180.0 / 3.14159265358979323846;
         if (!(yfov > 0.0 && yfov < 180.0)) fail(name + ".perspective.yfov", "must be in (0, pi)");
+        // 0 where the file has none (check_gltf_types refuses a 0 it has).
         const double aspect = cam.perspective.aspectRatio;
-        if (!(aspect >= 0.0 && aspect <= 1e4)) fail(name + ".perspective.aspectRatio", "must be positive");
+        const double width = std::round(aspect * kGltfImageHeight);
+        if (aspect != 0.0 && !(width >= 1.0 && width <= double(kMaxImageSide)))
+            fail(name + ".perspective.aspectRatio",
+                 "makes the image " + (std::isfinite(width) ? std::to_string(std::llround(width)) : std::string("inf")) +
+                     " pixels wide at its height of " + std::to_string(kGltfImageHeight) + "; must be from 1 to " +
+                     std::to_string(kMaxImageSide));
         Camera c;
         c.position = glm::vec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
         if (!is_finite(c.position)) fail(node, "the camera's position is not finite");
@@ -313,8 +325,7 @@ private:
             fail(node, "the camera's up is parallel to its view direction");
         c.fov_y_degrees = float(yfov);
         c.height = kGltfImageHeight;
-        c.width = aspect > 0.0 ? std::uint32_t(std::clamp(std::lround(aspect * kGltfImageHeight), 1l, 16384l))
-                               : kGltfImageHeight;
+        c.width = aspect > 0.0 ? std::uint32_t(width) : kGltfImageHeight;
         contents_.cameras.push_back({cam.name, c});
     }
 

@@ -251,7 +251,10 @@ std::uint32_t GltfMaterials::image(int index) {
     if ((im.bits != 8 && im.bits != 16) || im.component < 1 || im.component > 4 || im.width < 1 || im.height < 1 ||
         im.image.size() != std::size_t(im.width) * std::size_t(im.height) * std::size_t(im.component) *
                                std::size_t(bytes))
-        throw InputError(notes_.file(), name, "no decoded 8- or 16-bit pixels (the image could not be read)");
+        throw InputError(notes_.file(), name,
+                         "no decoded 8- or 16-bit pixels (the image" +
+                             (im.uri.empty() || im.uri.rfind("data:", 0) == 0 ? std::string() : " " + im.uri) +
+                             " could not be read)");
     const std::size_t texels = std::size_t(im.width) * std::size_t(im.height);
     std::vector<std::uint8_t> rgba(texels * 4);
     for (std::size_t i = 0; i < texels; ++i) {

@@ -326,6 +326,18 @@ def bad_cases():
     variant("bad_spot_cone", lambda d: d["extensions"]["KHR_lights_punctual"]["lights"][0].update(
         type="spot", spot={"innerConeAngle": 0.5, "outerConeAngle": 2.0}))
     variant("bad_position_type", lambda d: d["accessors"][0].update(componentType=USHORT))
+    # Values of the wrong JSON type, which tinygltf 2.7 would replace by its default.
+    variant("bad_roughness_string", lambda d: (d.update(materials=[{"pbrMetallicRoughness": {
+        "roughnessFactor": "0.5"}}]), d["meshes"][0]["primitives"][0].update(material=0)))
+    variant("bad_negative_view", lambda d: d["accessors"][0].update(bufferView=-5))
+    variant("bad_aspect_zero", lambda d: (d.update(cameras=[{"type": "perspective", "perspective": {
+        "yfov": 0.8, "aspectRatio": 0, "znear": 0.1}}]), d["nodes"].append({"camera": 0, "translation": [0, 0, 3]}),
+        d["scenes"][0]["nodes"].append(len(d["nodes"]) - 1)))
+    variant("bad_aspect_wide", lambda d: (d.update(cameras=[{"type": "perspective", "perspective": {
+        "yfov": 0.8, "aspectRatio": 100, "znear": 0.1}}]), d["nodes"].append({"camera": 0, "translation": [0, 0, 3]}),
+        d["scenes"][0]["nodes"].append(len(d["nodes"]) - 1)))
+    variant("bad_projective_matrix", lambda d: d["nodes"][0].update(
+        matrix=[1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0]))
     return cases
 
 
