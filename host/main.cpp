@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <utility>
@@ -116,6 +117,8 @@ int run_render(RenderArgs a) {
 
 int run_compare(const std::string& image, const std::string& reference, const std::string& heatmap,
                 bool as_json) {
+    if (!heatmap.empty() && std::filesystem::path(heatmap).extension() != ".png")
+        throw std::invalid_argument("heatmap " + heatmap + ": must end in .png");
     lc::Image a = lc::read_exr(image);
     lc::Image r = lc::read_exr(reference);
     if (a.width != r.width || a.height != r.height)

@@ -166,6 +166,8 @@ OutputSet reserve_render_outputs(const RenderOutputs& outputs, const fs::path& s
     if (!outputs.cut_heatmap.empty() && !method_selects_cuts(method))
         throw std::invalid_argument("cut heatmap " + outputs.cut_heatmap.string() +
                                     ": needs method lightcuts or stochastic, not " + std::string(method));
+    if (!outputs.cut_heatmap.empty() && outputs.cut_heatmap.extension() != ".png")
+        throw std::invalid_argument("cut heatmap " + outputs.cut_heatmap.string() + ": must end in .png");
     OutputSet set;
     set.add_input(scene_file, "scene");
     for (const fs::path& input : inputs) set.add_input(input, "file the scene reads (" + input.string() + ")");

@@ -58,6 +58,7 @@ expect_error "--area-samples" render "$root/scenes/room/room.json" -o "$tmp/c.ex
 expect_error "folder $tmp/nowhere does not exist" render "$root/scenes/room/room.json" -o "$tmp/nowhere/c.exr"
 expect_error "must end in .exr" render "$root/scenes/room/room.json" -o "$tmp/c.png"
 expect_error "nope.exr" compare "$tmp/a.exr" "$tmp/nope.exr"
+expect_error "heatmap $tmp/err.exr: must end in .png" compare "$tmp/a.exr" "$tmp/a.exr" --heatmap "$tmp/err.exr"
 expect_error "bad_env_nan.exr: pixel (1, 0)" compare "$root/tests/data/scenes/bad_env_nan.exr" "$root/tests/data/scenes/bad_env_nan.exr"
 [ -e "$tmp/c.exr" ] && fail "a failed render left c.exr behind"
 
@@ -69,7 +70,9 @@ before=$(md5sum "$tmp"/inputs/* | md5sum)
 expect_error "stats file $tmp/inputs/room.obj: is the file the scene reads" \
   render "$tmp/inputs/room.json" -o "$tmp/c.exr" --stats "$tmp/inputs/room.obj" --width 8 --height 8
 expect_error "is the file the scene reads" \
-  render "$tmp/inputs/room.json" -o "$tmp/inputs/room_lights.exr" --cut-heatmap "$tmp/inputs/room.mtl" --width 8 --height 8
+  render "$tmp/inputs/room.json" -o "$tmp/c.exr" --stats "$tmp/inputs/room_lights.csv" --width 8 --height 8
+expect_error "is the file the scene reads" \
+  render "$tmp/inputs/room.json" -o "$tmp/c.exr" --stats "$tmp/inputs/room.mtl" --width 8 --height 8
 [ "$(md5sum "$tmp"/inputs/* | md5sum)" = "$before" ] || fail "a refused render changed the scene's files"
 [ -e "$tmp/c.exr" ] && fail "a refused render left c.exr behind"
 

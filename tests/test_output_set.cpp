@@ -176,6 +176,9 @@ TEST_F(OutputSetTest, RenderOutputsRefuseImpossibleCombinations) {
     o.cut_heatmap = at("cuts.png");
     EXPECT_THAT(error_of([&] { reserve_render_outputs(o, at("scene.json"), "brute"); }),
                 HasSubstr("needs method lightcuts"));
+    o.cut_heatmap = at("cuts.exr");  // the heatmap is a PNG, whatever its name says
+    EXPECT_THAT(error_of([&] { reserve_render_outputs(o, at("scene.json"), "lightcuts"); }),
+                HasSubstr("cuts.exr: must end in .png"));
     o.cut_heatmap = at("a.png");
     EXPECT_THAT(error_of([&] { reserve_render_outputs(o, at("scene.json"), "lightcuts"); }),
                 HasSubstr("is also the PNG preview"));

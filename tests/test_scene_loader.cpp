@@ -270,6 +270,31 @@ TEST(SceneLoader, InputFilesListEveryFileRead) {
         EXPECT_EQ(room.count(f), 1u) << f;
 }
 
+// tinyobj's Pr is 0 when the MTL has none; any other value was given and
+// is checked (a negative one was taken for "none").
+TEST(SceneLoader, MtlRoughnessOutOfRangeIsRefused) {
+    for (const char* pr : {"-0.5", "1.5"}) {
+        TempDir dir;
+        dir.write("m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n");
+        dir.write("m.mtl", std::string("newmtl m\nKd 0.5 0.5 0.5\nKs 0.2 0.2 0.2\nPr ") + pr + "\n");
+        const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "m.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+        const std::string message = input_error_of([&] { load_scene(scene); });
+        EXPECT_NE(message.find("m.obj: material 'm'.Pr: must be in [0, 1]"), std::string::npos) << pr << ": " << message;
+    }
+}
+
+// A look_at so far from the position that their distance overflows a float
+// is named as that, not as "must differ from camera.position".
+TEST(SceneLoader, CameraDistanceBeyondFloatIsNamed) {
+    TempDir dir;
+    fs::copy_file(kFixtures / "tri.obj", dir.path() / "tri.obj");
+    const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 3e38, 7], "look_at": [0, -3e38, 0]},
+ "meshes": [{"obj": "tri.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+    const std::string message = input_error_of([&] { load_scene(scene); });
+    EXPECT_NE(message.find("camera.look_at: is too far from camera.position"), std::string::npos) << message;
+}
+
 TEST(SceneLoader, MaterialOverrideReplacesMtlForWholeMesh) {
     const Scene scene = load_scene(kFixtures / "override.json");
     ASSERT_EQ(scene.materials.size(), 2u);  // one per overridden mesh, none from the MTL
@@ -844,6 +869,17 @@ TEST(PointsCsv, AcceptsCrLfMissingFinalNewlineAndTinyNumbers) {
     expect_near({lights[0].r, lights[0].g, lights[0].b}, {4, 5, 6});
     EXPECT_EQ(lights[1].r, 0.0f);  // underflow is zero, not an error
     EXPECT_FLOAT_EQ(lights[1].b, 1.0f);
+}
+
+// Spreadsheets start a CSV with a UTF-8 byte order mark; it is not part of
+// the first line (which was refused: "'\xEF\xBB\xBF0' is not a number").
+TEST(PointsCsv, AByteOrderMarkIsSkipped) {
+    TempDir dir;
+    for (const char* text : {"\xEF\xBB\xBF" "0,1,2,3,4,5\n", "\xEF\xBB\xBF" "x,y,z,r,g,b\n0,1,2,3,4,5\n"}) {
+        const std::vector<gpu::Light> lights = load_points_csv(dir.write("bom.csv", text));
+        ASSERT_EQ(lights.size(), 1u) << text;
+        expect_near({lights[0].x, lights[0].y, lights[0].z}, {0, 1, 2});
+    }
 }
 
 TEST(PointsCsv, EmptyFileGivesNoLights) {

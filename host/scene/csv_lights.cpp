@@ -148,7 +148,9 @@ std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::pa
     // ~30 bytes per point line is typical; reserving avoids regrowth for 10^6 lights.
     lights.reserve(text.size() / (format.columns * 5) + 1);
 
-    const std::string_view all(text);
+    std::string_view all(text);
+    // A UTF-8 byte order mark (spreadsheets write one) is not part of line 1.
+    if (all.substr(0, 3) == "\xEF\xBB\xBF") all.remove_prefix(3);
     std::size_t line_number = 0;
     bool seen_content = false;
     for (std::size_t pos = 0; pos < all.size();) {

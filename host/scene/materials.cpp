@@ -95,7 +95,7 @@ gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj
     if (metallic > 0.0f || sheen > 0.0f || clearcoat > 0.0f || clearcoat_roughness > 0.0f) {
         DisneyParams p;
         p.base_color = kd;
-        p.roughness = mtl.roughness > 0.0 ? unit(mtl.roughness, "Pr") : kDefaultRoughness;
+        p.roughness = mtl.roughness != 0.0 ? unit(mtl.roughness, "Pr") : kDefaultRoughness;
         p.metallic = metallic;
         p.sheen = sheen;
         p.clearcoat = clearcoat;
@@ -106,10 +106,11 @@ gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj
     }
     const glm::vec3 ks = rgb(mtl.specular, "Ks");
     // tinyobj leaves roughness at 0 when the MTL has no "Pr", so Pr = 0 means
-    // "not given" and the Blinn-Phong exponent decides (Walter et al. 2007).
+    // "not given" and the Blinn-Phong exponent decides (Walter et al. 2007);
+    // any other value was given, and must be in range.
     float alpha = 1.0f;
-    if (mtl.roughness > 0.0) {
-        if (!std::isfinite(mtl.roughness) || mtl.roughness > 1.0) {
+    if (mtl.roughness != 0.0) {
+        if (!std::isfinite(mtl.roughness) || mtl.roughness < 0.0 || mtl.roughness > 1.0) {
             throw InputError(obj_name, field + ".Pr", "must be in [0, 1]");
         }
         alpha = static_cast<float>(mtl.roughness * mtl.roughness);

@@ -93,9 +93,9 @@ private:
         // The camera basis is cross(forward, up): both must be usable.
         const glm::vec3 forward = cam.look_at - cam.position;
         const float forward_len = glm::length(forward);
-        if (!(forward_len > 0.0f) || !std::isfinite(forward_len)) {
-            in_.fail("camera.look_at", "must differ from camera.position");
-        }
+        if (!std::isfinite(forward_len))
+            in_.fail("camera.look_at", "is too far from camera.position (their distance overflows a float)");
+        if (!(forward_len > 0.0f)) in_.fail("camera.look_at", "must differ from camera.position");
         const float up_len = glm::length(cam.up);
         if (!(up_len > 0.0f) || !std::isfinite(up_len)) in_.fail("camera.up", "must not be zero");
         const float sin_angle = glm::length(glm::cross(forward / forward_len, cam.up / up_len));
