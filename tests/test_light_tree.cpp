@@ -55,8 +55,13 @@ void check_tree(const LightTree& tree, std::span<const gpu::Light> input) {
         ASSERT_GT(n.left, i);
         const gpu::LightNode& a = tree.nodes[n.left];
         const gpu::LightNode& b = tree.nodes[n.left + 1];
-        // Intensity is the sum of the children's.
-        auto near = [](float sum, float x, float y) { return std::abs(sum - (x + y)) <= 1e-5f * std::abs(sum) + 1e-30f; };
+        // Intensity is the sum of the children's: each of the three is the
+        // exact sum of its lights rounded once to float (relative error
+        // 2^-24 at most, intensities >= 0), so the node and the exact sum of
+        // its children's floats are at most 3 * 2^-24 of the node apart.
+        auto near = [](float sum, float x, float y) {
+            return std::abs(double(sum) - (double(x) + double(y))) <= 3.0 * 0x1p-24 * double(sum) + 1e-45;
+        };
         EXPECT_TRUE(near(n.intensity_r, a.intensity_r, b.intensity_r)) << i;
         EXPECT_TRUE(near(n.intensity_g, a.intensity_g, b.intensity_g)) << i;
         EXPECT_TRUE(near(n.intensity_b, a.intensity_b, b.intensity_b)) << i;

@@ -100,7 +100,9 @@ TEST(ShadingGgx, BrdfIsReciprocalAndNonNegative) {
         const glm::vec3 fba = k.lc_brdf_cos(materials[0], n, b, a, b.z) / b.z;
         for (int c = 0; c < 3; ++c) {
             ASSERT_GE(fab[c], 0.0f);
-            ASSERT_NEAR(fab[c], fba[c], 1e-4f * std::max(1.0f, fab[c])) << trial;
+            // Relative, at about 3x the largest difference measured over
+            // these trials (3.1e-7: the two orders round differently).
+            ASSERT_NEAR(fab[c], fba[c], 1e-6f * std::max(fab[c], fba[c])) << trial;
         }
     }
 }

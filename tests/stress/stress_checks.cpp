@@ -79,11 +79,14 @@ std::vector<NodeRange> check_tree(const PreparedScene& p) {
         }
         const gpu::LightNode& a = tree.nodes[n.left];
         const gpu::LightNode& b = tree.nodes[n.left + 1];
-        // Built as the float sum of the children's, so equal up to nothing;
-        // the relative slack only tolerates a different summation order.
-        const glm::vec3 sum = node_intensity(a) + node_intensity(b);
+        // The node and both children are each the exact sum of their
+        // lights rounded once to float (light_tree.cpp sums in double), so
+        // the node is within 3 * 2^-24 of the exact sum of the children's
+        // floats (intensities are >= 0).
+        const glm::dvec3 sum = glm::dvec3(node_intensity(a)) + glm::dvec3(node_intensity(b));
         for (int c = 0; c < 3; ++c)
-            if (std::abs(intensity[c] - sum[c]) > 1e-6f * sum[c]) fail(i, "intensity is not the children's sum");
+            if (std::abs(double(intensity[c]) - sum[c]) > 3.0 * 0x1p-24 * double(intensity[c]) + 1e-45)
+                fail(i, "intensity is not the children's sum");
         for (const auto* child : {&a, &b})
             if (!glm::all(glm::lessThanEqual(lo, node_min(*child))) ||
                 !glm::all(glm::greaterThanEqual(hi, node_max(*child))))

@@ -100,6 +100,9 @@ TEST(SpirvSpecialize, DropsTheCodeOfSwitchedOffFeatures) {
     std::printf("[ measured ] lightcuts.comp: %zu words, specialized %zu with every feature, %zu with none\n",
                 kLightcutsWords, all, none);
     EXPECT_LT(all, kLightcutsWords);
+    // Measured (glslang of Debian 12): 17,588 of 25,165 words, 0.70. The
+    // limit 0.8 fails if the switches stop removing the features' code,
+    // and leaves room for another glslang's code generation.
     EXPECT_LT(double(none), 0.8 * double(all)) << none << " words against " << all;
 }
 
