@@ -115,8 +115,15 @@ TEST_P(VulkanLights, BruteAndLightcutsMatchCpu) {
     // rounding may move the sum a little, as the cut sizes).
     const RenderResult cpu = render_cpu(p, lc);
     EXPECT_EQ(cpu.stats.cut_indirect_total > 0, indirect);
-    EXPECT_NEAR(double(g.stats.cut_indirect_total), double(cpu.stats.cut_indirect_total),
-                0.01 * double(cpu.stats.cut_indirect_total));
+    // A pixel whose cut differs by d clusters has at most d VPL clusters
+    // more or fewer. Measured: 29521 against 29523 (K = 64).
+    double cut_steps_apart = 0.0;
+    for (std::size_t i = 0; i < g.stats.cut_size.size(); ++i)
+        cut_steps_apart += std::abs(double(g.stats.cut_size[i]) - double(cpu.stats.cut_size[i])) * double(lc.spp);
+    std::printf("[ measured ] VPL clusters in the cuts: %llu on the GPU, %llu on the CPU (cuts %g clusters apart)\n",
+                static_cast<unsigned long long>(g.stats.cut_indirect_total),
+                static_cast<unsigned long long>(cpu.stats.cut_indirect_total), cut_steps_apart);
+    EXPECT_NEAR(double(g.stats.cut_indirect_total), double(cpu.stats.cut_indirect_total), cut_steps_apart);
 }
 
 // Lightcuts at error 0 and no cut limit is brute force over the sampled
@@ -175,11 +182,23 @@ TEST_P(VulkanSampled, SampledAndStochasticMatchCpu) {
         // Stochastic: a pixel whose cut froze clusters on either device is
         // compared at kFrozenRelative (vulkan_test_support.h) instead.
         std::vector<bool> froze(differs.size(), false), not_frozen(differs.size(), true);
+        // Where the cut is the same size, both devices froze clusters or
+        // neither did (expect_lightcuts_matches counts the same).
+        std::size_t froze_differs = 0;
         if (std::string(m.method) == "stochastic")
             for (std::size_t i = 0; i < differs.size(); ++i) {
                 froze[i] = g.stats.heap_froze[i] > 0.0f || cpu.stats.heap_froze[i] > 0.0f;
                 not_frozen[i] = !froze[i];
+                froze_differs += g.stats.cut_size[i] == cpu.stats.cut_size[i] &&
+                                         (g.stats.heap_froze[i] > 0.0f) != (cpu.stats.heap_froze[i] > 0.0f)
+                                     ? 1
+                                     : 0;
             }
+        EXPECT_LE(double(froze_differs), vulkan_test::kCutsDifferFraction * double(differs.size())) << label;
+        // The floor of max_relative_difference: 1e-6 of the image's mean value.
+        double mean = 0.0;
+        for (float v : cpu.image.rgb) mean += std::abs(v);
+        const double floor = 1e-6 * mean / double(std::max<std::size_t>(cpu.image.rgb.size(), 1));
         for (std::size_t i = 0; i < differs.size(); ++i)
             for (int ch = 0; ch < 3; ++ch) {
                 if (froze[i]) {
@@ -187,7 +206,7 @@ TEST_P(VulkanSampled, SampledAndStochasticMatchCpu) {
                     break;
                 }
                 const double a = g.image.rgb[3 * i + ch], r = cpu.image.rgb[3 * i + ch];
-                if (std::abs(a - r) > tolerance * std::abs(r) + 1e-6 && !differs[i]) {
+                if (std::abs(a - r) > tolerance * (std::abs(r) + floor) && !differs[i]) {
                     differs[i] = true;
                     ++differing;
                 }
@@ -202,8 +221,13 @@ TEST_P(VulkanSampled, SampledAndStochasticMatchCpu) {
                                                            vulkan_test::kFrozenRelative, not_frozen),
                       vulkan_test::kFrozenRelative);
         }
+        std::printf("[ measured ] %s: shadow rays %llu on the GPU, %llu on the CPU\n", label.c_str(),
+                    static_cast<unsigned long long>(g.stats.shadow_rays),
+                    static_cast<unsigned long long>(cpu.stats.shadow_rays));
+        // Rays differ where a light choice or a cut does. Measured: equal
+        // for sampled, at most 2.7e-5 apart for stochastic; about 4x that.
         EXPECT_NEAR(double(g.stats.shadow_rays), double(cpu.stats.shadow_rays),
-                    1e-3 * double(cpu.stats.shadow_rays) + 1.0)
+                    1e-4 * double(cpu.stats.shadow_rays) + 1.0)
             << label;
         if (std::string(m.method) == "stochastic") {
             EXPECT_LE(double(vulkan_test::pixels_with_different_cut(g.stats, cpu.stats)),
