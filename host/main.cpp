@@ -53,11 +53,16 @@ CLI::Validator setting(std::string_view key) {
     std::string range = lc::setting_problem(key, kNaN);
     if (range.starts_with("must be ")) range.erase(0, 8);
     return ask(
-        [key](const std::string& text) {
+        [key](std::string& text) {
             double value = kNaN;
             const char* end = text.data() + text.size();
             if (auto [p, ec] = std::from_chars(text.data(), end, value); ec != std::errc{} || p != end) value = kNaN;
-            return lc::setting_problem(key, value);
+            std::string problem = lc::setting_problem(key, value);
+            // A whole number written as "4.0" or "1e1" is that integer, as in
+            // a scene file; CLI11 converts integer options from digits only.
+            if (problem.empty() && value == std::floor(value) && std::abs(value) < 0x1p53)
+                text = std::to_string(static_cast<long long>(value));
+            return problem;
         },
         range);
 }
@@ -199,46 +204,46 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
                        "brute (exact), lightcuts, sampled (lights drawn through the light tree), "
                        "stochastic (Stochastic Lightcuts) or path (the path tracer, CPU only)")
         ->check(ask(lc::method_problem));
-    render->add_option("--spp", r.spp, "Camera rays per pixel")->check(setting(lc::kSettingSpp));
-    render->add_option("--width", r.width, "Image width")->check(setting(lc::kSettingWidth));
-    render->add_option("--height", r.height, "Image height")->check(setting(lc::kSettingHeight));
+    render->add_option("--spp", r.spp, "Camera rays per pixel")->transform(setting(lc::kSettingSpp));
+    render->add_option("--width", r.width, "Image width")->transform(setting(lc::kSettingWidth));
+    render->add_option("--height", r.height, "Image height")->transform(setting(lc::kSettingHeight));
     render->add_option("--error", r.relative_error,
                        "lightcuts and stochastic: relative error threshold of the cut (default 0.02)")
-        ->check(setting(lc::kSettingRelativeError));
+        ->transform(setting(lc::kSettingRelativeError));
     render->add_option("--max-cut", r.max_cut, "lightcuts and stochastic: largest cut (default 1000)")
-        ->check(setting(lc::kSettingMaxCut));
+        ->transform(setting(lc::kSettingMaxCut));
     render->add_option("--cut-heap", r.cut_heap,
                        "lightcuts and stochastic: cut-heap capacity per shaded point; a larger cut freezes "
                        "its clusters of smallest bound (default " + std::to_string(lc::kDefaultCutHeap) + ")")
-        ->check(setting(lc::kSettingCutHeap));
+        ->transform(setting(lc::kSettingCutHeap));
     render->add_option("--area-samples", r.area_samples,
                        "Point lights the emissive surfaces become, in all (default 65536)")
-        ->check(setting(lc::kSettingAreaLightSamples));
+        ->transform(setting(lc::kSettingAreaLightSamples));
     render->add_option("--light-samples", r.light_samples,
                        "sampled: lights drawn per camera sample; stochastic: representatives drawn per cluster "
                        "of the cut; path: paths per camera ray (default 1)")
-        ->check(setting(lc::kSettingLightSamples));
+        ->transform(setting(lc::kSettingLightSamples));
     render->add_option("--light-pick", r.light_pick,
                        "sampled: how lights are drawn: tree (importance through the light tree, the default), "
                        "uniform or power")
         ->check(ask(lc::light_pick_problem));
     render->add_option("--vpls", r.vpls,
                        "Virtual point lights for indirect light (render.indirect.vpls; 0 = direct light only)")
-        ->check(setting(lc::kSettingVpls));
+        ->transform(setting(lc::kSettingVpls));
     render->add_option("--vpl-bounces", r.vpl_bounces,
                        "VPLs per light path at most (render.indirect.max_bounces, default 3; 0 = until roulette)")
-        ->check(setting(lc::kSettingMaxBounces));
+        ->transform(setting(lc::kSettingMaxBounces));
     render->add_option("--vpl-clamp", r.vpl_clamp,
                        "Distance below which a VPL's 1/d^2 stops growing (render.indirect.clamp; 0 = none)")
-        ->check(setting(lc::kSettingClamp));
+        ->transform(setting(lc::kSettingClamp));
     render->add_option("--max-bounces", r.max_bounces,
                        "path: surface interactions per path (1 = direct light only; 0 = unlimited, the default)")
-        ->check(setting(lc::kSettingMaxBounces));
+        ->transform(setting(lc::kSettingMaxBounces));
     render->add_option("--time-limit", r.time_limit,
                        "path: stop after the sample pass that ends past this many seconds (0 = none)")
-        ->check(setting(lc::kSettingTimeLimit));
+        ->transform(setting(lc::kSettingTimeLimit));
     render->add_option("--seed", r.seed, "Seed for pixel jitter, light-tree representatives and light samples")
-        ->check(setting(lc::kSettingSeed));
+        ->transform(setting(lc::kSettingSeed));
     render->add_option("--threads", r.threads, "CPU threads (0 = all cores)");
     render->add_option("--device", r.device.device,
                        "auto (a hardware GPU through Vulkan, else the CPU path), cpu or vulkan")

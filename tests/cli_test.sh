@@ -55,6 +55,12 @@ expect_error "bad_env_nan.exr: pixel (1, 0)" render "$root/tests/data/scenes/bad
 expect_error "bad_env_two.json: lights[1]" render "$root/tests/data/scenes/bad_env_two.json" -o "$tmp/c.exr"
 expect_error "bad_ke.obj: material 'glow'.Ke" render "$root/tests/data/scenes/bad_mtl_ke.json" -o "$tmp/c.exr"
 expect_error "--area-samples" render "$root/scenes/room/room.json" -o "$tmp/c.exr" --area-samples 0
+expect_error "--spp: must be an integer from 1 to 65536" render "$root/scenes/room/room.json" -o "$tmp/c.exr" --spp 2.5
+# A whole number written with a point or an exponent is that integer, as in a scene file.
+"$exe" render "$root/scenes/room/room.json" -o "$tmp/w.exr" --no-png --device cpu --width 1.2e1 --height 8.0 \
+  --stats "$tmp/w.json" >/dev/null 2>&1 || fail "--width 1.2e1 --height 8.0 were refused"
+grep -Eq '"width": 12,?$' "$tmp/w.json" || fail "--width 1.2e1 did not give 12 columns"
+rm -f "$tmp/w.exr" "$tmp/w.json"
 expect_error "folder $tmp/nowhere does not exist" render "$root/scenes/room/room.json" -o "$tmp/nowhere/c.exr"
 expect_error "must end in .exr" render "$root/scenes/room/room.json" -o "$tmp/c.png"
 expect_error "nope.exr" compare "$tmp/a.exr" "$tmp/nope.exr"
