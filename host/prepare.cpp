@@ -79,7 +79,7 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
     // infinite root intensity, and lightcuts infinite or NaN pixels).
     loader::LightLimits limits;
     for (const gpu::Light& l : scene.lights) limits.add(l);
-    check_generated_totals(scene, limits, area, "emission",
+    check_generated_totals(scene, limits, area, "emissive surfaces",
                            "the lights sampled on the emissive surfaces (emission times area)");
     check_generated_totals(scene, limits, sky, "environment",
                            "the environment's directional lights (radiance times solid angle)");
@@ -91,7 +91,7 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
     if (scene.render.indirect.vpls > 0) {
         const auto vpl_start = std::chrono::steady_clock::now();
         VplSet vpls = trace_vpls(scene, prepared.bvh, lights, scene.render.indirect, seed);
-        check_generated_totals(scene, limits, vpls.lights, "render.indirect", "the virtual point lights");
+        check_generated_totals(scene, limits, vpls.lights, "indirect light", "the virtual point lights");
         prepared.vpls = vpls.lights.size();
         prepared.vpl_paths = vpls.paths;
         lights.insert(lights.end(), vpls.lights.begin(), vpls.lights.end());

@@ -315,7 +315,7 @@ TEST(GeneratedLights, TotalsPastTheFloatRangeAreRefused) {
     test::add_quad(glow, {-1, 1.9f, -1}, {1, 1.9f, -1}, {1, 1.9f, 1}, {-1, 1.9f, 1},
                    std::uint32_t(glow.materials.size() - 1));
     update_bounds(glow);
-    expect_refused(std::move(glow), "emission");
+    expect_refused(std::move(glow), "emissive surfaces");
 }
 
 }  // namespace

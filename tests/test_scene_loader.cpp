@@ -240,12 +240,14 @@ TEST(SceneLoader, ObjAndMtlNumbersThatAreNotNumbersAreRefused) {
         const std::string start = (dir.path() / b.file).lexically_normal().string() + ": " + b.start;
         EXPECT_EQ(message.rfind(start, 0), 0u) << message << "\n  wanted: " << start;
     }
-    // What the check lets through: signs, exponents, comments, tabs, CRLF,
-    // a vertex with a w or a colour, the MTL's "d -halo".
+    // What the check lets through: signs, exponents, comments, tabs, CRLF
+    // and lone CR line ends, a vertex with a w or a colour, a vertex normal
+    // of NaNs (the face normal replaces it), and MTL keys the renderer does
+    // not read, whatever they hold.
     TempDir dir;
-    dir.write("m.obj", "mtllib m.mtl\r\nv -0 +0 0.0 # a comment\r\nv\t1.e0 0 0 1\nv .5 1E+0 -0e-3 1 0.5 0\n"
-                       "vt 0.5\nusemtl m\nf 1 2 3\n");
-    dir.write("m.mtl", "newmtl m\nKd 0.5 0.5 0.5\nd -halo 1\nNs 10\n");
+    dir.write("m.obj", "mtllib m.mtl\r\nv -0 +0 0.0 # a comment\r\nv\t1.e0 0 0 1\rv .5 1E+0 -0e-3 1 0.5 0\n"
+                       "vt 0.5\nvn nan -nan(ind) INF\nusemtl m\nf 1//1 2//1 3//1\n");
+    dir.write("m.mtl", "newmtl m\nKd 0.5 0.5 0.5\nd -halo 1\nNs 10\nKa spectral ident.rfl 1\nTf xyz 1 1 1\nKa 0.2\n");
     const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
  "meshes": [{"obj": "m.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
     const Scene loaded = load_scene(scene);
@@ -268,6 +270,16 @@ TEST(SceneLoader, InputFilesListEveryFileRead) {
     const std::set<std::string> room = names(load_scene(kScenes / "room" / "room.json"));
     for (const char* f : {"room.json", "room.obj", "room.mtl", "torus.obj", "room_lights.csv"})
         EXPECT_EQ(room.count(f), 1u) << f;
+    // An environment map (read by tinyexr), a glTF's images (by tinygltf).
+    TempDir dir;
+    fs::copy_file(kFixtures / "tri.obj", dir.path() / "tri.obj");
+    fs::copy_file(kScenes / "sky" / "sky.exr", dir.path() / "sky.exr");
+    const fs::path sky = dir.write("sky.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "tri.obj"}], "lights": [{"type": "environment", "file": "sky.exr"}]})");
+    EXPECT_EQ(names(load_scene(sky)), (std::set<std::string>{"sky.json", "tri.obj", "sky.exr"}));
+    const std::set<std::string> textured = names(load_scene(kScenes / "gltf" / "textured.gltf"));
+    for (const char* f : {"textured.gltf", "textured.bin", "checker.png", "metal_rough.png", "glow.png", "bumps.png"})
+        EXPECT_EQ(textured.count(f), 1u) << f;
 }
 
 // tinyobj's Pr is 0 when the MTL has none; any other value was given and

@@ -52,6 +52,30 @@ std::string trimmed(std::string text) {
     return text;
 }
 
+int hex_digit(char c) {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return 0;
+}
+
+// A URI's file name as tinygltf 2.7 opens it: "%20" and the like are the
+// bytes they encode, "+" is a space.
+std::string decoded_uri(const std::string& uri) {
+    std::string out;
+    for (std::size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '+') {
+            out += ' ';
+        } else if (uri[i] == '%' && i + 2 < uri.size()) {
+            out += char(hex_digit(uri[i + 1]) * 16 + hex_digit(uri[i + 2]));
+            i += 2;
+        } else {
+            out += uri[i];
+        }
+    }
+    return out;
+}
+
 }  // namespace
 
 tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
@@ -83,9 +107,10 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
     }
     if (!ok) throw InputError(name, "", "tinygltf: " + (err.empty() ? std::string("cannot parse the file") : trimmed(err)));
     check_gltf_types(json, name);
-    // The buffers and images tinygltf read from files beside this one.
+    // The buffers and images tinygltf read from files beside this one, by
+    // their URIs decoded as tinygltf decodes them.
     auto note_uri = [&](const std::string& uri) {
-        if (!uri.empty() && uri.rfind("data:", 0) != 0) note_input_file(fs::path(base) / uri);
+        if (!uri.empty() && uri.rfind("data:", 0) != 0) note_input_file(fs::path(base) / decoded_uri(uri));
     };
     for (const tinygltf::Buffer& b : model.buffers) note_uri(b.uri);
     for (const tinygltf::Image& i : model.images) note_uri(i.uri);

@@ -296,6 +296,30 @@ private:
         return glm::vec3(d / length);
     }
 
+    // kGltfImageHeight rows and aspect times as many columns (as many rows
+    // as columns without an aspect ratio); where that is more than
+    // kMaxImageSide columns, or less than one, the size is scaled to fit,
+    // with a note.
+    void image_size(double aspect, const std::string& name, Camera& c) {
+        c.width = c.height = kGltfImageHeight;
+        if (!(aspect > 0.0)) return;
+        const double side = double(kMaxImageSide);
+        double width = aspect * kGltfImageHeight, height = kGltfImageHeight;
+        if (width > side) {
+            height = std::max(1.0, std::round(side / aspect));
+            width = side;
+        } else if (width < 1.0) {
+            height = std::min(side, std::round(1.0 / aspect));
+            width = 1.0;
+        }
+        c.width = std::uint32_t(std::max(1.0, std::round(width)));
+        c.height = std::uint32_t(height);
+        if (height != kGltfImageHeight)
+            notes_.add(name + ".perspective.aspectRatio",
+                       "the image is " + std::to_string(c.width) + "x" + std::to_string(c.height) + " to keep each side within " +
+                           std::to_string(kMaxImageSide) + " pixels");
+    }
+
     void add_camera(int index, const std::string& node, const glm::dmat4& world) {
         if (std::size_t(index) >= model_.cameras.size())
             fail(node + ".camera", "camera " + std::to_string(index) + " out of range (" +
@@ -309,13 +333,6 @@ private:
         const double yfov = cam.perspective.yfov * 180.0 / 3.14159265358979323846;
         if (!(yfov > 0.0 && yfov < 180.0)) fail(name + ".perspective.yfov", "must be in (0, pi)");
         // 0 where the file has none (check_gltf_types refuses a 0 it has).
-        const double aspect = cam.perspective.aspectRatio;
-        const double width = std::round(aspect * kGltfImageHeight);
-        if (aspect != 0.0 && !(width >= 1.0 && width <= double(kMaxImageSide)))
-            fail(name + ".perspective.aspectRatio",
-                 "makes the image " + (std::isfinite(width) ? std::to_string(std::llround(width)) : std::string("inf")) +
-                     " pixels wide at its height of " + std::to_string(kGltfImageHeight) + "; must be from 1 to " +
-                     std::to_string(kMaxImageSide));
         Camera c;
         c.position = glm::vec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
         if (!is_finite(c.position)) fail(node, "the camera's position is not finite");
@@ -324,8 +341,7 @@ private:
         if (!(glm::length(glm::cross(c.look_at - c.position, c.up)) > 1e-6f))
             fail(node, "the camera's up is parallel to its view direction");
         c.fov_y_degrees = float(yfov);
-        c.height = kGltfImageHeight;
-        c.width = aspect > 0.0 ? std::uint32_t(width) : kGltfImageHeight;
+        image_size(cam.perspective.aspectRatio, name, c);
         contents_.cameras.push_back({cam.name, c});
     }
 

@@ -18,6 +18,11 @@ public:
         throw InputError(name_, path, problem);
     }
 
+    // "path.key", or "key" at the top level.
+    static std::string at(const std::string& path, const char* key) {
+        return path.empty() ? std::string(key) : path + "." + key;
+    }
+
     // The member `key` of `object`, if both are there and it is an object.
     static const json* member(const json& object, const char* key) {
         if (!object.is_object()) return nullptr;
@@ -27,33 +32,33 @@ public:
 
     void number(const json& object, const char* key, const std::string& path) const {
         if (const json* v = member(object, key); v && !v->is_number())
-            fail(path + "." + key, std::string("must be a number, not a ") + v->type_name());
+            fail(at(path, key), std::string("must be a number, not a ") + v->type_name());
     }
 
     void numbers(const json& object, const char* key, std::size_t count, const std::string& path) const {
         const json* v = member(object, key);
         if (!v) return;
         if (!v->is_array() || v->size() != count)
-            fail(path + "." + key, "must be an array of " + std::to_string(count) + " numbers");
+            fail(at(path, key), "must be an array of " + std::to_string(count) + " numbers");
         for (std::size_t i = 0; i < count; ++i)
             if (!(*v)[i].is_number())
-                fail(path + "." + key + "[" + std::to_string(i) + "]",
+                fail(at(path, key) + "[" + std::to_string(i) + "]",
                      std::string("must be a number, not a ") + (*v)[i].type_name());
     }
 
     void index(const json& object, const char* key, const std::string& path) const {
         if (const json* v = member(object, key); v && !(v->is_number_unsigned()))
-            fail(path + "." + key, "must be a whole number >= 0, not " +
+            fail(at(path, key), "must be a whole number >= 0, not " +
                                        (v->is_number() ? v->dump() : std::string("a ") + v->type_name()));
     }
 
     void indices(const json& object, const char* key, const std::string& path) const {
         const json* v = member(object, key);
         if (!v) return;
-        if (!v->is_array()) fail(path + "." + key, "must be an array of whole numbers >= 0");
+        if (!v->is_array()) fail(at(path, key), "must be an array of whole numbers >= 0");
         for (std::size_t i = 0; i < v->size(); ++i)
             if (!(*v)[i].is_number_unsigned())
-                fail(path + "." + key + "[" + std::to_string(i) + "]", "must be a whole number >= 0");
+                fail(at(path, key) + "[" + std::to_string(i) + "]", "must be a whole number >= 0");
     }
 
     // Calls f(element, "key[i]") for each element of the array `key` of `object`.
@@ -62,17 +67,17 @@ public:
         const json* v = member(object, key);
         if (!v || !v->is_array()) return;
         for (std::size_t i = 0; i < v->size(); ++i)
-            f((*v)[i], (path.empty() ? "" : path + ".") + key + "[" + std::to_string(i) + "]");
+            f((*v)[i], at(path, key) + "[" + std::to_string(i) + "]");
     }
 
     void texture_info(const json& material, const char* key, const std::string& path) const {
         const json* t = member(material, key);
         if (!t) return;
-        const std::string at = path + "." + key;
-        index(*t, "index", at);
-        index(*t, "texCoord", at);
-        number(*t, "scale", at);
-        number(*t, "strength", at);
+        const std::string where = at(path, key);
+        index(*t, "index", where);
+        index(*t, "texCoord", where);
+        number(*t, "scale", where);
+        number(*t, "strength", where);
     }
 
     void material(const json& m, const std::string& path) const {

@@ -47,9 +47,12 @@ void read_obj(const std::filesystem::path& file, const std::string& obj_name, bo
     // tinyobjloader reads a number it cannot parse as 0: checked first.
     const std::string text = read_input_file(file);
     check_obj_numbers(text, obj_name);
-    if (uses_mtl)
-        for (const std::filesystem::path& library : material_libraries(text, file.parent_path()))
-            check_mtl_numbers(read_input_file(library), display(library));
+    // tinyobjloader reads the material libraries with or without a
+    // material override: they are the scene's inputs either way.
+    for (const std::filesystem::path& library : material_libraries(text, file.parent_path())) {
+        const std::string mtl = read_input_file(library);
+        if (uses_mtl) check_mtl_numbers(mtl, display(library));
+    }
     tinyobj::ObjReaderConfig config;
     config.triangulate = true;
     config.vertex_color = false;

@@ -1,6 +1,7 @@
 // Number checks of OBJ and MTL text ahead of tinyobjloader (obj_numbers.h).
 #include "obj_numbers.h"
 
+#include <algorithm>
 #include <cctype>
 
 #include "lightcuts/error.h"
@@ -13,15 +14,16 @@ struct Line {
     std::vector<std::string_view> words;  // up to a '#' comment
 };
 
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
 
-// Calls visit(Line) for each line that has a word.
+// Calls visit(Line) for each line that has a word. Lines end as
+// tinyobjloader ends them: at "\n", "\r\n" or a lone "\r".
 template <class Visit>
 void for_each_line(std::string_view text, Visit&& visit) {
     Line line{0, {}};
     std::size_t at = 0;
     while (at <= text.size()) {
-        const std::size_t end = std::min(text.find('\n', at), text.size());
+        const std::size_t end = std::min(text.find_first_of("\r\n", at), text.size());
         ++line.number;
         line.words.clear();
         std::size_t i = at;
@@ -33,7 +35,7 @@ void for_each_line(std::string_view text, Visit&& visit) {
             line.words.push_back(text.substr(start, i - start));
         }
         if (!line.words.empty()) visit(line);
-        at = end + 1;
+        at = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
     }
 }
 
@@ -61,11 +63,24 @@ bool is_number(std::string_view w) {
     return i == w.size();
 }
 
-// Words 1.. of `line` are `least` or more numbers (all of them numbers).
-void check_numbers(const Line& line, std::size_t least, const std::string& name) {
+// "nan", "-nan(ind)", "inf", "Infinity" and the like, any case.
+bool is_non_finite(std::string_view w) {
+    if (!w.empty() && (w[0] == '+' || w[0] == '-')) w.remove_prefix(1);
+    auto starts = [&](std::string_view prefix) {
+        if (w.size() < prefix.size()) return false;
+        for (std::size_t i = 0; i < prefix.size(); ++i)
+            if (std::tolower(static_cast<unsigned char>(w[i])) != prefix[i]) return false;
+        return true;
+    };
+    return starts("nan") || starts("inf");
+}
+
+// Words 1.. of `line` are `least` or more numbers (all of them numbers;
+// with `non_finite_ok`, NaN and infinity spelt out count as numbers).
+void check_numbers(const Line& line, std::size_t least, const std::string& name, bool non_finite_ok = false) {
     const std::string field = "line " + std::to_string(line.number) + " (" + std::string(line.words[0]) + ")";
     for (std::size_t k = 1; k < line.words.size(); ++k)
-        if (!is_number(line.words[k]))
+        if (!is_number(line.words[k]) && !(non_finite_ok && is_non_finite(line.words[k])))
             throw InputError(name, field, "'" + std::string(line.words[k]) + "' is not a number");
     if (line.words.size() - 1 < least)
         throw InputError(name, field, "needs " + std::to_string(least) + " numbers, has " +
@@ -117,7 +132,12 @@ void check_weights(const Line& line, const std::string& name) {
 void check_obj_numbers(std::string_view text, const std::string& name) {
     for_each_line(text, [&](const Line& line) {
         const std::string_view key = line.words[0];
-        if (key == "v" || key == "vn") check_numbers(line, 3, name);
+        if (key == "v") check_numbers(line, 3, name);
+        // Some exporters write "vn nan nan nan" for a degenerate face;
+        // tinyobjloader reads 0 and the loader takes the face normal for a
+        // zero vertex normal, as documented. Words that are no number at
+        // all are still refused.
+        else if (key == "vn") check_numbers(line, 3, name, true);
         else if (key == "vt") check_numbers(line, 1, name);
         else if (key == "f") check_face(line, name);
         else if (key == "vw") check_weights(line, name);
@@ -127,16 +147,13 @@ void check_obj_numbers(std::string_view text, const std::string& name) {
 void check_mtl_numbers(std::string_view text, const std::string& name) {
     for_each_line(text, [&](const Line& line) {
         const std::string_view key = line.words[0];
-        if (key == "Ka" || key == "Kd" || key == "Ks" || key == "Ke" || key == "Kt" || key == "Tf") {
+        // The keys materials.cpp reads (convert_mtl); the others are not
+        // used, whatever they hold. A colour needs all three numbers:
+        // tinyobjloader reads "Kd 0.5" as (0.5, 0, 0), where the MTL
+        // format means grey.
+        if (key == "Kd" || key == "Ks" || key == "Ke") {
             check_numbers(line, 3, name);
-        } else if (key == "d" && line.words.size() > 1 && line.words[1] == "-halo") {
-            // "d -halo 0.5": the halo option, then the number.
-            Line value = line;
-            value.words.erase(value.words.begin() + 1);
-            check_numbers(value, 1, name);
-        } else if (key == "Ns" || key == "Ni" || key == "d" || key == "Tr" || key == "illum" || key == "Pr" ||
-                   key == "Pm" || key == "Ps" || key == "Pc" || key == "Pcr" || key == "aniso" ||
-                   key == "anisor") {
+        } else if (key == "Ns" || key == "Pr" || key == "Pm" || key == "Ps" || key == "Pc" || key == "Pcr") {
             check_numbers(line, 1, name);
         }
     });

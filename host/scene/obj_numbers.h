@@ -13,14 +13,15 @@ namespace lc::loader {
 
 // Every number of every `v`, `vn` and `vt` line of `text` (an OBJ, shown as
 // `name` in errors) is a decimal number, and the line has as many as it
-// needs (3 for v and vn, 1 for vt); every index of an `f` line, and the
-// vertex and joints of a `vw` line, are whole numbers within int's range.
-// Throws InputError "NAME: line N (v): 'nan' is not a number".
+// needs (3 for v and vn, 1 for vt); a vn may also hold NaN or infinity
+// spelt out (the loader falls back to the face normal). Every index of an
+// `f` line, and the vertex and joints of a `vw` line, are whole numbers
+// within int's range. Throws InputError "NAME: line N (v): 'nan' is not a
+// number".
 void check_obj_numbers(std::string_view text, const std::string& name);
 
-// The same for the MTL values the loader reads: the colours (Ka, Kd, Ks,
-// Ke, Kt, Tf: three numbers each) and the scalars (Ns, Ni, d, Tr, illum,
-// and the PBR extension's Pr, Pm, Ps, Pc, Pcr, aniso, anisor).
+// The same for the MTL values the loader reads: the colours Kd, Ks and Ke
+// (three numbers each) and the scalars Ns, Pr, Pm, Ps, Pc and Pcr.
 void check_mtl_numbers(std::string_view text, const std::string& name);
 
 // The material libraries tinyobjloader reads for this OBJ text: of each

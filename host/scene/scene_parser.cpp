@@ -94,7 +94,8 @@ private:
         const glm::vec3 forward = cam.look_at - cam.position;
         const float forward_len = glm::length(forward);
         if (!std::isfinite(forward_len))
-            in_.fail("camera.look_at", "is too far from camera.position (their distance overflows a float)");
+            in_.fail("camera.look_at", "is too far from camera.position (the square of their distance overflows "
+                                       "a float: at most about 1.8e19 apart)");
         if (!(forward_len > 0.0f)) in_.fail("camera.look_at", "must differ from camera.position");
         const float up_len = glm::length(cam.up);
         if (!(up_len > 0.0f) || !std::isfinite(up_len)) in_.fail("camera.up", "must not be zero");

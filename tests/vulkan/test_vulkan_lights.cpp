@@ -115,15 +115,19 @@ TEST_P(VulkanLights, BruteAndLightcutsMatchCpu) {
     // rounding may move the sum a little, as the cut sizes).
     const RenderResult cpu = render_cpu(p, lc);
     EXPECT_EQ(cpu.stats.cut_indirect_total > 0, indirect);
-    // A pixel whose cut differs by d clusters has at most d VPL clusters
-    // more or fewer. Measured: 29521 against 29523 (K = 64).
+    // A pixel whose cut differs by d clusters has d VPL clusters more or
+    // fewer at most, and cuts of one size may still differ in which
+    // cluster was refined (bounds within rounding), as the shadow rays do
+    // (kVplShadowRaysRelative). Measured: 29521 against 29523, the cuts 4
+    // clusters apart (K = 64).
     double cut_steps_apart = 0.0;
     for (std::size_t i = 0; i < g.stats.cut_size.size(); ++i)
         cut_steps_apart += std::abs(double(g.stats.cut_size[i]) - double(cpu.stats.cut_size[i])) * double(lc.spp);
     std::printf("[ measured ] VPL clusters in the cuts: %llu on the GPU, %llu on the CPU (cuts %g clusters apart)\n",
                 static_cast<unsigned long long>(g.stats.cut_indirect_total),
                 static_cast<unsigned long long>(cpu.stats.cut_indirect_total), cut_steps_apart);
-    EXPECT_NEAR(double(g.stats.cut_indirect_total), double(cpu.stats.cut_indirect_total), cut_steps_apart);
+    EXPECT_NEAR(double(g.stats.cut_indirect_total), double(cpu.stats.cut_indirect_total),
+                cut_steps_apart + vulkan_test::kVplShadowRaysRelative * double(cpu.stats.cut_indirect_total));
 }
 
 // Lightcuts at error 0 and no cut limit is brute force over the sampled

@@ -333,7 +333,8 @@ def bad_cases():
     variant("bad_aspect_zero", lambda d: (d.update(cameras=[{"type": "perspective", "perspective": {
         "yfov": 0.8, "aspectRatio": 0, "znear": 0.1}}]), d["nodes"].append({"camera": 0, "translation": [0, 0, 3]}),
         d["scenes"][0]["nodes"].append(len(d["nodes"]) - 1)))
-    variant("bad_aspect_wide", lambda d: (d.update(cameras=[{"type": "perspective", "perspective": {
+    # Not bad: a camera whose aspect ratio would make the image wider than 16384 columns.
+    variant("wide_camera", lambda d: (d.update(cameras=[{"type": "perspective", "perspective": {
         "yfov": 0.8, "aspectRatio": 100, "znear": 0.1}}]), d["nodes"].append({"camera": 0, "translation": [0, 0, 3]}),
         d["scenes"][0]["nodes"].append(len(d["nodes"]) - 1)))
     variant("bad_projective_matrix", lambda d: d["nodes"][0].update(
