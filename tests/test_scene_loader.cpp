@@ -502,6 +502,27 @@ TEST(SceneLoader, DegenerateTrianglesAreDroppedAndCounted) {
     EXPECT_EQ(scene.degenerate_triangles_dropped, 3u);
 }
 
+// A triangle too large for float arithmetic (its area's square overflows)
+// is refused naming it; it was dropped and counted as degenerate. One
+// 1e8 units wide loads.
+TEST(SceneLoader, TooLargeTrianglesAreNamed) {
+    auto scene_with = [](const TempDir& dir, const std::string& size) {
+        dir.write("big.obj", "v -" + size + " 0 -" + size + "\nv " + size + " 0 -" + size + "\nv 0 0 " + size +
+                                 "\nf 1 3 2\n");
+        return dir.write("s.json", R"({"camera": {"position": [0, 5, 10], "look_at": [0, 0, 0]},
+ "meshes": [{"obj": "big.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+    };
+    TempDir dir;
+    const Scene ground = load_scene(scene_with(dir, "1e8"));
+    EXPECT_EQ(ground.triangles.size(), 1u);
+    EXPECT_EQ(ground.degenerate_triangles_dropped, 0u);
+    EXPECT_NEAR(ground.normals[0].n0_y, 1.0f, 1e-6f);
+    const std::string message = input_error_of([&] { load_scene(scene_with(dir, "1e10")); });
+    EXPECT_NE(message.find("big.obj: triangle 1: too large for the renderer's float arithmetic"),
+              std::string::npos)
+        << message;
+}
+
 TEST(SceneLoader, BoundsCoverTrianglesOnlyNotLights) {
     Scene scene = load_scene(kFixtures / "all_lights.json");
     // tri.obj spans [0,1]^2 x {0}; the point lights at (0,2,1), (1,2,3),

@@ -41,6 +41,28 @@ inline bool face_normal(const std::array<glm::vec3, 3>& v, glm::vec3& unit) {
     return unit_vector(glm::cross(b - a, c - a), unit);
 }
 
+enum class TriangleShape { ok, degenerate, too_large };
+
+// A triangle's corners as the renderer stores them: degenerate where a
+// corner is not finite or its edges' cross product has no length or
+// direction (dropped and counted); too large where the length of that
+// cross product, taken in float as the kernels take such lengths,
+// overflows (edges of about 4e9 or more: refused, naming the triangle; it
+// was dropped as degenerate). `face` is the unit face normal where ok.
+inline TriangleShape triangle_shape(const std::array<glm::vec3, 3>& v, glm::vec3& face) {
+    for (const glm::vec3& p : v)
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return TriangleShape::degenerate;
+    const float twice_area = glm::length(glm::cross(v[1] - v[0], v[2] - v[0]));
+    if (!std::isfinite(twice_area)) return TriangleShape::too_large;
+    if (!(twice_area > 0.0f) || !face_normal(v, face)) return TriangleShape::degenerate;
+    return TriangleShape::ok;
+}
+
+// What an InputError says of a TriangleShape::too_large triangle.
+inline constexpr const char* kTriangleTooLarge =
+    "too large for the renderer's float arithmetic: its area's square overflows (edges of about 4e9 or more); "
+    "scale the scene down";
+
 // Finite and within ±FLT_MAX (false for NaN).
 inline bool fits_float(double v) { return v >= -kFloatMax && v <= kFloatMax; }
 inline bool fits_float(glm::dvec3 p) { return fits_float(p.x) && fits_float(p.y) && fits_float(p.z); }

@@ -250,11 +250,10 @@ private:
                       const MeshTransform& t, const std::string& field) {
         std::array<glm::vec3, 3> v;
         for (int k = 0; k < 3; ++k) v[std::size_t(k)] = glm::vec3(t.position * glm::vec4(p[c[std::size_t(k)]], 1.0f));
-        const glm::vec3 cross = glm::cross(v[1] - v[0], v[2] - v[0]);
-        const float twice_area = glm::length(cross);
         glm::vec3 face;
-        if (!is_finite(v[0]) || !is_finite(v[1]) || !is_finite(v[2]) || !std::isfinite(twice_area) ||
-            !(twice_area > 0.0f) || !face_normal(v, face)) {
+        const TriangleShape shape = triangle_shape(v, face);
+        if (shape == TriangleShape::too_large) fail(field, kTriangleTooLarge);
+        if (shape == TriangleShape::degenerate) {
             ++target_.scene.degenerate_triangles_dropped;
             return false;
         }

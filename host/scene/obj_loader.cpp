@@ -19,7 +19,6 @@ namespace {
 
 using Corners = std::array<tinyobj::index_t, 3>;
 
-bool is_finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // tinyobj treats a missing .mtl or an unknown usemtl name as a warning and
 // falls back to "no material"; silently grey walls are worse than an error.
@@ -232,11 +231,10 @@ private:
     bool add_triangle(const Corners& idx, int mtl_id, std::size_t f, const tinyobj::shape_t& shape) {
         const std::array<glm::vec3, 3> v{position(idx[0].vertex_index), position(idx[1].vertex_index),
                                          position(idx[2].vertex_index)};
-        const glm::vec3 cross = glm::cross(v[1] - v[0], v[2] - v[0]);
-        const float twice_area = glm::length(cross);
-        const bool finite = is_finite(v[0]) && is_finite(v[1]) && is_finite(v[2]) && std::isfinite(twice_area);
         glm::vec3 face;
-        if (!finite || !(twice_area > 0.0f) || !loader::face_normal(v, face)) {
+        const TriangleShape shape_of = triangle_shape(v, face);
+        if (shape_of == TriangleShape::too_large) throw InputError(obj_name_, face_name(f, shape), kTriangleTooLarge);
+        if (shape_of == TriangleShape::degenerate) {
             ++target_.scene.degenerate_triangles_dropped;
             return false;
         }
