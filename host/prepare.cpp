@@ -75,8 +75,9 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
     lights.insert(lights.end(), sky.begin(), sky.end());
     // The loader checked the scene's own lights' totals; the lights made
     // from emissive surfaces and the environment join the same per-type
-    // sums, which must stay finite as floats too (two skies of 3e37 made an
-    // infinite root intensity, and lightcuts infinite or NaN pixels).
+    // sums, which must stay finite as floats too (a sky of radiance 3e37,
+    // 3.8e38 over the sphere, made an infinite root intensity, and
+    // lightcuts infinite pixels).
     loader::LightLimits limits;
     for (const gpu::Light& l : scene.lights) limits.add(l);
     check_generated_totals(scene, limits, area, "emissive surfaces",
