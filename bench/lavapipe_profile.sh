@@ -37,7 +37,13 @@ perf_pid=$!
 # LC_PROFILE_DELAY: seconds to wait first (a render shorter than it leaves
 # nothing to copy).
 sleep "${LC_PROFILE_DELAY:-1}"
-pid="$(pgrep -n -x lightcuts)"
+pid="$(pgrep -n -x lightcuts || true)"
+if [ -z "$pid" ]; then
+  wait "$perf_pid" || true
+  echo "lavapipe_profile: the render ended within ${LC_PROFILE_DELAY:-1} s, before its kernels could be copied;" \
+       "render a larger image (128x128 on the room takes a few seconds)" >&2
+  exit 1
+fi
 grep -E 'r-xp 00000000 00:00 0' "/proc/$pid/maps" | grep -v vdso | while read -r range _; do
   start="${range%-*}" end="${range#*-}"
   python3 -c "import sys
