@@ -175,16 +175,14 @@ long text_width(const std::string& s, long scale) {
     return s.empty() ? 0 : long(s.size()) * (kGlyphW + 1) * scale - scale;
 }
 
-}  // namespace
-
-// A max_value that is not positive and finite falls back to 1. NaN values
-// are drawn magenta. The legend below the map is a colour bar with ticks
-// labelled 0, max/2 and max; labels that do not fit the width are dropped,
-// the middle one first.
-void write_heatmap_png(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
-                       const std::vector<float>& values, float max_value) {
+// The heatmap's pixels: the map, then its legend below it. A max_value
+// that is not positive and finite falls back to 1. NaN values are drawn
+// magenta. The legend is a colour bar with ticks labelled 0, max/2 and max;
+// labels that do not fit the width are dropped, the middle one first.
+Canvas heatmap_canvas(std::uint32_t width, std::uint32_t height, const std::vector<float>& values, float max_value,
+                      const std::filesystem::path& file) {
     if (values.size() != std::size_t(width) * height)
-        throw std::invalid_argument("write_heatmap_png: " + file.string() + ": expected width * height values");
+        throw std::invalid_argument("heatmap " + file.string() + ": expected width * height values");
     if (!(max_value > 0.0f && std::isfinite(max_value))) max_value = 1.0f;
 
     const long scale = std::clamp(long(width) / 160, 1L, 4L);
@@ -229,7 +227,21 @@ void write_heatmap_png(const std::filesystem::path& file, std::uint32_t width, s
     }
     if (middle_fits) canvas.text(lx[1], text_y, labels[1], scale);
 
+    return canvas;
+}
+
+}  // namespace
+
+void write_heatmap_png(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
+                       const std::vector<float>& values, float max_value) {
+    const Canvas canvas = heatmap_canvas(width, height, values, max_value, file);
     write_png_rgb8(file, canvas.width, canvas.height, canvas.rgb);
+}
+
+std::string encode_heatmap_png(std::uint32_t width, std::uint32_t height, const std::vector<float>& values,
+                               float max_value, const std::filesystem::path& file) {
+    const Canvas canvas = heatmap_canvas(width, height, values, max_value, file);
+    return encode_png_rgb8(canvas.width, canvas.height, canvas.rgb, file);
 }
 
 }  // namespace lc

@@ -119,9 +119,9 @@ float auto_exposure(const Image& image) {
 
 }  // namespace
 
-void write_file(const fs::path& file, std::string_view bytes) {
+void write_file(const fs::path& file, std::string_view bytes, const fs::path& shown_as) {
     const std::string problem = write_bytes(file, bytes);
-    if (!problem.empty()) throw std::runtime_error(file.string() + ": " + problem);
+    if (!problem.empty()) throw std::runtime_error((shown_as.empty() ? file : shown_as).string() + ": " + problem);
 }
 
 // Concurrent writers (threads or processes) never share a temporary.
@@ -132,8 +132,8 @@ fs::path temporary_path_for(const fs::path& file) {
     return tmp;
 }
 
-void write_exr(const fs::path& file, const Image& image) {
-    check_image(image, "write_exr");
+std::string encode_exr(const Image& image, const fs::path& file) {
+    check_image(image, "encode_exr");
     if (image.width == 0 || image.height == 0 ||
         image.width > std::uint32_t(std::numeric_limits<int>::max()) ||
         image.height > std::uint32_t(std::numeric_limits<int>::max()))
@@ -176,9 +176,9 @@ void write_exr(const fs::path& file, const Image& image) {
     exr.width = int(image.width);
     exr.height = int(image.height);
 
-    // Encoded in memory and written by write_file: tinyexr's own file writer
-    // does not check its writes, and on a full disk left a truncated file
-    // behind a successful return.
+    // Encoded in memory and written by write_bytes: tinyexr's own file
+    // writer does not check its writes, and on a full disk left a truncated
+    // file behind a successful return.
     const char* err = nullptr;
     unsigned char* encoded = nullptr;
     const std::size_t size = SaveEXRImageToMemory(&exr, &header, &encoded, &err);
@@ -186,7 +186,11 @@ void write_exr(const fs::path& file, const Image& image) {
     if (size == 0 || encoded == nullptr)
         throw std::runtime_error(file.string() + ": " + exr_message(err, "cannot encode OpenEXR image"));
     if (err) FreeEXRErrorMessage(err);
-    const std::string_view bytes(reinterpret_cast<const char*>(encoded), size);
+    return std::string(reinterpret_cast<const char*>(encoded), size);
+}
+
+void write_exr(const fs::path& file, const Image& image) {
+    const std::string bytes = encode_exr(image, file);
     write_via_temp(file, [&](const fs::path& tmp) { return write_bytes(tmp, bytes); });
 }
 
@@ -258,27 +262,33 @@ Image read_exr(const fs::path& file) {
     return image;
 }
 
-void write_png_rgb8(const fs::path& file, std::uint32_t width, std::uint32_t height,
-                    const std::vector<std::uint8_t>& rgb8) {
+std::string encode_png_rgb8(std::uint32_t width, std::uint32_t height, const std::vector<std::uint8_t>& rgb8,
+                            const fs::path& file) {
     if (rgb8.size() != std::size_t(width) * height * 3)
-        throw std::invalid_argument("write_png_rgb8: " + file.string() + ": expected width * height * 3 bytes");
+        throw std::invalid_argument("encode_png_rgb8: " + file.string() + ": expected width * height * 3 bytes");
     if (width == 0 || height == 0 || width > std::uint32_t(std::numeric_limits<int>::max() / 3) ||
         height > std::uint32_t(std::numeric_limits<int>::max()))
         throw std::runtime_error(file.string() + ": cannot write a PNG of size " + std::to_string(width) +
                                  "x" + std::to_string(height));
-    // Encoded in memory, then written by write_file (stb's file writer does
-    // not check its writes either).
+    // Encoded in memory, then written by write_bytes (stb's file writer
+    // does not check its writes either).
     std::string encoded;
     auto append = [](void* context, void* data, int size) {
         static_cast<std::string*>(context)->append(static_cast<const char*>(data), std::size_t(size));
     };
     if (stbi_write_png_to_func(append, &encoded, int(width), int(height), 3, rgb8.data(), int(width * 3)) == 0)
         throw std::runtime_error(file.string() + ": cannot encode PNG image");
-    write_via_temp(file, [&](const fs::path& tmp) { return write_bytes(tmp, encoded); });
+    return encoded;
 }
 
-void write_png_tonemapped(const fs::path& file, const Image& image, float exposure) {
-    check_image(image, "write_png_tonemapped");
+void write_png_rgb8(const fs::path& file, std::uint32_t width, std::uint32_t height,
+                    const std::vector<std::uint8_t>& rgb8) {
+    const std::string bytes = encode_png_rgb8(width, height, rgb8, file);
+    write_via_temp(file, [&](const fs::path& tmp) { return write_bytes(tmp, bytes); });
+}
+
+std::string encode_png_tonemapped(const Image& image, float exposure, const fs::path& file) {
+    check_image(image, "encode_png_tonemapped");
     if (!(exposure > 0.0f)) exposure = auto_exposure(image);
     std::vector<std::uint8_t> rgb8(image.rgb.size());
     for (std::size_t i = 0; i < image.rgb.size(); ++i) {
@@ -286,7 +296,12 @@ void write_png_tonemapped(const fs::path& file, const Image& image, float exposu
         v = std::isnan(v) ? 0.0f : std::clamp(v, 0.0f, 1.0f);
         rgb8[i] = std::uint8_t(srgb_encode(v) * 255.0f + 0.5f);
     }
-    write_png_rgb8(file, image.width, image.height, rgb8);
+    return encode_png_rgb8(image.width, image.height, rgb8, file);
+}
+
+void write_png_tonemapped(const fs::path& file, const Image& image, float exposure) {
+    const std::string bytes = encode_png_tonemapped(image, exposure, file);
+    write_via_temp(file, [&](const fs::path& tmp) { return write_bytes(tmp, bytes); });
 }
 
 }  // namespace lc

@@ -72,20 +72,6 @@ void roll_back(const std::vector<fs::path>& files, const std::vector<Placement>&
     }
 }
 
-// Runs `write(temporary)`; a failure names `file`, the output the user
-// asked for, and not the temporary the writer was given.
-template <class Write>
-void write_output(const fs::path& temporary, const fs::path& file, Write&& write) {
-    try {
-        write(temporary);
-    } catch (const std::runtime_error& e) {
-        std::string message = e.what();
-        const std::string prefix = temporary.string() + ": ";
-        if (message.compare(0, prefix.size(), prefix) == 0) message = message.substr(prefix.size());
-        throw std::runtime_error(file.string() + ": " + message);
-    }
-}
-
 fs::path preview_path(const fs::path& image) { return fs::path(image).replace_extension(".png"); }
 
 }  // namespace
@@ -180,21 +166,23 @@ OutputSet reserve_render_outputs(const RenderOutputs& outputs, const fs::path& s
 
 void write_render_outputs(OutputSet& set, const RenderOutputs& outputs, const RenderResult& result,
                           std::string_view stats_json) {
-    const fs::path& image = outputs.image;
-    write_output(set.temporary(image), image, [&](const fs::path& t) { write_exr(t, result.image); });
+    // Each output encoded, then written to its temporary; a failure names
+    // the output, not the temporary.
+    auto write = [&](const fs::path& file, std::string_view bytes) {
+        write_file(set.temporary(file), bytes, file);
+    };
+    write(outputs.image, encode_exr(result.image, outputs.image));
     if (outputs.png_preview) {
-        const fs::path preview = preview_path(image);
-        write_output(set.temporary(preview), preview, [&](const fs::path& t) { write_png_tonemapped(t, result.image); });
+        const fs::path preview = preview_path(outputs.image);
+        write(preview, encode_png_tonemapped(result.image, 0.0f, preview));
     }
-    if (!outputs.stats.empty())
-        write_output(set.temporary(outputs.stats), outputs.stats, [&](const fs::path& t) { write_file(t, stats_json); });
+    if (!outputs.stats.empty()) write(outputs.stats, stats_json);
     if (!outputs.cut_heatmap.empty()) {
         const std::vector<float>& cuts = result.stats.cut_size;
         // The scale runs from 0 to the largest cut, so the map uses its whole range.
         const float largest = cuts.empty() ? 1.0f : *std::max_element(cuts.begin(), cuts.end());
-        write_output(set.temporary(outputs.cut_heatmap), outputs.cut_heatmap, [&](const fs::path& t) {
-            write_heatmap_png(t, result.image.width, result.image.height, cuts, std::max(1.0f, largest));
-        });
+        write(outputs.cut_heatmap, encode_heatmap_png(result.image.width, result.image.height, cuts,
+                                                      std::max(1.0f, largest), outputs.cut_heatmap));
     }
     set.commit();
 }

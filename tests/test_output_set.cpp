@@ -189,6 +189,26 @@ TEST_F(OutputSetTest, RenderOutputsRefuseImpossibleCombinations) {
     EXPECT_EQ(entries(), (std::set<std::string>{"scene.json"}));
 }
 
+// A write that fails names the output the user asked for, not the
+// temporary standing for it, and leaves nothing behind. (The temporary is
+// replaced by a folder, which cannot be opened for writing.)
+TEST_F(OutputSetTest, AFailedWriteNamesTheOutput) {
+    Scene s = test::room_scene({test::point_light({0.0f, 1.5f, 0.0f}, glm::vec3(1.0f))}, 4);
+    const PreparedScene prepared = prepare_scene(std::move(s), 1);
+    const RenderResult result = render_cpu(prepared, test::options("lightcuts", 4));
+    const RenderOutputs o{at("a.exr"), true, at("a.json"), {}};
+    {
+        OutputSet set = reserve_render_outputs(o, at("scene.json"), "lightcuts");
+        const fs::path temporary = set.temporary(at("a.json"));
+        fs::remove(temporary);
+        fs::create_directory(temporary);
+        const std::string message = error_of([&] { write_render_outputs(set, o, result, "{}\n"); });
+        EXPECT_EQ(message.rfind(at("a.json").string() + ": cannot write: ", 0), 0u) << message;
+        fs::remove(temporary);
+    }
+    EXPECT_TRUE(entries().empty());
+}
+
 TEST_F(OutputSetTest, RenderOutputsAreWrittenTogether) {
     Scene s = test::room_scene({test::point_light({0.0f, 1.5f, 0.0f}, glm::vec3(1.0f))}, 4);
     const PreparedScene prepared = prepare_scene(std::move(s), 1);

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -44,11 +45,19 @@ void write_png_rgb8(const std::filesystem::path& file, std::uint32_t width, std:
 // exposure <= 0 picks one that maps the 99th percentile luminance to 1.
 void write_png_tonemapped(const std::filesystem::path& file, const Image& image, float exposure = 0.0f);
 
+// The bytes the writers above write, for a caller that places them itself
+// (OutputSet's temporaries). `file` only names the output in errors.
+std::string encode_exr(const Image& image, const std::filesystem::path& file);
+std::string encode_png_rgb8(std::uint32_t width, std::uint32_t height, const std::vector<std::uint8_t>& rgb8,
+                            const std::filesystem::path& file);
+std::string encode_png_tonemapped(const Image& image, float exposure, const std::filesystem::path& file);
+
 // Writes `bytes` to `file` (created or truncated), every byte or an error:
 // a short write, a full disk or a failing close throws std::runtime_error
-// naming the file and the system's reason. The writers above and OutputSet
-// write through it.
-void write_file(const std::filesystem::path& file, std::string_view bytes);
+// naming the file (or `shown_as`, where a temporary stands for it) and the
+// system's reason. OutputSet writes through it.
+void write_file(const std::filesystem::path& file, std::string_view bytes,
+                const std::filesystem::path& shown_as = {});
 
 // The temporary the writers write before renaming onto `file`:
 // "<file>.tmp-<pid>-<n>", in the same folder so the rename stays within one
@@ -76,5 +85,7 @@ CompareResult compare_images(const Image& image, const Image& reference);
 // colour bar and its scale drawn along the bottom. Used for error and cut-size maps.
 void write_heatmap_png(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
                        const std::vector<float>& values, float max_value);
+std::string encode_heatmap_png(std::uint32_t width, std::uint32_t height, const std::vector<float>& values,
+                               float max_value, const std::filesystem::path& file);
 
 }  // namespace lc
