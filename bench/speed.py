@@ -8,16 +8,20 @@
    CPU path, both at full resolution in this run: render times, shadow rays,
    the cost of a shadow ray (render time over shadow rays; the CPU path does
    not time its camera rays apart, which are one per pixel against hundreds
-   of shadow rays) and the speedup.
+   of shadow rays) and the speedup; at the defaults (the CPU's cuts shared
+   by 2x2 quads of pixels) and with a cut per pixel (cut_sharing "pixel", as
+   the Vulkan kernels cut).
 2. The K table: every shipped scene rendered with lightcuts on the CPU with a
-   cut heap of K slots for each K of --heaps and with a heap as large as the
-   tree needs (nothing frozen), against brute force: relative RMSE, pixels
-   above 2%, mean cut, shadow rays per pixel, the share of samples that froze
-   clusters, and the time.
+   cut per pixel and a cut heap of K slots for each K of --heaps and with a
+   heap as large as the tree needs (nothing frozen), then at the defaults
+   (quads, K = 64 slots per pixel pooled by each quad), against brute force:
+   relative RMSE, pixels above 2%, mean cut, shadow rays per pixel, the
+   share of samples that froze clusters, and the time.
 3. The Vulkan path (lavapipe) on the room with 10^4 lights at the same size
-   for each K that fits its shared memory, with the CPU path in the same run:
-   the Vulkan/CPU time ratio, and the samples whose heap waited in global
-   memory between dispatches.
+   for each K that fits its shared memory, with the CPU path cutting each
+   pixel alone (the same image) in the same run, and the CPU at its
+   defaults: the Vulkan/CPU time ratios, and the samples whose heap waited
+   in global memory between dispatches.
 
 Writes DIR/speed.md and DIR/speed.json (default out/speed). Nothing here
 passes or fails. --quick: 32x32, two scenes (CI's bench label runs it);
@@ -38,13 +42,15 @@ SCENES = ["scenes/room/room_1e4.json", "scenes/room/room_1e5.json", "scenes/pane
 UNBOUNDED = 1000000  # more slots than any tree here can fill
 
 
-def render(out, scene, name, size, method, device="cpu", cut_heap=None):
+def render(out, scene, name, size, method, device="cpu", cut_heap=None, sharing=None):
     exr = os.path.join(out, name + ".exr")
     stats = os.path.join(out, name + ".json")
     cmd = [EXE, "render", os.path.join(ROOT, scene), "-o", exr, "--method", method, "--device", device,
            "--width", str(size), "--height", str(size), "--stats", stats, "--no-png"]
     if cut_heap is not None:
         cmd += ["--cut-heap", str(cut_heap)]
+    if sharing is not None:
+        cmd += ["--cut-sharing", sharing]
     env = dict(os.environ)
     if device == "vulkan":
         env["VK_DRIVER_FILES"] = LAVAPIPE
@@ -94,14 +100,19 @@ def main():
              "Command: `bench/speed.py " + " ".join(sys.argv[1:]) + "`", ""]
 
     # 1 and 2: brute force once per scene, lightcuts per heap size.
-    lines += ["## Lightcuts against brute force (defaults: error 0.02, max cut 1000, cut_heap 64)", "",
-              "lightcuts s: the median of the renders at the defaults before brute force, in the K table "
-              "(with --heaps holding 64) and after it, each in brackets.", "",
+    lines += ["## Lightcuts against brute force (defaults: error 0.02, max cut 1000, cut_heap 64, cuts shared "
+              "by quads)", "",
+              "lightcuts s: the median of the renders at the defaults before brute force, at the end of the K "
+              "table and after it, each in brackets. pixel s: the render with a cut per pixel and K = 64 in the "
+              "K table (as the Vulkan kernels cut), and its speedup.", "",
               "| scene | brute s | brute rays/px | lightcuts s | rays/px | us per brute ray | us per lightcuts ray "
-              "| ratio | speedup |", "|---|---|---|---|---|---|---|---|---|"]
+              "| ratio | speedup | pixel s | pixel rays/px | pixel speedup |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     table = ["## The cut heap: K slots against a heap as large as the tree needs", "",
-             "| scene | K | relative RMSE | above 2% | mean cut | rays/px | samples that froze | time s |",
-             "|---|---|---|---|---|---|---|---|"]
+             "Rows `pixel`: a cut per pixel, K slots per pixel (the Vulkan kernels' heap). Row `quad`: the "
+             "defaults, a cut per 2x2 quad with its pixels' 4 x 64 slots pooled.", "",
+             "| scene | cuts | K | relative RMSE | above 2% | mean cut | rays/px | samples that froze | time s |",
+             "|---|---|---|---|---|---|---|---|---|"]
     for scene in [] if a.vulkan_only else scenes:
         why = missing(scene)
         if why:
@@ -119,20 +130,25 @@ def main():
         print(f"{scene}: brute force", file=sys.stderr)
         ref, bstats = render(a.out, scene, name + "_brute", size, "brute")
         pixels = size * size
-        for k in heaps + [UNBOUNDED]:
-            print(f"{scene}: lightcuts, cut_heap {k}", file=sys.stderr)
-            img, s = render(a.out, scene, f"{name}_k{k}", size, "lightcuts", cut_heap=k)
+        pixel = None
+        for sharing, k in [("pixel", k) for k in heaps + [UNBOUNDED]] + [("quad", None)]:
+            print(f"{scene}: lightcuts, {sharing}, cut_heap {k or 'default'}", file=sys.stderr)
+            img, s = render(a.out, scene, f"{name}_{sharing}_k{k or 'default'}", size, "lightcuts", cut_heap=k,
+                            sharing=sharing)
             c = compare(img, ref)
             lc = s["lightcuts"]
-            row = {"scene": scene, "cut_heap": k, "seconds": s["seconds"]["render"],
+            row = {"scene": scene, "cut_sharing": sharing, "cut_heap": lc["cut_heap"],
+                   "heap_slots": lc["heap_slots"], "seconds": s["seconds"]["render"],
                    "rays_per_pixel": s["shadow_rays"] / pixels, "cut_mean": lc["cut_size_mean"],
                    "frozen": lc["heap_frozen_samples"] / pixels, **c}
             results["heaps"].append(row)
-            label = "as needed" if k == UNBOUNDED else str(k)
-            table.append(f"| {name} | {label} | {c['rmse']:.4f} | {100 * c['above_2pct']:.1f}% | "
+            label = "as needed" if k == UNBOUNDED else str(lc["cut_heap"])
+            table.append(f"| {name} | {sharing} | {label} | {c['rmse']:.4f} | {100 * c['above_2pct']:.1f}% | "
                          f"{row['cut_mean']:.1f} | {row['rays_per_pixel']:.1f} | {100 * row['frozen']:.1f}% | "
                          f"{row['seconds']:.3f} |")
-            if k == 64 and room:
+            if sharing == "pixel" and k == 64:
+                pixel = s
+            if sharing == "quad" and room:
                 lightcuts_times.append(s["seconds"]["render"])
         if not room:
             continue
@@ -140,13 +156,16 @@ def main():
         tb, tl = bstats["seconds"]["render"], sorted(lightcuts_times)[len(lightcuts_times) // 2]
         rb, rl = bstats["shadow_rays"], first["shadow_rays"]
         cb, cl = 1e6 * tb / rb, 1e6 * tl / rl
+        tp = pixel["seconds"]["render"] if pixel else float("nan")
+        rp = pixel["shadow_rays"] if pixel else float("nan")
         results["speed"].append({"scene": scene, "brute_seconds": tb, "brute_rays": rb,
                                  "lightcuts_seconds": tl, "lightcuts_runs": lightcuts_times,
                                  "lightcuts_rays": rl, "us_per_brute_ray": cb, "us_per_lightcuts_ray": cl,
-                                 "ratio": cl / cb, "speedup": tb / tl})
+                                 "ratio": cl / cb, "speedup": tb / tl, "pixel_seconds": tp, "pixel_rays": rp,
+                                 "pixel_speedup": tb / tp})
         runs = ", ".join(f"{t:.3f}" for t in lightcuts_times)
         lines.append(f"| {name} | {tb:.2f} | {rb / pixels:.0f} | {tl:.3f} ({runs}) | {rl / pixels:.1f} | {cb:.4f} | "
-                     f"{cl:.4f} | {cl / cb:.2f} | {tb / tl:.1f}x |")
+                     f"{cl:.4f} | {cl / cb:.2f} | {tb / tl:.1f}x | {tp:.3f} | {rp / pixels:.1f} | {tb / tp:.1f}x |")
     lines += [""] + table + [""]
 
     # 3: Vulkan against the CPU, room 10^4, for the heap sizes that fit.
@@ -157,11 +176,14 @@ def main():
                       "Vulkan s is the whole render call (device, pipelines, uploads included); kernels s the GPU "
                       "timestamps of the camera-ray and shading kernels. Each K rendered once at 8x8 first, so that "
                       "its kernels are in Mesa's shader cache.", "",
+                      "CPU s: the CPU path with a cut per pixel, the image the Vulkan kernels make; CPU default s: "
+                      "at the CPU's defaults (cuts shared by quads, once at K = 64).", "",
                       "| K | CPU s | Vulkan s | Vulkan/CPU | kernels s | kernels/CPU | heaps paused in global memory "
                       "| relative RMSE vulkan vs cpu |",
                       "|---|---|---|---|---|---|---|---|"]
+            default_cpu = render(a.out, scene, "vk_cpu_default", size, "lightcuts")[1]["seconds"]["render"]
             for k in heaps:
-                cimg, cs = render(a.out, scene, f"vk_cpu_k{k}", size, "lightcuts", cut_heap=k)
+                cimg, cs = render(a.out, scene, f"vk_cpu_k{k}", size, "lightcuts", cut_heap=k, sharing="pixel")
                 try:
                     # Each K is its own pipeline: the first render with it
                     # compiles the kernel (seconds on lavapipe, inside the
@@ -180,6 +202,11 @@ def main():
                                           "rmse": c["rmse"]})
                 lines.append(f"| {k} | {tc:.3f} | {tv:.3f} | {tv / tc:.1f} | {tk:.3f} | {tk / tc:.1f} | "
                              f"{100 * paused:.1f}% | {c['rmse']:.2e} |")
+                if k == 64:
+                    results["vulkan_against_cpu_default"] = {"cpu_default_seconds": default_cpu,
+                                                             "ratio": tv / default_cpu}
+                    lines.append(f"| 64, CPU at its defaults | {default_cpu:.3f} | {tv:.3f} | {tv / default_cpu:.1f} "
+                                 f"| {tk:.3f} | {tk / default_cpu:.1f} | | |")
             lines.append("")
 
     open(os.path.join(a.out, "speed.md"), "w").write("\n".join(lines) + "\n")

@@ -26,10 +26,14 @@ RenderResult render(const PreparedScene& prepared, const RenderOptions& options,
     if (choice.device == "cpu") return render_cpu(prepared, options);
     if (choice.device == "vulkan") return render_vulkan(prepared, options, choice.vulkan);
 
-    // auto: the path tracer runs on the CPU only. Otherwise a named device is
+    // auto: the path tracer and quad-shared cuts run on the CPU only. Otherwise a named device is
     // always tried, and only real GPU hardware
     // beats the CPU path (lavapipe on the same cores is several times slower).
     if (options.method == "path") return render_cpu(prepared, options);
+    if (options.method == "lightcuts" && options.cut_sharing == "quad") {
+        say(choice, "cut_sharing \"quad\" runs on the CPU only; rendering on the CPU");
+        return render_cpu(prepared, options);
+    }
     if (choice.vulkan.gpu.empty() && !vulkan_hardware_device_present()) {
         say(choice, list_vulkan_devices().empty()
                         ? "no Vulkan device; rendering on the CPU"

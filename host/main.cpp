@@ -27,7 +27,7 @@
 namespace {
 
 struct RenderArgs {
-    std::string scene, method, light_pick;
+    std::string scene, method, light_pick, cut_sharing;
     lc::SceneOptions scene_options;
     lc::RenderOutputs outputs;
     lc::DeviceChoice device;
@@ -75,6 +75,7 @@ lc::RenderOptions render_options(const RenderArgs& a, const lc::Scene& scene) {
     o.relative_error = a.relative_error.value_or(scene.render.relative_error);
     o.max_cut = a.max_cut.value_or(scene.render.max_cut);
     o.cut_heap = a.cut_heap.value_or(scene.render.cut_heap);
+    o.cut_sharing = a.cut_sharing.empty() ? scene.render.cut_sharing : a.cut_sharing;
     o.seed = a.seed.value_or(scene.render.seed);
     o.light_samples = a.light_samples.value_or(scene.render.light_samples);
     o.light_pick = a.light_pick.empty() ? scene.render.light_pick : a.light_pick;
@@ -216,6 +217,11 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
                        "lightcuts and stochastic: cut-heap capacity per shaded point; a larger cut freezes "
                        "its clusters of smallest bound (default " + std::to_string(lc::kDefaultCutHeap) + ")")
         ->transform(setting(lc::kSettingCutHeap));
+    render->add_option("--cut-sharing", r.cut_sharing,
+                       "lightcuts: pixel (a cut per pixel, as the Vulkan kernels), quad (the four pixels of a 2x2 "
+                       "block share one cut: CPU only, faster) or auto (quad on the CPU, pixel on Vulkan; the "
+                       "default)")
+        ->check(ask(lc::cut_sharing_problem));
     render->add_option("--area-samples", r.area_samples,
                        "Point lights the emissive surfaces become, in all (default 65536)")
         ->transform(setting(lc::kSettingAreaLightSamples));

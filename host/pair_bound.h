@@ -133,4 +133,130 @@ bool pair_errors(Kernel& kernel, const SurfacePoint& sp, const gpu::Material& m,
 #endif
 }
 
+#if defined(__SSE2__)
+// The four shaded points of a quad (host/quad_cut.h) lane by lane, for
+// quad_errors: positions, frames and the diffuse colours.
+struct QuadLanes {
+    __m128 px, py, pz;
+    __m128 nx, ny, nz, anx, any, anz;
+    __m128 tx, ty, tz, atx, aty, atz;
+    __m128 bx, by, bz, abx, aby, abz;
+    __m128 kd_r, kd_g, kd_b;
+    __m128 active;        // all ones in the lanes of active points
+    unsigned specular;    // lanes whose material has a GGX lobe
+    bool covered = false; // no active point has the Disney BRDF
+};
+
+template <class SurfacePoint>
+QuadLanes quad_lanes(const SurfacePoint* sp, unsigned active) {
+    QuadLanes q;
+    alignas(16) float v[24][4];
+    alignas(16) std::uint32_t mask[4];
+    q.specular = 0u;
+    q.covered = true;
+    for (unsigned p = 0; p < 4u; ++p) {
+        const bool on = (active >> p & 1u) != 0u;
+        mask[p] = on ? ~0u : 0u;
+        const SurfacePoint& s = sp[p];
+        const glm::vec3 zero(0.0f);
+        const glm::vec3 pos = on ? s.p : zero, n = on ? s.n : zero, t = on ? s.t : zero, b = on ? s.b : zero;
+        const float f[24] = {pos.x, pos.y, pos.z, n.x, n.y, n.z, std::fabs(n.x), std::fabs(n.y), std::fabs(n.z),
+                             t.x, t.y, t.z, std::fabs(t.x), std::fabs(t.y), std::fabs(t.z),
+                             b.x, b.y, b.z, std::fabs(b.x), std::fabs(b.y), std::fabs(b.z),
+                             on ? s.mat.kd_r : 0.0f, on ? s.mat.kd_g : 0.0f, on ? s.mat.kd_b : 0.0f};
+        for (unsigned i = 0; i < 24u; ++i) v[i][p] = f[i];
+        if (!on) continue;
+        if ((s.mat.flags & gpu::kMaterialDisney) != 0u) q.covered = false;
+        if ((s.mat.flags & gpu::kMaterialHasSpecular) != 0u) q.specular |= 1u << p;
+    }
+    __m128* out[24] = {&q.px, &q.py, &q.pz, &q.nx, &q.ny, &q.nz, &q.anx, &q.any, &q.anz,
+                       &q.tx, &q.ty, &q.tz, &q.atx, &q.aty, &q.atz, &q.bx, &q.by, &q.bz,
+                       &q.abx, &q.aby, &q.abz, &q.kd_r, &q.kd_g, &q.kd_b};
+    for (unsigned i = 0; i < 24u; ++i) *out[i] = _mm_load_ps(v[i]);
+    q.active = _mm_load_ps(reinterpret_cast<const float*>(mask));
+    return q;
+}
+
+// ((a_x * v_x + a_y * v_y) + a_z * v_z) lane by lane: glm's dot.
+inline __m128 dot4(__m128 ax, __m128 ay, __m128 az, __m128 vx, __m128 vy, __m128 vz) {
+    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, vx), _mm_mul_ps(ay, vy)), _mm_mul_ps(az, vz));
+}
+
+// lc_cluster_error of one `node` at the quad's four points, into errors[p]
+// (zero in inactive lanes), or false where this evaluation does not cover
+// them (the cases pair_errors leaves out). The same operations in the same
+// order as lc_cluster_bound, so the values are the scalar ones bit for bit.
+template <class Kernel, class SurfacePoint>
+bool quad_errors(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, const gpu::LightNode& node,
+                 float min_distance2, float errors[4]) {
+    if (!q.covered || !pair_bound_covers(node)) return false;
+    const __m128 half = _mm_set1_ps(0.5f), zero = _mm_setzero_ps();
+    const __m128 min_x = _mm_set1_ps(node.min_x), min_y = _mm_set1_ps(node.min_y), min_z = _mm_set1_ps(node.min_z);
+    const __m128 max_x = _mm_set1_ps(node.max_x), max_y = _mm_set1_ps(node.max_y), max_z = _mm_set1_ps(node.max_z);
+    const __m128 lo_x = _mm_sub_ps(min_x, q.px), lo_y = _mm_sub_ps(min_y, q.py), lo_z = _mm_sub_ps(min_z, q.pz);
+    const __m128 hi_x = _mm_sub_ps(max_x, q.px), hi_y = _mm_sub_ps(max_y, q.py), hi_z = _mm_sub_ps(max_z, q.pz);
+    const __m128 c_x = _mm_mul_ps(half, _mm_add_ps(lo_x, hi_x)), c_y = _mm_mul_ps(half, _mm_add_ps(lo_y, hi_y)),
+                 c_z = _mm_mul_ps(half, _mm_add_ps(lo_z, hi_z));
+    const __m128 e_x = _mm_mul_ps(half, _mm_sub_ps(hi_x, lo_x)), e_y = _mm_mul_ps(half, _mm_sub_ps(hi_y, lo_y)),
+                 e_z = _mm_mul_ps(half, _mm_sub_ps(hi_z, lo_z));
+    const __m128 ne = dot4(q.anx, q.any, q.anz, e_x, e_y, e_z);
+    const __m128 z_max = _mm_add_ps(
+        _mm_add_ps(dot4(q.nx, q.ny, q.nz, c_x, c_y, c_z), ne),
+        _mm_mul_ps(_mm_set1_ps(Kernel::kCosineAbsSlack),
+                   _mm_add_ps(dot4(q.anx, q.any, q.anz, abs_lanes(c_x), abs_lanes(c_y), abs_lanes(c_z)), ne)));
+    const __m128 near_x = _mm_max_ps(
+        _mm_sub_ps(abs_lanes(dot4(q.tx, q.ty, q.tz, c_x, c_y, c_z)), dot4(q.atx, q.aty, q.atz, e_x, e_y, e_z)), zero);
+    const __m128 near_y = _mm_max_ps(
+        _mm_sub_ps(abs_lanes(dot4(q.bx, q.by, q.bz, c_x, c_y, c_z)), dot4(q.abx, q.aby, q.abz, e_x, e_y, e_z)), zero);
+    const __m128 qq = _mm_add_ps(_mm_add_ps(_mm_mul_ps(near_x, near_x), _mm_mul_ps(near_y, near_y)),
+                                 _mm_mul_ps(z_max, z_max));
+    const __m128 bound = _mm_mul_ps(z_max, _mm_div_ps(_mm_set1_ps(1.0f), _mm_sqrt_ps(qq)));
+    const __m128 cos_bound = _mm_min_ps(_mm_mul_ps(bound, _mm_set1_ps(Kernel::kBoundSlack)), _mm_set1_ps(1.0f));
+    const __m128 lit = _mm_and_ps(_mm_cmpgt_ps(z_max, zero), q.active);
+    alignas(16) float cosines[4];
+    _mm_store_ps(cosines, _mm_and_ps(cos_bound, lit));
+    if (_mm_movemask_ps(_mm_cmpgt_ps(_mm_load_ps(cosines), zero)) == 0) {
+        for (unsigned p = 0; p < 4u; ++p) errors[p] = 0.0f;
+        return true;
+    }
+    const __m128 d_x = _mm_max_ps(_mm_max_ps(lo_x, _mm_sub_ps(q.px, max_x)), zero);
+    const __m128 d_y = _mm_max_ps(_mm_max_ps(lo_y, _mm_sub_ps(q.py, max_y)), zero);
+    const __m128 d_z = _mm_max_ps(_mm_max_ps(lo_z, _mm_sub_ps(q.pz, max_z)), zero);
+    const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d_x, d_x), _mm_mul_ps(d_y, d_y)), _mm_mul_ps(d_z, d_z));
+    const std::uint32_t type = (node.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask;
+    const __m128 clamp = _mm_set1_ps(kernel.lc_falloff_clamp2(min_distance2, type));
+    const __m128 factor = _mm_div_ps(_mm_set1_ps(Kernel::kBoundSlack), _mm_max_ps(d2, clamp));
+    const __m128 cos_over_pi = _mm_div_ps(_mm_load_ps(cosines), _mm_set1_ps(Kernel::kPi));
+    __m128 r = _mm_mul_ps(q.kd_r, cos_over_pi);
+    __m128 g = _mm_mul_ps(q.kd_g, cos_over_pi);
+    __m128 b = _mm_mul_ps(q.kd_b, cos_over_pi);
+    if (q.specular != 0u) {
+        alignas(16) float ks[3][4] = {}, ggx[4] = {};
+        const glm::vec3 box_min(node.min_x, node.min_y, node.min_z), box_max(node.max_x, node.max_y, node.max_z);
+        for (unsigned p = 0; p < 4u; ++p) {
+            if ((q.specular >> p & 1u) == 0u || !(cosines[p] > 0.0f)) continue;
+            const SurfacePoint& s = sp[p];
+            ggx[p] = kernel.lc_ggx_bound(s.mat, box_min, box_max, s.p, s.n, s.wo);
+            ks[0][p] = s.mat.ks_r;
+            ks[1][p] = s.mat.ks_g;
+            ks[2][p] = s.mat.ks_b;
+        }
+        const __m128 gv = _mm_load_ps(ggx);
+        r = _mm_add_ps(r, _mm_mul_ps(_mm_load_ps(ks[0]), gv));
+        g = _mm_add_ps(g, _mm_mul_ps(_mm_load_ps(ks[1]), gv));
+        b = _mm_add_ps(b, _mm_mul_ps(_mm_load_ps(ks[2]), gv));
+    }
+    r = _mm_mul_ps(_mm_mul_ps(r, factor), _mm_set1_ps(node.intensity_r));
+    g = _mm_mul_ps(_mm_mul_ps(g, factor), _mm_set1_ps(node.intensity_g));
+    b = _mm_mul_ps(_mm_mul_ps(b, factor), _mm_set1_ps(node.intensity_b));
+    const __m128 error = _mm_add_ps(
+        _mm_add_ps(_mm_mul_ps(_mm_set1_ps(0.2126f), r), _mm_mul_ps(_mm_set1_ps(0.7152f), g)),
+        _mm_mul_ps(_mm_set1_ps(0.0722f), b));
+    alignas(16) float out[4];
+    _mm_store_ps(out, _mm_and_ps(error, _mm_cmpgt_ps(_mm_load_ps(cosines), zero)));
+    for (unsigned p = 0; p < 4u; ++p) errors[p] = out[p];
+    return true;
+}
+#endif
+
 }  // namespace lc::cpu

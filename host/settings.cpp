@@ -64,11 +64,22 @@ std::string light_pick_problem(std::string_view pick) {
     return "must be \"tree\", \"uniform\" or \"power\", got \"" + std::string(pick) + "\"";
 }
 
+std::string cut_sharing_problem(std::string_view sharing) {
+    if (sharing == "auto" || sharing == "pixel" || sharing == "quad") return "";
+    return "must be \"auto\", \"pixel\" or \"quad\", got \"" + std::string(sharing) + "\"";
+}
+
+bool cpu_shares_cuts(std::string_view method, std::string_view sharing) {
+    return method == "lightcuts" && (sharing == "quad" || sharing == "auto");
+}
+
 void validate_render_options(const RenderOptions& o) {
     std::string problem = method_problem(o.method);
     if (!problem.empty()) throw std::invalid_argument("method " + problem);
     problem = light_pick_problem(o.light_pick);
     if (!problem.empty()) throw std::invalid_argument(std::string(kSettingLightPick) + " " + problem);
+    problem = cut_sharing_problem(o.cut_sharing);
+    if (!problem.empty()) throw std::invalid_argument(std::string(kSettingCutSharing) + " " + problem);
     const std::pair<std::string_view, double> values[] = {
         {kSettingSpp, o.spp},
         {kSettingRelativeError, o.relative_error},

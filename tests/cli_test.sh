@@ -120,6 +120,11 @@ accept --width 2 --height 2 --method stochastic --spp 4 --light-pick tree
 accept --width 2 --height 2 --method lightcuts --vpls 0 --vpl-bounces 0 --vpl-clamp 0
 accept --width 2 --height 2 --method lightcuts --vpls 100 --vpl-bounces 1024 --vpl-clamp 0.5
 accept --width 2 --height 2 --method path --spp 2 --max-bounces 0 --time-limit 0
+accept --width 3 --height 3 --method lightcuts --cut-sharing quad --stats "$tmp/quad.json"
+grep -q '"cut_sharing": "quad"' "$tmp/quad.json" || fail "--cut-sharing quad: the stats do not say quad"
+accept --width 3 --height 3 --method lightcuts --cut-sharing pixel --stats "$tmp/quad.json"
+grep -q '"cut_sharing": "pixel"' "$tmp/quad.json" || fail "--cut-sharing pixel: the stats do not say pixel"
+rm -f "$tmp/quad.json"
 accept --width 2 --height 2 --method path --max-bounces 1024 --time-limit 1e30
 accept --width 16384 --height 1 --method brute
 accept --width 1 --height 16384 --method brute
@@ -143,6 +148,8 @@ for bad in "--max-bounces=1025" "--vpl-bounces=-1"; do
 for bad in "--vpl-clamp=-0.5" "--time-limit=nan" "--time-limit=-1"; do
   expect_error "must be a finite number, 0 or more" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
 expect_error "method path (the path tracer) runs on the CPU only" render "$mini" -o "$tmp/edge2.exr" --method path --device vulkan
+expect_error 'cut_sharing "quad" runs on the CPU only' render "$mini" -o "$tmp/edge2.exr" --method lightcuts --cut-sharing quad --device vulkan
+expect_error '--cut-sharing: must be "auto", "pixel" or "quad", got "tiles"' render "$mini" -o "$tmp/edge2.exr" --cut-sharing tiles
 expect_error '--method: must be "brute", "lightcuts", "sampled", "stochastic" or "path", got "fast"' render "$mini" -o "$tmp/edge2.exr" --method fast
 expect_error '--light-pick: must be "tree", "uniform" or "power", got "random"' render "$mini" -o "$tmp/edge2.exr" --light-pick random
 expect_error '--device: must be "auto", "cpu" or "vulkan"' render "$mini" -o "$tmp/edge2.exr" --device gpu

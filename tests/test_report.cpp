@@ -35,8 +35,8 @@ TEST(Report, JsonHasEveryKeyScriptsReadAndTheBlackLights) {
                             "buffer_bytes", "bvh_nodes", "normals", "materials", "light_tree_nodes", "lightcuts",
                             "relative_error", "max_cut", "tree_nodes", "tree_bytes", "cut_size_mean",
                             "cut_size_p50", "cut_size_p99", "cut_size_max", "max_cut_samples",
-                            "cut_heap", "heap_slots", "heap_bytes_per_workgroup", "heap_frozen_samples",
-                            "heap_paused_samples"}) {
+                            "cut_heap", "cut_sharing", "heap_slots", "heap_bytes_per_workgroup",
+                            "heap_frozen_samples", "heap_paused_samples"}) {
         std::string quoted = "\"";
         quoted.append(key).append("\": ");
         EXPECT_THAT(json, HasSubstr(quoted));
@@ -48,6 +48,16 @@ TEST(Report, JsonHasEveryKeyScriptsReadAndTheBlackLights) {
     EXPECT_THAT(json, HasSubstr("\"load\": 0.25"));
     EXPECT_THAT(report_text(report), HasSubstr("lights 20 (and 3 black, left out of the tree)"));
     EXPECT_THAT(report_text(report), HasSubstr("cut size mean"));
+    // The CPU's default: quads share cuts, and the heap is a quad's.
+    EXPECT_THAT(json, HasSubstr("\"cut_sharing\": \"quad\""));
+    EXPECT_THAT(report_text(report), HasSubstr("cuts shared by the pixels of each 2x2 quad"));
+    EXPECT_THAT(report_text(report), HasSubstr("slots per quad"));
+    RenderOptions pixel = o;
+    pixel.cut_sharing = "pixel";
+    const RenderReport per_pixel = make_report("room.json", pixel, p, render_cpu(p, pixel), 0.25);
+    EXPECT_THAT(report_json(per_pixel), HasSubstr("\"cut_sharing\": \"pixel\""));
+    EXPECT_THAT(report_text(per_pixel), Not(HasSubstr("2x2 quad")));
+    EXPECT_THAT(report_text(per_pixel), HasSubstr("slots per point"));
 }
 
 // Sampled reports its light samples and pick; stochastic its cut and its

@@ -307,6 +307,7 @@ TEST(Sampling, SameSeedSameImageWhateverTheThreads) {
 TEST(Sampling, StochasticSelectsTheLightcutsCut) {
     PreparedScene p = prepare_scene(test::room_scene(mixed_lights(300, 4), 16), 1);
     RenderOptions o = test::options("lightcuts", 16);
+    o.cut_sharing = "pixel";  // stochastic cuts each pixel alone
     const RenderResult lightcuts = render_cpu(p, o);
     o.method = "stochastic";
     const RenderResult stochastic = render_cpu(p, o);

@@ -814,6 +814,18 @@ TEST(SceneLoader, SamplingSettings) {
               bad.lexically_normal().string() + ": render.light_pick: " + light_pick_problem("random"));
 }
 
+TEST(SceneLoader, CutSharingSetting) {
+    TempDir dir;
+    EXPECT_EQ(load_scene(scene_with_render(dir, R"({"method": "lightcuts"})")).render.cut_sharing, "auto");
+    EXPECT_EQ(load_scene(scene_with_render(dir, R"({"cut_sharing": "pixel"})")).render.cut_sharing, "pixel");
+    EXPECT_EQ(load_scene(scene_with_render(dir, R"({"cut_sharing": "quad"})")).render.cut_sharing, "quad");
+    const fs::path bad = scene_with_render(dir, R"({"cut_sharing": "tiles"})");
+    EXPECT_EQ(input_error_of([&] { load_scene(bad); }),
+              bad.lexically_normal().string() + ": render.cut_sharing: " + cut_sharing_problem("tiles"));
+    const fs::path wrong_type = scene_with_render(dir, R"({"cut_sharing": 4})");
+    EXPECT_NE(input_error_of([&] { load_scene(wrong_type); }).find("render.cut_sharing"), std::string::npos);
+}
+
 TEST(SceneLoader, IndirectAndPathSettings) {
     TempDir dir;
     const Scene scene = load_scene(scene_with_render(

@@ -110,7 +110,7 @@ private:
         in_.expect_object(j, path);
         in_.check_keys(j, path, {kSettingMethod, kSettingSpp, kSettingRelativeError, kSettingMaxCut, kSettingCutHeap,
                                  kSettingSeed, kSettingAreaLightSamples, kSettingLightSamples, kSettingLightPick,
-                                 kSettingMaxBounces, kSettingTimeLimit, kSettingIndirect});
+                                 kSettingCutSharing, kSettingMaxBounces, kSettingTimeLimit, kSettingIndirect});
         RenderSettings& r = scene_.render;
         if (const json* v = JsonReader::find(j, kSettingMethod)) {
             const std::string field = join_key(path, kSettingMethod);
@@ -121,6 +121,12 @@ private:
             const std::string field = join_key(path, kSettingLightPick);
             r.light_pick = in_.string(*v, field);
             if (const std::string problem = light_pick_problem(r.light_pick); !problem.empty()) in_.fail(field, problem);
+        }
+        if (const json* v = JsonReader::find(j, kSettingCutSharing)) {
+            const std::string field = join_key(path, kSettingCutSharing);
+            r.cut_sharing = in_.string(*v, field);
+            if (const std::string problem = cut_sharing_problem(r.cut_sharing); !problem.empty())
+                in_.fail(field, problem);
         }
         const auto setting = [&](std::string_view key) { return number_setting(j, path, key); };
         if (const auto v = setting(kSettingSpp)) r.spp = static_cast<std::uint32_t>(*v);

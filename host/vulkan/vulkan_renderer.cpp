@@ -187,6 +187,10 @@ RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& o
                            const VulkanOptions& vulkan, const Tuning& tuning) {
     if (options.method == "path")
         throw std::invalid_argument("method path (the path tracer) runs on the CPU only: use --device cpu");
+    if (options.method == "lightcuts" && options.cut_sharing == "quad")
+        throw std::invalid_argument(
+            "cut_sharing \"quad\" runs on the CPU only (the Vulkan kernels cut each pixel alone): use "
+            "--device cpu, or cut_sharing \"pixel\" or \"auto\"");
     const Clock::time_point start = Clock::now();
     MessageLog log;
     RenderResult result;

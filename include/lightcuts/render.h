@@ -69,6 +69,9 @@ struct RenderOptions {
     float relative_error = 0.02f;
     std::uint32_t max_cut = 1000;
     std::uint32_t cut_heap = kDefaultCutHeap;  // lightcuts: cut-heap capacity K per shaded point
+                                               // (per quad where quads share cuts)
+    std::string cut_sharing = "auto";  // lightcuts: "pixel", "quad" (CPU only) or "auto"
+                                       // (cut_sharing_problem, lightcuts/settings.h)
     std::uint32_t seed = 1;
     std::uint32_t light_samples = 1;  // sampled: lights per camera sample; stochastic: draws per cluster
     std::string light_pick = "tree";  // sampled: "tree", "uniform" or "power"
@@ -88,6 +91,8 @@ struct RenderStats {
     std::uint64_t camera_rays = 0;
     std::uint64_t shadow_rays = 0;
     std::uint64_t max_cut_pixels = 0;       // samples where refinement hit max_cut
+    bool quad_cuts = false;                 // lightcuts: 2x2 quads of pixels shared each cut
+                                            // (cut_sharing; then the heap is a quad's)
     std::uint32_t heap_slots = 0;           // lightcuts: cut-heap slots per shaded point (GPU: in
                                             // shared memory), min(cut_heap, what the tree can fill)
     std::uint64_t heap_frozen_samples = 0;  // lightcuts: samples whose cut froze clusters out of a

@@ -27,6 +27,8 @@ struct LightcutsReport {
     double cut_indirect_mean = 0.0;           // of cut_size_mean, VPL clusters (indirect light)
     std::uint64_t max_cut_samples = 0;        // samples whose refinement stopped at max_cut
     std::uint32_t cut_heap = 0;               // render.cut_heap, the heap's capacity K
+    bool quad_cuts = false;                   // CPU: the pixels of each 2x2 quad shared a cut (and a
+                                              // heap); cut sizes are then the quads' (cut_sharing)
     std::uint32_t heap_slots = 0;             // slots a heap gets: K, or less where the tree
                                               // cannot fill K (GPU: in shared memory)
     std::uint64_t heap_bytes = 0;             // GPU: shared memory the heaps of a workgroup take

@@ -38,6 +38,7 @@ inline constexpr std::string_view kSettingAreaLightSamples = "area_light_samples
 inline constexpr std::string_view kSettingDirections = "directions";  // of an environment
 inline constexpr std::string_view kSettingLightSamples = "light_samples";  // sampled, stochastic
 inline constexpr std::string_view kSettingLightPick = "light_pick";        // --method sampled
+inline constexpr std::string_view kSettingCutSharing = "cut_sharing";      // --method lightcuts
 inline constexpr std::string_view kSettingMaxBounces = "max_bounces";      // path, and indirect's
 inline constexpr std::string_view kSettingTimeLimit = "time_limit";        // path, seconds
 inline constexpr std::string_view kSettingIndirect = "indirect";           // the VPL block:
@@ -59,5 +60,15 @@ inline bool method_selects_cuts(std::string_view method) { return method == "lig
 
 // What is wrong with a light pick, or "" for "tree", "uniform" and "power".
 std::string light_pick_problem(std::string_view pick);
+
+// What is wrong with a cut sharing, or "" for "auto", "pixel" and "quad".
+// Lightcuts cuts each shaded point alone ("pixel"), or the four points of a
+// 2x2 block of pixels together ("quad", CPU only: host/quad_cut.h). "auto"
+// is "quad" on the CPU and "pixel" on Vulkan.
+std::string cut_sharing_problem(std::string_view sharing);
+
+// Whether a render on the CPU with these settings shares cuts between the
+// pixels of a quad: method "lightcuts" and cut_sharing "quad" or "auto".
+bool cpu_shares_cuts(std::string_view method, std::string_view sharing);
 
 }  // namespace lc

@@ -324,6 +324,11 @@ std::optional<RenderResult> render_vulkan_if_available(const PreparedScene& p, c
 #endif
 }
 
+RenderResult render_cpu_as_vulkan(const PreparedScene& p, RenderOptions o) {
+    o.cut_sharing = "pixel";
+    return render_cpu(p, o);
+}
+
 void write_failure_images(const std::string& label, const Image& image, const Image& reference) {
     const std::filesystem::path dir = std::filesystem::path(LC_BINARY_DIR) / "test-output" / "stress";
     std::filesystem::create_directories(dir);

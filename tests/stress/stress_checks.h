@@ -92,6 +92,10 @@ CpuRenders run_cpu_checks(const PreparedScene& p, const RenderOptions& lightcuts
 // failure (a validation message included) throws.
 std::optional<RenderResult> render_vulkan_if_available(const PreparedScene& p, const RenderOptions& o);
 
+// The CPU render the Vulkan kernels must match: each pixel's cut alone
+// (cut_sharing "pixel"), as the kernels cut, whatever `o` says.
+RenderResult render_cpu_as_vulkan(const PreparedScene& p, RenderOptions o);
+
 // Writes image, reference and error map under <build>/test-output/stress/.
 void write_failure_images(const std::string& label, const Image& image, const Image& reference);
 

@@ -57,7 +57,7 @@ TEST(StressMillionLights, VulkanMatchesCpu) {
     const RenderOptions o = test::options("lightcuts", kSize);
     std::optional<RenderResult> gpu = stress::render_vulkan_if_available(p, o);
     if (!gpu) GTEST_SKIP() << "no Vulkan device (or a build without the Vulkan path)";
-    const RenderResult cpu = render_cpu(p, o);
+    const RenderResult cpu = stress::render_cpu_as_vulkan(p, o);
     stress::expect_images_agree(gpu->image, cpu.image, 4e-4, 0.004, "MillionLights vulkan lightcuts");
 }
 

@@ -283,7 +283,7 @@ TEST_P(Stress, VulkanMatchesCpu) {
         std::printf("[ stress   ] %s on %s: %llu samples froze clusters (%u heap slots in shared memory)\n",
                     method, gpu->stats.device.c_str(),
                     static_cast<unsigned long long>(gpu->stats.heap_frozen_samples), gpu->stats.heap_slots);
-        const RenderResult cpu = render_cpu(p, o);
+        const RenderResult cpu = stress::render_cpu_as_vulkan(p, o);
         const bool brute = std::string(method) == "brute";
         stress::expect_images_agree(gpu->image, cpu.image,
                                     brute ? c.vulkan.brute_rmse : c.vulkan.lightcuts_rmse,

@@ -134,7 +134,7 @@ TEST_P(Transformed, VulkanMatchesCpu) {
         const RenderOptions o = test::options(method, moved.scene.camera.width);
         std::optional<RenderResult> gpu = stress::render_vulkan_if_available(moved, o);
         if (!gpu) GTEST_SKIP() << "no Vulkan device (or a build without the Vulkan path)";
-        const RenderResult cpu = render_cpu(moved, o);
+        const RenderResult cpu = stress::render_cpu_as_vulkan(moved, o);
         const bool brute = std::string(method) == "brute";
         const double* tolerance = c.vulkan[brute ? 0 : 1];
         stress::expect_images_agree(gpu->image, cpu.image, tolerance[0], tolerance[1],

@@ -74,6 +74,29 @@ TEST_F(Vulkan, NoMatchingDeviceListsTheDevicesAndWhy) {
     EXPECT_THROW(render_vulkan(p, options("brute", 8, 8), v), std::runtime_error);
 }
 
+// Cuts shared by quads of pixels are the CPU's alone: the Vulkan renderer
+// refuses them before it touches a device, and device "auto" renders them
+// on the CPU, saying so.
+TEST(VulkanQuadCuts, RefusedByVulkanAndRenderedOnTheCpuByAuto) {
+    PreparedScene p = prepare_scene(random_scene(5, 4, 0, 8, 8), 1);
+    RenderOptions o = options("lightcuts", 8, 8);
+    o.cut_sharing = "quad";
+    try {
+        render_vulkan(p, o, VulkanOptions{});
+        FAIL() << "expected an exception";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("cut_sharing \"quad\" runs on the CPU only"), std::string::npos)
+            << e.what();
+    }
+    DeviceChoice choice;
+    std::string said;
+    choice.note = [&](const std::string& line) { said = line; };
+    const RenderResult r = render(p, o, choice);
+    EXPECT_EQ(r.stats.device, "cpu");
+    EXPECT_TRUE(r.stats.quad_cuts);
+    EXPECT_NE(said.find("cut_sharing \"quad\" runs on the CPU only"), std::string::npos) << said;
+}
+
 // --- Analytic truth (pbrt-v4 style): a point light of intensity pi * h^2 at
 // height h straight above the point the centre pixel sees, on a Lambert
 // plane of albedo 0.5, gives radiance kd/pi * I * cos / d^2 = 0.5 there.

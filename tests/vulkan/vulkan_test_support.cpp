@@ -202,6 +202,8 @@ RenderOptions options(const std::string& method, std::uint32_t w, std::uint32_t 
     o.width = w;
     o.height = h;
     o.spp = spp;
+    // The CPU reference cuts each pixel alone, as the Vulkan kernels do.
+    o.cut_sharing = "pixel";
     return o;
 }
 

@@ -1,0 +1,375 @@
+// Lightcuts for a quad of pixels that share one cut (the CPU path's
+// cut_sharing "quad"). The four shaded points of a 2x2 block of pixels
+// refine one cut together: a cluster is split when its error bound exceeds
+// relative_error times the estimate of any of the four, so when refinement
+// stops every cluster of the cut meets Walter's criterion at every one of
+// the points (or the cut reached max_cut). Each point still has its own
+// estimate: its own representative contributions, shadow rays and sums.
+// What the four share is the cut's bookkeeping (one heap, one pass over
+// the tree, one read of each node) instead of doing it four times.
+//
+// The shared cut is the union of the four points' own refinements, so it
+// is at least as fine as each point's own cut, and costs more shadow rays
+// (about 1.1 times on the shipped room); the bookkeeping it saves costs
+// more than those rays (docs/results/speed.md).
+#pragma once
+
+#include <algorithm>
+#include <cfloat>
+#include <cstdint>
+#include <vector>
+
+#include "cpu_kernel.h"
+
+namespace lc::cpu {
+
+inline constexpr uint kQuadLanes = 4u;
+
+// One cluster of a quad's cut: its node, and at each of the four points its
+// error bound and its representative's unit contribution (zero where the
+// light is hidden or the bound is zero).
+struct QuadEntry {
+    uint node;
+    float error[kQuadLanes];
+    vec3 unit[kQuadLanes];
+};
+
+// The quad's cut heap: `key` and `slot` are the heap (a max-heap on key,
+// the largest ratio of a cluster's bound to a point's estimate), `entries`
+// the clusters it refers to, which stay where they are while the heap
+// moves their 8-byte handles.
+class QuadHeap {
+public:
+    explicit QuadHeap(std::size_t slots = 0)
+        : slots_(uint(slots)), key_(slots + 2 * kPad), slot_(slots + 2 * kPad), entries_(slots + 1), free_(slots + 1) {}
+    uint slots() const { return slots_; }
+    float* key() { return key_.data() + kPad; }
+    uint* slot() { return slot_.data() + kPad; }
+    QuadEntry* entries() { return entries_.data(); }
+    uint* free_slots() { return free_.data(); }
+
+private:
+    static constexpr std::size_t kPad = 64 / sizeof(float);
+    uint slots_;
+    std::vector<float> key_;
+    std::vector<uint> slot_;
+    std::vector<QuadEntry> entries_;
+    std::vector<uint> free_;
+};
+
+// One sample of a quad: the four points (`active` bit p where point p is a
+// surface to shade) refine one cut; radiance[p] is point p's estimate.
+template <class Kernel>
+class QuadCut {
+public:
+    using SurfacePoint = typename Kernel::SurfacePoint;
+    using ShadeStats = typename Kernel::ShadeStats;
+
+    QuadCut(Kernel& kernel, QuadHeap& heap, const FrameParams& frame)
+        : k_(kernel), f_(frame), key_(heap.key()), slot_(heap.slot()), entries_(heap.entries()),
+          free_(heap.free_slots()), capacity_(heap.slots()) {}
+
+    // Shades the active points of `sp`; their results in radiance[p], the
+    // stats in stats[p] (cut_size, hit_max_cut and frozen are the quad's).
+    void shade(const SurfacePoint* sp, unsigned active, vec3* radiance, ShadeStats* stats) {
+        sp_ = sp;
+        active_ = active;
+#if defined(__SSE2__)
+        lanes_ = quad_lanes(sp, active);
+#endif
+        stats_ = stats;
+        size_ = 0u;
+        free_count_ = capacity_ + 1u;
+        for (uint i = 0; i <= capacity_; ++i) free_[i] = capacity_ - i;
+        for (uint p = 0; p < kQuadLanes; ++p) {
+            fixed_[p] = vec3(0.0f);
+            heap_sum_[p] = vec3(0.0f);
+            frozen_error_[p] = 0.0f;
+            stats[p] = ShadeStats{};
+        }
+        cut_size_ = 0u;
+        cut_indirect_ = f_.roots[kLightVpl] != kInvalidIndex ? 1u : 0u;
+        frozen_ = 0u;
+        hit_max_cut_ = 0u;
+        root_bounds_ = 0.0f;
+        for (uint type = 0u; type < kLightTypeCount; ++type) {
+            if (f_.roots[type] == kInvalidIndex) continue;
+            const LightNode& root = k_.light_nodes[f_.roots[type]];
+            const uint slot = free_[--free_count_];
+            QuadEntry& e = entries_[slot];
+            e.node = f_.roots[type];
+            for (uint p = 0; p < kQuadLanes; ++p) {
+                e.error[p] = lane(p) ? k_.lc_cluster_error(sp_[p], sp_[p].mat, root, f_.min_distance2) : 0.0f;
+                e.unit[p] = vec3(0.0f);
+                if (lane(p) && k_.lc_cluster_needs_unit(root, e.error[p])) {
+                    bool visible;
+                    e.unit[p] = k_.lc_rep_unit(sp_[p], root.rep_light, f_.min_distance2, visible, stats_[p]);
+                }
+            }
+            for (uint p = 0; p < kQuadLanes; ++p)
+                if (e.error[p] > 0.0f) root_bounds_ += e.error[p];
+            if (enter(root, e)) {
+                update_weights();
+                push(key_of(e), slot);
+            } else {
+                free_[free_count_++] = slot;
+            }
+            cut_size_ += 1u;
+        }
+        refine_all();
+        for (uint p = 0; p < kQuadLanes; ++p) {
+            vec3 sum = fixed_[p];
+            for (uint i = 0; i < size_; ++i) {
+                const QuadEntry& e = entries_[slot_[i]];
+                sum += e.unit[p] * k_.lc_node_intensity(k_.light_nodes[e.node]);
+            }
+            radiance[p] = sum;
+            stats[p].cut_size = cut_size_;
+            stats[p].cut_indirect = cut_indirect_;
+            stats[p].hit_max_cut = hit_max_cut_;
+            stats[p].frozen = frozen_;
+            stats[p].frozen_error = frozen_error_[p];
+        }
+    }
+
+    // After shade(): the clusters the heap still holds (the cut's others
+    // are leaves and frozen clusters), at the first heap_size() handles of
+    // the QuadHeap's slot().
+    uint heap_size() const { return size_; }
+
+private:
+    bool lane(uint p) const { return (active_ >> p & 1u) != 0u; }
+
+    // A cluster entering the cut with its errors and units: a leaf goes to
+    // the fixed sums; an interior cluster with a nonzero bound at some
+    // point is refinable (true), its units counted in the heap's sums; one
+    // whose bound is zero at a point contributes nothing there.
+    bool enter(const LightNode& node, QuadEntry& e) {
+        const vec3 intensity = k_.lc_node_intensity(node);
+        if ((node.flags & kNodeLeaf) != 0u) {
+            for (uint p = 0; p < kQuadLanes; ++p) fixed_[p] += e.unit[p] * intensity;
+            return false;
+        }
+        bool any = false;
+        for (uint p = 0; p < kQuadLanes; ++p) {
+            if (!(e.error[p] > 0.0f)) {
+                e.unit[p] = vec3(0.0f);
+                continue;
+            }
+            any = true;
+        }
+        if (!any) return false;
+        for (uint p = 0; p < kQuadLanes; ++p) heap_sum_[p] += e.unit[p] * intensity;
+        __builtin_prefetch(k_.light_nodes + node.left);
+        __builtin_prefetch(k_.light_nodes + node.left + 1u);
+        return true;
+    }
+
+    // Each point's 1 / estimate (as luminance), which turns a bound into
+    // the ratio the criterion tests. An estimate is taken as at least
+    // 2^-20 of the quad's summed estimate (of the roots' summed bounds
+    // while that sum is zero): a point whose estimate is zero would
+    // otherwise weigh every bound there infinitely, and the heap could not
+    // order them. Such a point is held to relative_error times that floor
+    // instead of to Walter's bound > 0. The floor scales with the lights,
+    // so scaling every light by a power of two leaves the keys, and so the
+    // cuts, unchanged.
+    void update_weights() {
+        float estimate[kQuadLanes];
+        float total = 0.0f;
+        for (uint p = 0; p < kQuadLanes; ++p) {
+            estimate[p] = lc_luminance(fixed_[p] + heap_sum_[p]);
+            total += std::max(estimate[p], 0.0f);
+        }
+        const float floor = (total > 0.0f ? total : root_bounds_) * 0x1p-20f;
+        for (uint p = 0; p < kQuadLanes; ++p)
+            weight_[p] = floor > 0.0f ? 1.0f / std::max(estimate[p], floor) : 1.0f;
+    }
+    // A cluster's key in the heap: its largest ratio of bound to estimate
+    // over the points, at most FLT_MAX. A NaN bound is passed over, as
+    // Walter's test never refines it.
+    float key_of(const QuadEntry& e) const {
+        float key = 0.0f;
+        for (uint p = 0; p < kQuadLanes; ++p)
+            if (e.error[p] > 0.0f) key = std::max(key, e.error[p] * weight_[p]);
+        return std::min(key, FLT_MAX);
+    }
+
+    void sift_up(uint i, float key, uint slot) {
+        while (i > 0u) {
+            const uint parent = (i - 1u) / 2u;
+            if (key_[parent] >= key) break;
+            key_[i] = key_[parent];
+            slot_[i] = slot_[parent];
+            i = parent;
+        }
+        key_[i] = key;
+        slot_[i] = slot;
+    }
+    void sift_down(uint i, float key, uint slot) {
+        while (true) {
+            uint child = 2u * i + 1u;
+            if (child >= size_) break;
+            if (child + 1u < size_) child += uint(key_[child + 1u] > key_[child]);
+            if (key_[child] <= key) break;
+            key_[i] = key_[child];
+            slot_[i] = slot_[child];
+            i = child;
+        }
+        key_[i] = key;
+        slot_[i] = slot;
+    }
+    void remove_estimate(const QuadEntry& e, vec3* into) {
+        const vec3 intensity = k_.lc_node_intensity(k_.light_nodes[e.node]);
+        for (uint p = 0; p < kQuadLanes; ++p) {
+            const vec3 estimate = e.unit[p] * intensity;
+            heap_sum_[p] -= estimate;
+            if (into != nullptr) into[p] += estimate;
+        }
+    }
+
+    // Pushes the entry in `slot` (its estimates already in heap_sum_) with
+    // `key`; into a full heap it freezes the entry with the smallest key,
+    // this one included, and frees its slot.
+    void push(float key, uint slot) {
+        if (size_ < capacity_) {
+            size_ += 1u;
+            sift_up(size_ - 1u, key, slot);
+            return;
+        }
+        frozen_ += 1u;
+        const uint smallest = heap_smallest(key_, size_ / 2u, size_, key);
+        const uint leaving = smallest == kInvalidIndex ? slot : slot_[smallest];
+        for (uint p = 0; p < kQuadLanes; ++p) frozen_error_[p] += entries_[leaving].error[p];
+        remove_estimate(entries_[leaving], fixed_);
+        if (smallest == kInvalidIndex) {
+            free_[free_count_++] = slot;
+            return;
+        }
+        free_[free_count_++] = leaving;
+        sift_up(smallest, key, slot);
+    }
+
+    // Every key again from the current estimates, and the heap rebuilt.
+    void rekey() {
+        update_weights();
+        for (uint i = 0; i < size_; ++i) key_[i] = key_of(entries_[slot_[i]]);
+        for (uint i = size_ / 2u; i-- > 0u;) sift_down(i, key_[i], slot_[i]);
+    }
+
+    // Refines until every cluster meets the criterion at every point, or
+    // the cut reaches max_cut. The weights are those of the last
+    // refinement (a freeze moves an estimate between the sums, which
+    // changes them only by rounding); the final check is made with fresh
+    // ones.
+    void refine_all() {
+        bool fresh_keys = false;
+        update_weights();
+        while (size_ > 0u) {
+            const float top_key = key_of(entries_[slot_[0]]);
+            if (!(top_key > f_.relative_error)) {
+                // The keys were computed from the estimates of their time;
+                // the cut is final only if no cluster exceeds the criterion
+                // at today's.
+                if (fresh_keys) return;
+                rekey();
+                fresh_keys = true;
+                continue;
+            }
+            if (cut_size_ >= f_.max_cut) {
+                hit_max_cut_ = 1u;
+                return;
+            }
+            fresh_keys = false;
+            refine_top();
+        }
+    }
+
+    // lc_cluster_error of `node` at the four points (zero at inactive ones).
+    void errors(const LightNode& node, float* out) {
+#if defined(__SSE2__)
+        if (quad_errors(k_, lanes_, sp_, node, f_.min_distance2, out)) return;
+#endif
+        for (uint p = 0; p < kQuadLanes; ++p)
+            out[p] = lane(p) ? k_.lc_cluster_error(sp_[p], sp_[p].mat, node, f_.min_distance2) : 0.0f;
+    }
+
+    // Replaces the cluster at the top of the heap by its children. The
+    // child that keeps the parent's representative keeps its units (and
+    // its slot); the other one's come from one new shadow ray per point.
+    void refine_top() {
+        const uint kept_slot = slot_[0];
+        QuadEntry& kept = entries_[kept_slot];
+        const LightNode& node = k_.light_nodes[kept.node];
+        remove_estimate(kept, nullptr);
+        const bool right_shares = (node.flags & kNodeRepFromRight) != 0u;
+        const uint kept_index = right_shares ? node.left + 1u : node.left;
+        const uint fresh_index = right_shares ? node.left : node.left + 1u;
+        const LightNode& kept_node = k_.light_nodes[kept_index];
+        const LightNode& fresh_node = k_.light_nodes[fresh_index];
+        const uint fresh_slot = free_[--free_count_];
+        QuadEntry& fresh = entries_[fresh_slot];
+        kept.node = kept_index;
+        fresh.node = fresh_index;
+        errors(kept_node, kept.error);
+        errors(fresh_node, fresh.error);
+        const bool fresh_leaf = (fresh_node.flags & kNodeLeaf) != 0u;
+        // The new representative's shadow ray from each point. (Traced as
+        // one packet of four rays with a shared box test they ran slower:
+        // the points' spread widens the packet's bounds.)
+        for (uint p = 0; p < kQuadLanes; ++p) {
+            fresh.unit[p] = vec3(0.0f);
+            if (!lane(p) || !(fresh_leaf || fresh.error[p] > 0.0f)) continue;
+            bool visible;
+            fresh.unit[p] = k_.lc_rep_unit(sp_[p], fresh_node.rep_light, f_.min_distance2, visible, stats_[p]);
+        }
+        const bool has_kept = enter(kept_node, kept);
+        const bool has_fresh = enter(fresh_node, fresh);
+        if (!has_kept) free_[free_count_++] = kept_slot;
+        if (!has_fresh) free_[free_count_++] = fresh_slot;
+        cut_size_ += 1u;
+        if (k_.lc_node_type(node) == kLightVpl) cut_indirect_ += 1u;
+        update_weights();
+        float key_a = has_kept ? key_of(kept) : 0.0f, key_b = has_fresh ? key_of(fresh) : 0.0f;
+        uint slot_a = kept_slot, slot_b = fresh_slot;
+        bool has_a = has_kept, has_b = has_fresh;
+        if (has_b && (!has_a || key_b > key_a)) {
+            std::swap(key_a, key_b);
+            std::swap(slot_a, slot_b);
+            std::swap(has_a, has_b);
+        }
+        // The larger child takes the parent's place in the heap and sinks;
+        // the smaller one is pushed.
+        if (has_a) {
+            sift_down(0u, key_a, slot_a);
+        } else {
+            size_ -= 1u;
+            if (size_ > 0u) sift_down(0u, key_[size_], slot_[size_]);
+        }
+        if (has_b) push(key_b, slot_b);
+    }
+
+    Kernel& k_;
+    const FrameParams& f_;
+    float* key_;
+    uint* slot_;
+    QuadEntry* entries_;
+    uint* free_;
+    uint capacity_;
+    uint size_ = 0u;
+    uint free_count_ = 0u;
+    const SurfacePoint* sp_ = nullptr;
+    unsigned active_ = 0u;
+#if defined(__SSE2__)
+    QuadLanes lanes_;
+#endif
+    ShadeStats* stats_ = nullptr;
+    vec3 fixed_[kQuadLanes];     // each point's final estimates: leaves and frozen clusters
+    vec3 heap_sum_[kQuadLanes];  // ... and the running sum of the heap's
+    float weight_[kQuadLanes];   // update_weights
+    float frozen_error_[kQuadLanes];
+    float root_bounds_ = 0.0f;  // the roots' bounds summed over the points (update_weights)
+    uint cut_size_ = 0u, cut_indirect_ = 0u, frozen_ = 0u, hit_max_cut_ = 0u;
+};
+
+}  // namespace lc::cpu

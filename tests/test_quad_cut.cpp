@@ -1,0 +1,193 @@
+// Cuts shared by the four pixels of a 2x2 quad (host/quad_cut.h, the CPU's
+// cut_sharing "quad"): the four points' bounds in SSE lanes, the criterion
+// at every point, and quads cut short by the image's edge or by camera rays
+// that miss.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "cpu_kernel.h"
+#include "quad_cut.h"
+#include "test_util.h"
+
+namespace lc {
+namespace {
+
+using Kernel = cpu::ShadeKernel;
+
+// Over random clusters (points, VPLs, oriented and directional ones,
+// leaves) and quads of random points with random materials (Lambert, GGX,
+// Disney) and random active lanes, quad_errors gives lc_cluster_error's
+// value bit for bit in every active lane and 0 in the others, and covers
+// most of the cases.
+TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
+    std::mt19937 rng(4242);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const std::vector<gpu::Material> materials = {test::lambert(glm::vec3(0.5f))};
+    Kernel k;
+    k.materials = materials.data();  // lc_make_surface's; each point's own is set after it
+    k.vpl_min_distance2 = 0.01f;
+    int trials = 0, covered = 0, nonzero = 0;
+    for (int trial = 0; trial < 40000; ++trial) {
+        const glm::vec3 centre = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 4.0f;
+        const glm::vec3 half = glm::vec3(u(rng), u(rng), u(rng)) * (u(rng) < 0.2f ? 0.0f : 0.7f);
+        const float pick = u(rng);
+        const std::uint32_t type = pick < 0.7f   ? gpu::kLightPoint
+                                   : pick < 0.8f ? gpu::kLightVpl
+                                   : pick < 0.9f ? gpu::kLightOriented
+                                                 : gpu::kLightDirectional;
+        gpu::LightNode node = test::node_with_box(centre - half, centre + half, type);
+        if (type == gpu::kLightOriented) node.cos_theta_o = 0.5f;
+        if (u(rng) < 0.05f) node.flags |= gpu::kNodeLeaf;
+        node.intensity_r = 10.0f * u(rng), node.intensity_g = 10.0f * u(rng), node.intensity_b = 10.0f * u(rng);
+        Kernel::SurfacePoint sp[4];
+        const unsigned active = trial % 5 == 0 ? unsigned(rng() & 0xFu) : 0xFu;
+        const bool disney = trial % 11 == 0;
+        for (Kernel::SurfacePoint& s : sp) {
+            glm::vec3 x = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 6.0f;
+            if (u(rng) < 0.1f) x = glm::vec3(node.min_x, node.min_y + 0.5f * (node.max_y - node.min_y), node.max_z);
+            const glm::vec3 n = test::random_unit(rng);
+            glm::vec3 wo = test::random_unit(rng);
+            if (glm::dot(wo, n) < 0.0f) wo = -wo;
+            s = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f));
+            const glm::vec3 kd(u(rng), u(rng), u(rng));
+            const glm::vec3 ks(u(rng), u(rng), u(rng));
+            s.mat = u(rng) < 0.5f ? test::lambert(kd) : test::glossy(kd, ks, std::pow(10.0f, -3.0f * u(rng)));
+            if (disney) s.mat.flags |= gpu::kMaterialDisney;
+        }
+        const float min_distance2 = u(rng) < 0.5f ? 1e-8f : 0.05f;
+        float errors[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
+#if defined(__SSE2__)
+        const cpu::QuadLanes lanes = cpu::quad_lanes(sp, active);
+        const bool took = cpu::quad_errors(k, lanes, sp, node, min_distance2, errors);
+#else
+        const bool took = false;
+#endif
+        ++trials;
+        if (!took) continue;
+        ++covered;
+        for (unsigned p = 0; p < 4u; ++p) {
+            if ((active >> p & 1u) == 0u) {
+                ASSERT_EQ(errors[p], 0.0f) << "trial " << trial << " lane " << p;
+                continue;
+            }
+            const float scalar = k.lc_cluster_error(sp[p], sp[p].mat, node, min_distance2);
+            nonzero += scalar > 0.0f ? 1 : 0;
+            // Bit for bit: the same float, not merely close.
+            ASSERT_EQ(errors[p], scalar) << "trial " << trial << " lane " << p;
+        }
+    }
+#if defined(__SSE2__)
+    EXPECT_GT(covered, trials / 2);
+    EXPECT_GT(nonzero, covered / 2);
+#endif
+}
+
+// With a heap as large as the tree needs and no cut limit, every cluster
+// left in a quad's cut meets Walter's criterion at each of the four points:
+// its bound there is at most relative_error times that point's estimate.
+// (The estimate the refinement tests is the running sum, which differs
+// from the final sum by float rounding: the check allows 1e-5 of it.)
+// Nothing is frozen, and every cut refines beyond the roots.
+TEST(QuadCut, EveryClusterMeetsTheCriterionAtEveryPoint) {
+    Scene s = test::room_scene(test::random_point_lights(500, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 17), 16);
+    PreparedScene p = prepare_scene(std::move(s), 1);
+    RenderOptions o = test::options("lightcuts", 16);
+    o.max_cut = 1u << 20;
+    const gpu::FrameParams f = make_frame_params(p, o);
+    cpu::QuadHeap heap(p.tree.cut_heap_capacity(f.max_cut));
+    Kernel k = cpu::make_shade_kernel(p);
+    cpu::QuadCut<Kernel> quad(k, heap, f);
+    std::size_t checked = 0;
+    for (std::uint32_t y = 0; y < 16; y += 2)
+        for (std::uint32_t x = 0; x < 16; x += 2) {
+            Kernel::SurfacePoint sp[4];
+            unsigned active = 0u;
+            for (std::uint32_t q = 0; q < 4u; ++q)
+                if (k.lc_camera_hit(f, x + (q & 1u), y + (q >> 1u), 0, sp[q])) active |= 1u << q;
+            ASSERT_EQ(active, 0xFu) << "the room is closed";
+            glm::vec3 radiance[4];
+            Kernel::ShadeStats stats[4];
+            quad.shade(sp, active, radiance, stats);
+            for (std::uint32_t q = 0; q < 4u; ++q) {
+                ASSERT_EQ(stats[q].frozen, 0u);
+                ASSERT_EQ(stats[q].hit_max_cut, 0u);
+                ASSERT_GT(stats[q].cut_size, 1u);
+                ASSERT_EQ(stats[q].cut_size, stats[0].cut_size) << "one cut for the quad";
+            }
+            for (std::uint32_t i = 0; i < quad.heap_size(); ++i) {
+                const cpu::QuadEntry& e = heap.entries()[heap.slot()[i]];
+                for (std::uint32_t q = 0; q < 4u; ++q) {
+                    const float estimate = gpu::lc_luminance(radiance[q]);
+                    ASSERT_LE(e.error[q], f.relative_error * estimate * (1.0f + 1e-5f))
+                        << "quad " << x << "," << y << " point " << q << " node " << e.node;
+                    ++checked;
+                }
+            }
+        }
+    EXPECT_GT(checked, 1000u);
+}
+
+// A floor seen at an angle, with the sky above the horizon: quads whose
+// camera rays partly miss, on an image whose odd sides cut the last column
+// and row of quads in half. With relative_error 0 and a heap as large as
+// the tree needs every cluster is refined to its lights, so each pixel of
+// the quads is brute force's up to the summation order, the missed ones
+// included.
+TEST(QuadCut, PartialQuadsAndMissedPixelsAreShaded) {
+    Scene s;
+    s.materials = {test::lambert(glm::vec3(0.6f))};
+    test::add_quad(s, {-4, 0, -8}, {4, 0, -8}, {4, 0, 2}, {-4, 0, 2}, 0);
+    s.lights = test::random_point_lights(200, {-2.0f, 0.5f, -4.0f}, {2.0f, 2.0f, 0.0f}, 10.0f, 9);
+    s.camera = test::camera({0.0f, 1.0f, 3.0f}, {0.0f, 0.6f, -2.0f}, 60.0f, 13, 7);
+    update_bounds(s);
+    PreparedScene p = prepare_scene(std::move(s), 1);
+    RenderOptions o = test::options("lightcuts", 13);
+    o.height = 7;
+    o.cut_sharing = "quad";
+    o.relative_error = 0.0f;
+    o.max_cut = 1u << 20;
+    o.cut_heap = o.max_cut;
+    const RenderResult lc = render_cpu(p, o);
+    EXPECT_TRUE(lc.stats.quad_cuts);
+    o.method = "brute";
+    const RenderResult brute = render_cpu(p, o);
+    int missed = 0, lit = 0;
+    for (std::uint32_t y = 0; y < 7; ++y)
+        for (std::uint32_t x = 0; x < 13; ++x) {
+            const glm::vec3 want = brute.image.at(x, y), got = lc.image.at(x, y);
+            for (int c = 0; c < 3; ++c) ASSERT_NEAR(got[c], want[c], 1e-5f * want[c] + 1e-9f) << x << "," << y;
+            const float cut = lc.stats.cut_size[std::size_t(y) * 13 + x];
+            if (want == glm::vec3(0.0f) && cut == 0.0f) ++missed;
+            if (want.x > 0.0f) ++lit;
+        }
+    EXPECT_GT(missed, 5) << "some camera rays must leave the scene";
+    EXPECT_GT(lit, 30);
+}
+
+// Each pixel's cut alone, or the quad's: a render names the one it made.
+TEST(QuadCut, CutSharingSettingPicksThePath) {
+    Scene s = test::room_scene(test::random_point_lights(100, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 2), 8);
+    PreparedScene p = prepare_scene(std::move(s), 1);
+    RenderOptions o = test::options("lightcuts", 8);
+    EXPECT_EQ(o.cut_sharing, "auto");
+    EXPECT_TRUE(render_cpu(p, o).stats.quad_cuts);
+    o.cut_sharing = "pixel";
+    const RenderResult pixel = render_cpu(p, o);
+    EXPECT_FALSE(pixel.stats.quad_cuts);
+    EXPECT_EQ(pixel.stats.heap_slots, std::min(kDefaultCutHeap, p.tree.cut_heap_capacity(o.max_cut)));
+    o.cut_sharing = "quad";
+    const RenderResult quad = render_cpu(p, o);
+    EXPECT_TRUE(quad.stats.quad_cuts);
+    EXPECT_EQ(quad.stats.heap_slots, std::min(4 * kDefaultCutHeap, p.tree.cut_heap_capacity(o.max_cut)));
+    o.method = "stochastic";  // cuts each pixel alone
+    EXPECT_FALSE(render_cpu(p, o).stats.quad_cuts);
+    o.method = "lightcuts";
+    o.cut_sharing = "tiles";
+    EXPECT_THROW(render_cpu(p, o), std::invalid_argument);
+    EXPECT_EQ(cut_sharing_problem("tiles"), "must be \"auto\", \"pixel\" or \"quad\", got \"tiles\"");
+}
+
+}  // namespace
+}  // namespace lc
