@@ -257,6 +257,58 @@ bool quad_errors(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, con
     for (unsigned p = 0; p < 4u; ++p) errors[p] = out[p];
     return true;
 }
+
+// lc_light_unit of one point `light` at the quad's four points, lane by
+// lane, into unit[p] (zero in inactive lanes), and for each point where the
+// unit is not zero the shadow ray's direction wi[p] and length t_max[p]:
+// the scalar function's values bit for bit (tests/test_quad_cut.cpp). False
+// where this does not cover the case: a light that is not a point light, or
+// a Disney material at an active point. Points with a GGX lobe get their
+// BRDF from the scalar lc_brdf_cos, on the direction and cosine computed
+// here. A change to lc_light_unit or lc_brdf_cos (shaders/shared/shading.h)
+// must be made here too; the test fails until it is.
+template <class Kernel, class SurfacePoint>
+bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, const gpu::Light& light,
+                      float min_distance2, glm::vec3 unit[4], glm::vec3 wi[4], float t_max[4]) {
+    if (!q.covered || (light.type & gpu::kLightTypeMask) != gpu::kLightPoint) return false;
+    const __m128 zero = _mm_setzero_ps();
+    const __m128 tx = _mm_sub_ps(_mm_set1_ps(light.x), q.px), ty = _mm_sub_ps(_mm_set1_ps(light.y), q.py),
+                 tz = _mm_sub_ps(_mm_set1_ps(light.z), q.pz);
+    const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(tx, tx), _mm_mul_ps(ty, ty)), _mm_mul_ps(tz, tz));
+    const __m128 d = _mm_sqrt_ps(d2);
+    const __m128 wx = _mm_div_ps(tx, d), wy = _mm_div_ps(ty, d), wz = _mm_div_ps(tz, d);
+    const __m128 length = _mm_mul_ps(d, _mm_set1_ps(1.0f - Kernel::kShadowEndRelative));
+    const __m128 factor = _mm_div_ps(
+        _mm_set1_ps(1.0f), _mm_max_ps(d2, _mm_set1_ps(kernel.lc_falloff_clamp2(min_distance2, gpu::kLightPoint))));
+    const __m128 cos_i = dot4(q.nx, q.ny, q.nz, wx, wy, wz);
+    // lc_light_unit's early returns: no direction (d = 0), the light behind
+    // the surface, no emission towards it.
+    const __m128 lit = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(d, zero), _mm_cmpgt_ps(cos_i, zero)),
+                                  _mm_and_ps(_mm_cmpgt_ps(factor, zero), q.active));
+    const __m128 c = _mm_div_ps(cos_i, _mm_set1_ps(Kernel::kPi));
+    alignas(16) float v[9][4];
+    _mm_store_ps(v[0], _mm_mul_ps(_mm_mul_ps(q.kd_r, c), factor));
+    _mm_store_ps(v[1], _mm_mul_ps(_mm_mul_ps(q.kd_g, c), factor));
+    _mm_store_ps(v[2], _mm_mul_ps(_mm_mul_ps(q.kd_b, c), factor));
+    _mm_store_ps(v[3], wx);
+    _mm_store_ps(v[4], wy);
+    _mm_store_ps(v[5], wz);
+    _mm_store_ps(v[6], length);
+    _mm_store_ps(v[7], cos_i);
+    _mm_store_ps(v[8], factor);
+    const unsigned mask = unsigned(_mm_movemask_ps(lit));
+    for (unsigned p = 0; p < 4u; ++p) {
+        unit[p] = glm::vec3(0.0f);
+        if ((mask >> p & 1u) == 0u) continue;
+        wi[p] = glm::vec3(v[3][p], v[4][p], v[5][p]);
+        t_max[p] = v[6][p];
+        if ((q.specular >> p & 1u) != 0u)
+            unit[p] = kernel.lc_brdf_cos(sp[p].mat, sp[p].n, wi[p], sp[p].wo, v[7][p]) * v[8][p];
+        else
+            unit[p] = glm::vec3(v[0][p], v[1][p], v[2][p]);
+    }
+    return true;
+}
 #endif
 
 }  // namespace lc::cpu

@@ -84,6 +84,72 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
 #endif
 }
 
+// The same for a representative's contribution: over random point lights
+// (and some of other kinds, which quad_light_units leaves to the scalar
+// code), points near and far, in front of and behind the light, Lambert,
+// GGX and Disney materials and random active lanes, the four units are
+// lc_light_unit's bit for bit, with its ray direction and length where the
+// unit is not zero.
+TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
+    std::mt19937 rng(2024);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const std::vector<gpu::Material> materials = {test::lambert(glm::vec3(0.5f))};
+    Kernel k;
+    k.materials = materials.data();
+    int covered = 0, lit = 0, trials = 0;
+    for (int trial = 0; trial < 40000; ++trial) {
+        const glm::vec3 at = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 4.0f;
+        const gpu::Light light = trial % 9 == 0
+                                     ? test::spot_light(at, test::random_unit(rng), glm::vec3(3.0f), 20.0f, 40.0f)
+                                     : test::point_light(at, glm::vec3(u(rng), u(rng), u(rng)) * 10.0f);
+        Kernel::SurfacePoint sp[4];
+        const unsigned active = trial % 5 == 0 ? unsigned(rng() & 0xFu) : 0xFu;
+        const bool disney = trial % 13 == 0;
+        for (Kernel::SurfacePoint& s : sp) {
+            // Some points on the light itself (no direction), some close.
+            const float spread = u(rng) < 0.3f ? 0.01f : 6.0f;
+            const glm::vec3 x = u(rng) < 0.02f ? at : at + (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * spread;
+            glm::vec3 wo = test::random_unit(rng);
+            const glm::vec3 n = test::random_unit(rng);
+            if (glm::dot(wo, n) < 0.0f) wo = -wo;
+            s = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f));
+            const glm::vec3 kd(u(rng), u(rng), u(rng)), ks(u(rng), u(rng), u(rng));
+            s.mat = u(rng) < 0.5f ? test::lambert(kd) : test::glossy(kd, ks, std::pow(10.0f, -3.0f * u(rng)));
+            if (disney) s.mat.flags |= gpu::kMaterialDisney;
+        }
+        const float min_distance2 = u(rng) < 0.5f ? 1e-8f : 0.05f;
+        glm::vec3 unit[4], wi[4];
+        float t_max[4];
+#if defined(__SSE2__)
+        const bool took =
+            cpu::quad_light_units(k, cpu::quad_lanes(sp, active), sp, light, min_distance2, unit, wi, t_max);
+#else
+        const bool took = false;
+#endif
+        ++trials;
+        if (!took) continue;
+        ++covered;
+        for (unsigned p = 0; p < 4u; ++p) {
+            if ((active >> p & 1u) == 0u) {
+                ASSERT_EQ(unit[p], glm::vec3(0.0f)) << "trial " << trial << " lane " << p;
+                continue;
+            }
+            glm::vec3 scalar_wi;
+            float scalar_t_max;
+            const glm::vec3 scalar = k.lc_light_unit(sp[p], light, min_distance2, scalar_wi, scalar_t_max);
+            ASSERT_EQ(unit[p], scalar) << "trial " << trial << " lane " << p;
+            if (!(scalar.x + scalar.y + scalar.z > 0.0f)) continue;
+            ++lit;
+            ASSERT_EQ(wi[p], scalar_wi) << "trial " << trial << " lane " << p;
+            ASSERT_EQ(t_max[p], scalar_t_max) << "trial " << trial << " lane " << p;
+        }
+    }
+#if defined(__SSE2__)
+    EXPECT_GT(covered, trials / 2);
+    EXPECT_GT(lit, covered / 2);
+#endif
+}
+
 // With a heap as large as the tree needs and no cut limit, every cluster
 // left in a quad's cut meets Walter's criterion at each of the four points:
 // its bound there is at most relative_error times that point's estimate.
