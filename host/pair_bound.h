@@ -10,6 +10,12 @@
 // A change to lc_cluster_bound, lc_cosine_bound, lc_box_distance2 or
 // lc_luminance (shaders/shared) must be made here too; the test fails until
 // it is.
+//
+// The quad functions below do the same for one cluster at the four shaded
+// points of a 2x2 quad (host/quad_cut.h), the points in the lanes: its
+// bound (quad_errors, with the GGX lobe's, quad_ggx_bounds) and its
+// representative's contribution (quad_light_units), bit for bit the scalar
+// functions' (tests/test_quad_cut.cpp).
 #pragma once
 
 #include <cmath>
@@ -142,6 +148,7 @@ struct QuadLanes {
     __m128 tx, ty, tz, atx, aty, atz;
     __m128 bx, by, bz, abx, aby, abz;
     __m128 kd_r, kd_g, kd_b;
+    __m128 wox, woy, woz, alpha;  // the view direction and the GGX roughness
     __m128 active;        // all ones in the lanes of active points
     unsigned specular;    // lanes whose material has a GGX lobe
     bool covered = false; // no active point has the Disney BRDF
@@ -150,7 +157,7 @@ struct QuadLanes {
 template <class SurfacePoint>
 QuadLanes quad_lanes(const SurfacePoint* sp, unsigned active) {
     QuadLanes q;
-    alignas(16) float v[24][4];
+    alignas(16) float v[28][4];
     alignas(16) std::uint32_t mask[4];
     q.specular = 0u;
     q.covered = true;
@@ -160,19 +167,21 @@ QuadLanes quad_lanes(const SurfacePoint* sp, unsigned active) {
         const SurfacePoint& s = sp[p];
         const glm::vec3 zero(0.0f);
         const glm::vec3 pos = on ? s.p : zero, n = on ? s.n : zero, t = on ? s.t : zero, b = on ? s.b : zero;
-        const float f[24] = {pos.x, pos.y, pos.z, n.x, n.y, n.z, std::fabs(n.x), std::fabs(n.y), std::fabs(n.z),
+        const float f[28] = {pos.x, pos.y, pos.z, n.x, n.y, n.z, std::fabs(n.x), std::fabs(n.y), std::fabs(n.z),
                              t.x, t.y, t.z, std::fabs(t.x), std::fabs(t.y), std::fabs(t.z),
                              b.x, b.y, b.z, std::fabs(b.x), std::fabs(b.y), std::fabs(b.z),
-                             on ? s.mat.kd_r : 0.0f, on ? s.mat.kd_g : 0.0f, on ? s.mat.kd_b : 0.0f};
-        for (unsigned i = 0; i < 24u; ++i) v[i][p] = f[i];
+                             on ? s.mat.kd_r : 0.0f, on ? s.mat.kd_g : 0.0f, on ? s.mat.kd_b : 0.0f,
+                             on ? s.wo.x : 0.0f, on ? s.wo.y : 0.0f, on ? s.wo.z : 0.0f,
+                             on ? s.mat.alpha : 1.0f};
+        for (unsigned i = 0; i < 28u; ++i) v[i][p] = f[i];
         if (!on) continue;
         if ((s.mat.flags & gpu::kMaterialDisney) != 0u) q.covered = false;
         if ((s.mat.flags & gpu::kMaterialHasSpecular) != 0u) q.specular |= 1u << p;
     }
-    __m128* out[24] = {&q.px, &q.py, &q.pz, &q.nx, &q.ny, &q.nz, &q.anx, &q.any, &q.anz,
+    __m128* out[28] = {&q.px, &q.py, &q.pz, &q.nx, &q.ny, &q.nz, &q.anx, &q.any, &q.anz,
                        &q.tx, &q.ty, &q.tz, &q.atx, &q.aty, &q.atz, &q.bx, &q.by, &q.bz,
-                       &q.abx, &q.aby, &q.abz, &q.kd_r, &q.kd_g, &q.kd_b};
-    for (unsigned i = 0; i < 24u; ++i) *out[i] = _mm_load_ps(v[i]);
+                       &q.abx, &q.aby, &q.abz, &q.kd_r, &q.kd_g, &q.kd_b, &q.wox, &q.woy, &q.woz, &q.alpha};
+    for (unsigned i = 0; i < 28u; ++i) *out[i] = _mm_load_ps(v[i]);
     q.active = _mm_load_ps(reinterpret_cast<const float*>(mask));
     return q;
 }
@@ -180,6 +189,66 @@ QuadLanes quad_lanes(const SurfacePoint* sp, unsigned active) {
 // ((a_x * v_x + a_y * v_y) + a_z * v_z) lane by lane: glm's dot.
 inline __m128 dot4(__m128 ax, __m128 ay, __m128 az, __m128 vx, __m128 vy, __m128 vz) {
     return _mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, vx), _mm_mul_ps(ay, vy)), _mm_mul_ps(az, vz));
+}
+
+// lc_ggx_bound of one box at the quad's points, lane by lane, with the
+// same operations in the same order as lc_ggx_bound, lc_box_cone,
+// lc_cos_h_max, lc_ggx_d and lc_smith_g1: into ggx[p] for the lanes of
+// `lanes`, 0 elsewhere.
+template <class Kernel>
+void quad_ggx_bounds(const QuadLanes& q, const gpu::LightNode& node, unsigned lanes, float ggx[4]) {
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), half = _mm_set1_ps(0.5f);
+    // cos_o = dot(n, wo); the lanes with cos_o <= 0 give 0.
+    const __m128 cos_o = dot4(q.nx, q.ny, q.nz, q.wox, q.woy, q.woz);
+    // lc_box_cone: the box seen from each point.
+    const __m128 c_x = _mm_mul_ps(half, _mm_add_ps(_mm_sub_ps(_mm_set1_ps(node.min_x), q.px),
+                                                   _mm_sub_ps(_mm_set1_ps(node.max_x), q.px)));
+    const __m128 c_y = _mm_mul_ps(half, _mm_add_ps(_mm_sub_ps(_mm_set1_ps(node.min_y), q.py),
+                                                   _mm_sub_ps(_mm_set1_ps(node.max_y), q.py)));
+    const __m128 c_z = _mm_mul_ps(half, _mm_add_ps(_mm_sub_ps(_mm_set1_ps(node.min_z), q.pz),
+                                                   _mm_sub_ps(_mm_set1_ps(node.max_z), q.pz)));
+    const glm::vec3 extent(node.max_x - node.min_x, node.max_y - node.min_y, node.max_z - node.min_z);
+    const __m128 radius = _mm_set1_ps(0.5f * std::sqrt((extent.x * extent.x + extent.y * extent.y) +
+                                                       extent.z * extent.z));
+    const __m128 dist = _mm_sqrt_ps(dot4(c_x, c_y, c_z, c_x, c_y, c_z));
+    const __m128 outside = _mm_cmpgt_ps(dist, radius);  // else any direction: cos_h_max = 1
+    const __m128 a_x = _mm_div_ps(c_x, dist), a_y = _mm_div_ps(c_y, dist), a_z = _mm_div_ps(c_z, dist);
+    const __m128 sin_c = _mm_min_ps(_mm_div_ps(radius, dist), one);
+    // lc_cos_h_max.
+    const __m128 two_cos_o = _mm_mul_ps(_mm_set1_ps(2.0f), cos_o);
+    const __m128 wr_x = _mm_sub_ps(_mm_mul_ps(two_cos_o, q.nx), q.wox);
+    const __m128 wr_y = _mm_sub_ps(_mm_mul_ps(two_cos_o, q.ny), q.woy);
+    const __m128 wr_z = _mm_sub_ps(_mm_mul_ps(two_cos_o, q.nz), q.woz);
+    const __m128 cos_r = dot4(wr_x, wr_y, wr_z, a_x, a_y, a_z);
+    const __m128 cos_c = _mm_sqrt_ps(_mm_max_ps(_mm_sub_ps(one, _mm_mul_ps(sin_c, sin_c)), zero));
+    const __m128 in_cone = _mm_cmpge_ps(cos_r, cos_c);  // the mirror direction in the cone: 1
+    const __m128 x_x = _mm_sub_ps(_mm_mul_ps(wr_y, a_z), _mm_mul_ps(a_y, wr_z));
+    const __m128 x_y = _mm_sub_ps(_mm_mul_ps(wr_z, a_x), _mm_mul_ps(a_z, wr_x));
+    const __m128 x_z = _mm_sub_ps(_mm_mul_ps(wr_x, a_y), _mm_mul_ps(a_x, wr_y));
+    const __m128 sin_r = _mm_sqrt_ps(dot4(x_x, x_y, x_z, x_x, x_y, x_z));
+    const __m128 cos_delta = _mm_min_ps(
+        _mm_add_ps(_mm_add_ps(_mm_mul_ps(cos_r, cos_c), _mm_mul_ps(sin_r, sin_c)), _mm_set1_ps(Kernel::kCosineAbsSlack)),
+        one);
+    const __m128 narrowed = _mm_min_ps(
+        _mm_mul_ps(_mm_sqrt_ps(_mm_max_ps(_mm_add_ps(half, _mm_mul_ps(half, cos_delta)), zero)),
+                   _mm_set1_ps(Kernel::kBoundSlack)),
+        one);
+    const __m128 wide = _mm_andnot_ps(outside, one);
+    const __m128 narrow = _mm_and_ps(outside, _mm_or_ps(_mm_and_ps(in_cone, one), _mm_andnot_ps(in_cone, narrowed)));
+    const __m128 cos_h = _mm_or_ps(wide, narrow);
+    // lc_ggx_d(cos_h, alpha) * lc_smith_g1(cos_o, alpha) / (4 cos_o) * kBoundSlack.
+    const __m128 a2 = _mm_mul_ps(q.alpha, q.alpha);
+    const __m128 c2 = _mm_mul_ps(cos_h, cos_h);
+    const __m128 denom = _mm_add_ps(_mm_sub_ps(one, c2), _mm_mul_ps(a2, c2));
+    const __m128 d = _mm_div_ps(a2, _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(Kernel::kPi), denom), denom));
+    const __m128 g1 = _mm_div_ps(
+        _mm_mul_ps(_mm_set1_ps(2.0f), cos_o),
+        _mm_add_ps(cos_o, _mm_sqrt_ps(_mm_add_ps(a2, _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(one, a2), cos_o), cos_o)))));
+    const __m128 bound = _mm_mul_ps(_mm_div_ps(_mm_mul_ps(d, g1), _mm_mul_ps(_mm_set1_ps(4.0f), cos_o)),
+                                    _mm_set1_ps(Kernel::kBoundSlack));
+    alignas(16) float out[4];
+    _mm_store_ps(out, _mm_and_ps(bound, _mm_cmpgt_ps(cos_o, zero)));
+    for (unsigned p = 0; p < 4u; ++p) ggx[p] = (lanes >> p & 1u) != 0u ? out[p] : 0.0f;
 }
 
 // lc_cluster_error of one `node` at the quad's four points, into errors[p]
@@ -232,15 +301,15 @@ bool quad_errors(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, con
     __m128 b = _mm_mul_ps(q.kd_b, cos_over_pi);
     if (q.specular != 0u) {
         alignas(16) float ks[3][4] = {}, ggx[4] = {};
-        const glm::vec3 box_min(node.min_x, node.min_y, node.min_z), box_max(node.max_x, node.max_y, node.max_z);
+        unsigned lanes = 0u;
         for (unsigned p = 0; p < 4u; ++p) {
             if ((q.specular >> p & 1u) == 0u || !(cosines[p] > 0.0f)) continue;
-            const SurfacePoint& s = sp[p];
-            ggx[p] = kernel.lc_ggx_bound(s.mat, box_min, box_max, s.p, s.n, s.wo);
-            ks[0][p] = s.mat.ks_r;
-            ks[1][p] = s.mat.ks_g;
-            ks[2][p] = s.mat.ks_b;
+            lanes |= 1u << p;
+            ks[0][p] = sp[p].mat.ks_r;
+            ks[1][p] = sp[p].mat.ks_g;
+            ks[2][p] = sp[p].mat.ks_b;
         }
+        quad_ggx_bounds<Kernel>(q, node, lanes, ggx);
         const __m128 gv = _mm_load_ps(ggx);
         r = _mm_add_ps(r, _mm_mul_ps(_mm_load_ps(ks[0]), gv));
         g = _mm_add_ps(g, _mm_mul_ps(_mm_load_ps(ks[1]), gv));
