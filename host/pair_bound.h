@@ -40,6 +40,12 @@ inline __m128 dot_lanes(glm::vec3 a, __m128 vx, __m128 vy, __m128 vz) {
                       _mm_mul_ps(_mm_set1_ps(a.z), vz));
 }
 inline __m128 abs_lanes(__m128 v) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), v); }
+// glm's min and max lane by lane, which the kernels' min and max are on the
+// CPU: min(x, y) = y < x ? y : x and max(x, y) = x < y ? y : x, so a NaN in
+// x is kept (and -0 or +0 chosen as there). _mm_min_ps(a, b) = a < b ? a : b,
+// hence the swapped operands.
+inline __m128 glsl_min(__m128 x, __m128 y) { return _mm_min_ps(y, x); }
+inline __m128 glsl_max(__m128 x, __m128 y) { return _mm_max_ps(y, x); }
 #endif
 
 // Whether the pair evaluation covers this child.
@@ -79,13 +85,13 @@ bool pair_errors(Kernel& kernel, const SurfacePoint& sp, const gpu::Material& m,
     const glm::vec3 at = glm::vec3(std::fabs(sp.t.x), std::fabs(sp.t.y), std::fabs(sp.t.z));
     const glm::vec3 ab = glm::vec3(std::fabs(sp.b.x), std::fabs(sp.b.y), std::fabs(sp.b.z));
     const __m128 near_x =
-        _mm_max_ps(_mm_sub_ps(abs_lanes(dot_lanes(sp.t, c_x, c_y, c_z)), dot_lanes(at, e_x, e_y, e_z)), zero);
+        glsl_max(_mm_sub_ps(abs_lanes(dot_lanes(sp.t, c_x, c_y, c_z)), dot_lanes(at, e_x, e_y, e_z)), zero);
     const __m128 near_y =
-        _mm_max_ps(_mm_sub_ps(abs_lanes(dot_lanes(sp.b, c_x, c_y, c_z)), dot_lanes(ab, e_x, e_y, e_z)), zero);
+        glsl_max(_mm_sub_ps(abs_lanes(dot_lanes(sp.b, c_x, c_y, c_z)), dot_lanes(ab, e_x, e_y, e_z)), zero);
     const __m128 q = _mm_add_ps(_mm_add_ps(_mm_mul_ps(near_x, near_x), _mm_mul_ps(near_y, near_y)),
                                 _mm_mul_ps(z_max, z_max));
     const __m128 bound = _mm_mul_ps(z_max, _mm_div_ps(_mm_set1_ps(1.0f), _mm_sqrt_ps(q)));
-    const __m128 cos_bound = _mm_min_ps(_mm_mul_ps(bound, _mm_set1_ps(Kernel::kBoundSlack)), _mm_set1_ps(1.0f));
+    const __m128 cos_bound = glsl_min(_mm_mul_ps(bound, _mm_set1_ps(Kernel::kBoundSlack)), _mm_set1_ps(1.0f));
     // z_max <= 0 returns 0 there, and so cos_bound <= 0 here.
     alignas(16) float cosines[4];
     _mm_store_ps(cosines, _mm_and_ps(cos_bound, _mm_cmpgt_ps(z_max, zero)));
@@ -94,15 +100,15 @@ bool pair_errors(Kernel& kernel, const SurfacePoint& sp, const gpu::Material& m,
         return true;
     }
     // The falloff: kBoundSlack / max(lc_box_distance2, the clamp).
-    const __m128 d_x = _mm_max_ps(_mm_max_ps(lo_x, _mm_sub_ps(px, max_x)), zero);
-    const __m128 d_y = _mm_max_ps(_mm_max_ps(lo_y, _mm_sub_ps(py, max_y)), zero);
-    const __m128 d_z = _mm_max_ps(_mm_max_ps(lo_z, _mm_sub_ps(pz, max_z)), zero);
+    const __m128 d_x = glsl_max(glsl_max(lo_x, _mm_sub_ps(px, max_x)), zero);
+    const __m128 d_y = glsl_max(glsl_max(lo_y, _mm_sub_ps(py, max_y)), zero);
+    const __m128 d_z = glsl_max(glsl_max(lo_z, _mm_sub_ps(pz, max_z)), zero);
     const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d_x, d_x), _mm_mul_ps(d_y, d_y)), _mm_mul_ps(d_z, d_z));
     const std::uint32_t type_left = (left.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask;
     const std::uint32_t type_right = (right.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask;
     const __m128 clamp = lanes(kernel.lc_falloff_clamp2(min_distance2, type_left),
                                kernel.lc_falloff_clamp2(min_distance2, type_right));
-    const __m128 factor = _mm_div_ps(_mm_set1_ps(Kernel::kBoundSlack), _mm_max_ps(d2, clamp));
+    const __m128 factor = _mm_div_ps(_mm_set1_ps(Kernel::kBoundSlack), glsl_max(d2, clamp));
     // lc_kd(m) * (cos_bound / kPi) [+ lc_ks(m) * lc_ggx_bound], times factor.
     const __m128 cos_over_pi = _mm_div_ps(_mm_load_ps(cosines), _mm_set1_ps(Kernel::kPi));
     __m128 r = _mm_mul_ps(_mm_set1_ps(m.kd_r), cos_over_pi);
@@ -213,24 +219,24 @@ void quad_ggx_bounds(const QuadLanes& q, const gpu::LightNode& node, unsigned la
     const __m128 dist = _mm_sqrt_ps(dot4(c_x, c_y, c_z, c_x, c_y, c_z));
     const __m128 outside = _mm_cmpgt_ps(dist, radius);  // else any direction: cos_h_max = 1
     const __m128 a_x = _mm_div_ps(c_x, dist), a_y = _mm_div_ps(c_y, dist), a_z = _mm_div_ps(c_z, dist);
-    const __m128 sin_c = _mm_min_ps(_mm_div_ps(radius, dist), one);
+    const __m128 sin_c = glsl_min(_mm_div_ps(radius, dist), one);
     // lc_cos_h_max.
     const __m128 two_cos_o = _mm_mul_ps(_mm_set1_ps(2.0f), cos_o);
     const __m128 wr_x = _mm_sub_ps(_mm_mul_ps(two_cos_o, q.nx), q.wox);
     const __m128 wr_y = _mm_sub_ps(_mm_mul_ps(two_cos_o, q.ny), q.woy);
     const __m128 wr_z = _mm_sub_ps(_mm_mul_ps(two_cos_o, q.nz), q.woz);
     const __m128 cos_r = dot4(wr_x, wr_y, wr_z, a_x, a_y, a_z);
-    const __m128 cos_c = _mm_sqrt_ps(_mm_max_ps(_mm_sub_ps(one, _mm_mul_ps(sin_c, sin_c)), zero));
+    const __m128 cos_c = _mm_sqrt_ps(glsl_max(_mm_sub_ps(one, _mm_mul_ps(sin_c, sin_c)), zero));
     const __m128 in_cone = _mm_cmpge_ps(cos_r, cos_c);  // the mirror direction in the cone: 1
     const __m128 x_x = _mm_sub_ps(_mm_mul_ps(wr_y, a_z), _mm_mul_ps(a_y, wr_z));
     const __m128 x_y = _mm_sub_ps(_mm_mul_ps(wr_z, a_x), _mm_mul_ps(a_z, wr_x));
     const __m128 x_z = _mm_sub_ps(_mm_mul_ps(wr_x, a_y), _mm_mul_ps(a_x, wr_y));
     const __m128 sin_r = _mm_sqrt_ps(dot4(x_x, x_y, x_z, x_x, x_y, x_z));
-    const __m128 cos_delta = _mm_min_ps(
+    const __m128 cos_delta = glsl_min(
         _mm_add_ps(_mm_add_ps(_mm_mul_ps(cos_r, cos_c), _mm_mul_ps(sin_r, sin_c)), _mm_set1_ps(Kernel::kCosineAbsSlack)),
         one);
-    const __m128 narrowed = _mm_min_ps(
-        _mm_mul_ps(_mm_sqrt_ps(_mm_max_ps(_mm_add_ps(half, _mm_mul_ps(half, cos_delta)), zero)),
+    const __m128 narrowed = glsl_min(
+        _mm_mul_ps(_mm_sqrt_ps(glsl_max(_mm_add_ps(half, _mm_mul_ps(half, cos_delta)), zero)),
                    _mm_set1_ps(Kernel::kBoundSlack)),
         one);
     const __m128 wide = _mm_andnot_ps(outside, one);
@@ -247,7 +253,7 @@ void quad_ggx_bounds(const QuadLanes& q, const gpu::LightNode& node, unsigned la
     const __m128 bound = _mm_mul_ps(_mm_div_ps(_mm_mul_ps(d, g1), _mm_mul_ps(_mm_set1_ps(4.0f), cos_o)),
                                     _mm_set1_ps(Kernel::kBoundSlack));
     alignas(16) float out[4];
-    _mm_store_ps(out, _mm_and_ps(bound, _mm_cmpgt_ps(cos_o, zero)));
+    _mm_store_ps(out, _mm_and_ps(bound, _mm_cmpnle_ps(cos_o, zero)));  // lc_ggx_bound: 0 where cos_o <= 0
     for (unsigned p = 0; p < 4u; ++p) ggx[p] = (lanes >> p & 1u) != 0u ? out[p] : 0.0f;
 }
 
@@ -273,28 +279,31 @@ bool quad_errors(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, con
         _mm_add_ps(dot4(q.nx, q.ny, q.nz, c_x, c_y, c_z), ne),
         _mm_mul_ps(_mm_set1_ps(Kernel::kCosineAbsSlack),
                    _mm_add_ps(dot4(q.anx, q.any, q.anz, abs_lanes(c_x), abs_lanes(c_y), abs_lanes(c_z)), ne)));
-    const __m128 near_x = _mm_max_ps(
+    const __m128 near_x = glsl_max(
         _mm_sub_ps(abs_lanes(dot4(q.tx, q.ty, q.tz, c_x, c_y, c_z)), dot4(q.atx, q.aty, q.atz, e_x, e_y, e_z)), zero);
-    const __m128 near_y = _mm_max_ps(
+    const __m128 near_y = glsl_max(
         _mm_sub_ps(abs_lanes(dot4(q.bx, q.by, q.bz, c_x, c_y, c_z)), dot4(q.abx, q.aby, q.abz, e_x, e_y, e_z)), zero);
     const __m128 qq = _mm_add_ps(_mm_add_ps(_mm_mul_ps(near_x, near_x), _mm_mul_ps(near_y, near_y)),
                                  _mm_mul_ps(z_max, z_max));
     const __m128 bound = _mm_mul_ps(z_max, _mm_div_ps(_mm_set1_ps(1.0f), _mm_sqrt_ps(qq)));
-    const __m128 cos_bound = _mm_min_ps(_mm_mul_ps(bound, _mm_set1_ps(Kernel::kBoundSlack)), _mm_set1_ps(1.0f));
-    const __m128 lit = _mm_and_ps(_mm_cmpgt_ps(z_max, zero), q.active);
+    const __m128 cos_bound = glsl_min(_mm_mul_ps(bound, _mm_set1_ps(Kernel::kBoundSlack)), _mm_set1_ps(1.0f));
+    // lc_cosine_bound and lc_cluster_bound return 0 where z_max <= 0 or the
+    // cosine bound <= 0 (a NaN goes on, as there).
+    const __m128 lit = _mm_and_ps(_mm_cmpnle_ps(z_max, zero), q.active);
     alignas(16) float cosines[4];
     _mm_store_ps(cosines, _mm_and_ps(cos_bound, lit));
-    if (_mm_movemask_ps(_mm_cmpgt_ps(_mm_load_ps(cosines), zero)) == 0) {
+    const __m128 positive = _mm_and_ps(_mm_cmpnle_ps(_mm_load_ps(cosines), zero), q.active);
+    if (_mm_movemask_ps(positive) == 0) {
         for (unsigned p = 0; p < 4u; ++p) errors[p] = 0.0f;
         return true;
     }
-    const __m128 d_x = _mm_max_ps(_mm_max_ps(lo_x, _mm_sub_ps(q.px, max_x)), zero);
-    const __m128 d_y = _mm_max_ps(_mm_max_ps(lo_y, _mm_sub_ps(q.py, max_y)), zero);
-    const __m128 d_z = _mm_max_ps(_mm_max_ps(lo_z, _mm_sub_ps(q.pz, max_z)), zero);
+    const __m128 d_x = glsl_max(glsl_max(lo_x, _mm_sub_ps(q.px, max_x)), zero);
+    const __m128 d_y = glsl_max(glsl_max(lo_y, _mm_sub_ps(q.py, max_y)), zero);
+    const __m128 d_z = glsl_max(glsl_max(lo_z, _mm_sub_ps(q.pz, max_z)), zero);
     const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d_x, d_x), _mm_mul_ps(d_y, d_y)), _mm_mul_ps(d_z, d_z));
     const std::uint32_t type = (node.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask;
     const __m128 clamp = _mm_set1_ps(kernel.lc_falloff_clamp2(min_distance2, type));
-    const __m128 factor = _mm_div_ps(_mm_set1_ps(Kernel::kBoundSlack), _mm_max_ps(d2, clamp));
+    const __m128 factor = _mm_div_ps(_mm_set1_ps(Kernel::kBoundSlack), glsl_max(d2, clamp));
     const __m128 cos_over_pi = _mm_div_ps(_mm_load_ps(cosines), _mm_set1_ps(Kernel::kPi));
     __m128 r = _mm_mul_ps(q.kd_r, cos_over_pi);
     __m128 g = _mm_mul_ps(q.kd_g, cos_over_pi);
@@ -303,7 +312,7 @@ bool quad_errors(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, con
         alignas(16) float ks[3][4] = {}, ggx[4] = {};
         unsigned lanes = 0u;
         for (unsigned p = 0; p < 4u; ++p) {
-            if ((q.specular >> p & 1u) == 0u || !(cosines[p] > 0.0f)) continue;
+            if ((q.specular >> p & 1u) == 0u || cosines[p] <= 0.0f) continue;
             lanes |= 1u << p;
             ks[0][p] = sp[p].mat.ks_r;
             ks[1][p] = sp[p].mat.ks_g;
@@ -322,7 +331,7 @@ bool quad_errors(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, con
         _mm_add_ps(_mm_mul_ps(_mm_set1_ps(0.2126f), r), _mm_mul_ps(_mm_set1_ps(0.7152f), g)),
         _mm_mul_ps(_mm_set1_ps(0.0722f), b));
     alignas(16) float out[4];
-    _mm_store_ps(out, _mm_and_ps(error, _mm_cmpgt_ps(_mm_load_ps(cosines), zero)));
+    _mm_store_ps(out, _mm_and_ps(error, positive));
     for (unsigned p = 0; p < 4u; ++p) errors[p] = out[p];
     return true;
 }
@@ -348,11 +357,11 @@ bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp
     const __m128 wx = _mm_div_ps(tx, d), wy = _mm_div_ps(ty, d), wz = _mm_div_ps(tz, d);
     const __m128 length = _mm_mul_ps(d, _mm_set1_ps(1.0f - Kernel::kShadowEndRelative));
     const __m128 factor = _mm_div_ps(
-        _mm_set1_ps(1.0f), _mm_max_ps(d2, _mm_set1_ps(kernel.lc_falloff_clamp2(min_distance2, gpu::kLightPoint))));
+        _mm_set1_ps(1.0f), glsl_max(d2, _mm_set1_ps(kernel.lc_falloff_clamp2(min_distance2, gpu::kLightPoint))));
     const __m128 cos_i = dot4(q.nx, q.ny, q.nz, wx, wy, wz);
     // lc_light_unit's early returns: no direction (d = 0), the light behind
     // the surface, no emission towards it.
-    const __m128 lit = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(d, zero), _mm_cmpgt_ps(cos_i, zero)),
+    const __m128 lit = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(d, zero), _mm_cmpnle_ps(cos_i, zero)),
                                   _mm_and_ps(_mm_cmpgt_ps(factor, zero), q.active));
     const __m128 c = _mm_div_ps(cos_i, _mm_set1_ps(Kernel::kPi));
     alignas(16) float v[9][4];

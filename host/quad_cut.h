@@ -3,19 +3,24 @@
 // refine one cut together: a cluster is split when its error bound exceeds
 // relative_error times the estimate of any of the four, so when refinement
 // stops every cluster of the cut meets Walter's criterion at every one of
-// the points (or the cut reached max_cut). Each point still has its own
-// estimate: its own representative contributions, shadow rays and sums.
-// What the four share is the cut's bookkeeping (one heap, one pass over
-// the tree, one read of each node) instead of doing it four times.
+// the points, except where the cut reached max_cut, clusters frozen out of
+// a full heap, and points held to the floor of update_weights. Each point
+// still has its own estimate: its own representative contributions, shadow
+// rays and sums. What the four share is the cut's bookkeeping (one heap,
+// one pass over the tree, one read of each node) instead of doing it four
+// times.
 //
 // The shared cut is the union of the four points' own refinements, so it
 // is at least as fine as each point's own cut, and costs more shadow rays
-// (about 1.1 times on the shipped room); the bookkeeping it saves costs
-// more than those rays (docs/results/speed.md).
+// (on the room at 128x128, 1.08 times a cut per pixel with a heap the tree
+// cannot fill, 1.19 times one with the per-pixel heap of 64, which freezes
+// more); the bookkeeping it saves costs more than those rays
+// (docs/results/speed.md).
 #pragma once
 
 #include <algorithm>
 #include <cfloat>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -91,15 +96,15 @@ public:
         cut_indirect_ = f_.roots[kLightVpl] != kInvalidIndex ? 1u : 0u;
         frozen_ = 0u;
         hit_max_cut_ = 0u;
-        root_bounds_ = 0.0f;
+        root_bounds_ = 0.0;
         for (uint type = 0u; type < kLightTypeCount; ++type) {
             if (f_.roots[type] == kInvalidIndex) continue;
             const LightNode& root = k_.light_nodes[f_.roots[type]];
             const uint slot = free_[--free_count_];
             QuadEntry& e = entries_[slot];
             e.node = f_.roots[type];
+            errors(root, e.error);
             for (uint p = 0; p < kQuadLanes; ++p) {
-                e.error[p] = lane(p) ? k_.lc_cluster_error(sp_[p], sp_[p].mat, root, f_.min_distance2) : 0.0f;
                 e.unit[p] = vec3(0.0f);
                 if (lane(p) && k_.lc_cluster_needs_unit(root, e.error[p])) {
                     bool visible;
@@ -107,7 +112,7 @@ public:
                 }
             }
             for (uint p = 0; p < kQuadLanes; ++p)
-                if (e.error[p] > 0.0f) root_bounds_ += e.error[p];
+                if (e.error[p] > 0.0f && std::isfinite(e.error[p])) root_bounds_ += double(e.error[p]);
             if (enter(root, e)) {
                 update_weights();
                 push(key_of(e), slot);
@@ -174,16 +179,20 @@ private:
     // instead of to Walter's bound > 0. The floor scales with the lights,
     // so scaling every light by a power of two leaves the keys, and so the
     // cuts, unchanged.
+    // (The sum is taken in double and the floor kept within the normal
+    // floats: a sum past the float range, or one whose 2^-20 underflows,
+    // still gives weights that order and test the bounds. A point whose
+    // estimate is not finite adds nothing to the sum.)
     void update_weights() {
         float estimate[kQuadLanes];
-        float total = 0.0f;
+        double total = 0.0;
         for (uint p = 0; p < kQuadLanes; ++p) {
             estimate[p] = lc_luminance(fixed_[p] + heap_sum_[p]);
-            total += std::max(estimate[p], 0.0f);
+            if (estimate[p] > 0.0f && std::isfinite(estimate[p])) total += double(estimate[p]);
         }
-        const float floor = (total > 0.0f ? total : root_bounds_) * 0x1p-20f;
-        for (uint p = 0; p < kQuadLanes; ++p)
-            weight_[p] = floor > 0.0f ? 1.0f / std::max(estimate[p], floor) : 1.0f;
+        if (!(total > 0.0)) total = root_bounds_;
+        const float floor = float(std::clamp(total * 0x1p-20, double(FLT_MIN), double(FLT_MAX)));
+        for (uint p = 0; p < kQuadLanes; ++p) weight_[p] = 1.0f / std::max(estimate[p], floor);
     }
     // A cluster's key in the heap: its largest ratio of bound to estimate
     // over the points, at most FLT_MAX. A NaN bound is passed over, as
@@ -287,6 +296,11 @@ private:
 
     // lc_cluster_error of `node` at the four points (zero at inactive ones).
     void errors(const LightNode& node, float* out) {
+        if (Kernel::tightest_bound) {  // benchmarks only (host/cpu_kernel.h)
+            for (uint p = 0; p < kQuadLanes; ++p)
+                out[p] = lane(p) ? k_.tightest_error(sp_[p], node, f_.min_distance2) : 0.0f;
+            return;
+        }
 #if defined(__SSE2__)
         if (quad_errors(k_, lanes_, sp_, node, f_.min_distance2, out)) return;
 #endif
@@ -380,7 +394,7 @@ private:
     vec3 heap_sum_[kQuadLanes];  // ... and the running sum of the heap's
     float weight_[kQuadLanes];   // update_weights
     float frozen_error_[kQuadLanes];
-    float root_bounds_ = 0.0f;  // the roots' bounds summed over the points (update_weights)
+    double root_bounds_ = 0.0;  // the roots' finite bounds summed over the points (update_weights)
     uint cut_size_ = 0u, cut_indirect_ = 0u, frozen_ = 0u, hit_max_cut_ = 0u;
 };
 

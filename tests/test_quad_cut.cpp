@@ -28,10 +28,13 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
     Kernel k;
     k.materials = materials.data();  // lc_make_surface's; each point's own is set after it
     k.vpl_min_distance2 = 0.01f;
-    int trials = 0, covered = 0, nonzero = 0;
+    int trials = 0, covered = 0, checked = 0, nonzero = 0;
     for (int trial = 0; trial < 40000; ++trial) {
         const glm::vec3 centre = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 4.0f;
-        const glm::vec3 half = glm::vec3(u(rng), u(rng), u(rng)) * (u(rng) < 0.2f ? 0.0f : 0.7f);
+        // Some boxes past the float range's middle, whose arithmetic gives
+        // infinities and NaNs: those must come out as the scalar code's too.
+        const float size = trial % 50 == 0 ? 3e38f : u(rng) < 0.2f ? 0.0f : 0.7f;
+        const glm::vec3 half = glm::vec3(u(rng), u(rng), u(rng)) * size;
         const float pick = u(rng);
         const std::uint32_t type = pick < 0.7f   ? gpu::kLightPoint
                                    : pick < 0.8f ? gpu::kLightVpl
@@ -73,14 +76,16 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
                 continue;
             }
             const float scalar = k.lc_cluster_error(sp[p], sp[p].mat, node, min_distance2);
+            ++checked;
             nonzero += scalar > 0.0f ? 1 : 0;
-            // Bit for bit: the same float, not merely close.
-            ASSERT_EQ(errors[p], scalar) << "trial " << trial << " lane " << p;
+            // Bit for bit: the same float (or both NaN), not merely close.
+            ASSERT_TRUE(errors[p] == scalar || (std::isnan(errors[p]) && std::isnan(scalar)))
+                << "trial " << trial << " lane " << p << ": " << errors[p] << " against " << scalar;
         }
     }
 #if defined(__SSE2__)
     EXPECT_GT(covered, trials / 2);
-    EXPECT_GT(nonzero, covered / 2);
+    EXPECT_GT(nonzero, checked / 3);
 #endif
 }
 
@@ -96,7 +101,7 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
     const std::vector<gpu::Material> materials = {test::lambert(glm::vec3(0.5f))};
     Kernel k;
     k.materials = materials.data();
-    int covered = 0, lit = 0, trials = 0;
+    int covered = 0, lanes = 0, lit = 0, trials = 0;
     for (int trial = 0; trial < 40000; ++trial) {
         const glm::vec3 at = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 4.0f;
         const gpu::Light light = trial % 9 == 0
@@ -137,6 +142,7 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
             glm::vec3 scalar_wi;
             float scalar_t_max;
             const glm::vec3 scalar = k.lc_light_unit(sp[p], light, min_distance2, scalar_wi, scalar_t_max);
+            ++lanes;
             ASSERT_EQ(unit[p], scalar) << "trial " << trial << " lane " << p;
             if (!(scalar.x + scalar.y + scalar.z > 0.0f)) continue;
             ++lit;
@@ -146,7 +152,7 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
     }
 #if defined(__SSE2__)
     EXPECT_GT(covered, trials / 2);
-    EXPECT_GT(lit, covered / 2);
+    EXPECT_GT(lit, lanes / 5);
 #endif
 }
 
@@ -195,6 +201,54 @@ TEST(QuadCut, EveryClusterMeetsTheCriterionAtEveryPoint) {
     EXPECT_GT(checked, 1000u);
 }
 
+// What the stress tests check of a cut per pixel, for quads: at each point
+// the error of the result against brute force is at most the sum of the
+// bounds of the cut's clusters there, those left in the heap and those
+// frozen out of it (each cluster's true contribution and its estimate both
+// lie between 0 and its bound). With heaps of 4 and 12 slots, which freeze
+// at almost every quad, and two trees (point and directional lights), so
+// two roots. The sums of floats are allowed 1e-4 of the bound.
+TEST(QuadCut, ErrorIsWithinTheCutsBoundsAtEveryPoint) {
+    std::vector<gpu::Light> lights = test::random_point_lights(300, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 6);
+    lights.push_back(test::directional_light({0.3f, -1.0f, 0.2f}, glm::vec3(0.5f)));
+    lights.push_back(test::directional_light({-0.4f, -1.0f, -0.1f}, glm::vec3(0.3f)));
+    PreparedScene p = prepare_scene(test::room_scene(std::move(lights), 12), 1);
+    const gpu::FrameParams f = make_frame_params(p, test::options("lightcuts", 12));
+    cpu::CutHeap brute_heap(1);
+    Kernel k = cpu::make_shade_kernel(p, &brute_heap);
+    std::size_t points = 0, froze = 0;
+    for (std::uint32_t slots : {4u, 12u}) {
+        cpu::QuadHeap heap(slots);
+        cpu::QuadCut<Kernel> quad(k, heap, f);
+        for (std::uint32_t y = 0; y < 12; y += 2)
+            for (std::uint32_t x = 0; x < 12; x += 2) {
+                Kernel::SurfacePoint sp[4];
+                unsigned active = 0u;
+                for (std::uint32_t q = 0; q < 4u; ++q)
+                    if (k.lc_camera_hit(f, x + (q & 1u), y + (q >> 1u), 0, sp[q])) active |= 1u << q;
+                glm::vec3 radiance[4];
+                Kernel::ShadeStats stats[4];
+                quad.shade(sp, active, radiance, stats);
+                for (std::uint32_t q = 0; q < 4u; ++q) {
+                    if ((active >> q & 1u) == 0u) continue;
+                    double bounds = stats[q].frozen_error;
+                    for (std::uint32_t i = 0; i < quad.heap_size(); ++i)
+                        bounds += heap.entries()[heap.slot()[i]].error[q];
+                    Kernel::ShadeStats ss{};
+                    const glm::vec3 exact = k.lc_shade_brute(sp[q], f.light_count, f.min_distance2, ss);
+                    const double error = std::abs(double(gpu::lc_luminance(radiance[q])) -
+                                                  double(gpu::lc_luminance(exact)));
+                    ASSERT_LE(error, bounds * (1.0 + 1e-4) + 1e-12)
+                        << slots << " slots, quad " << x << "," << y << " point " << q;
+                    ++points;
+                    froze += stats[q].frozen > 0u ? 1u : 0u;
+                }
+            }
+    }
+    EXPECT_EQ(points, 2u * 144u);
+    EXPECT_GT(froze, points / 2);
+}
+
 // A floor seen at an angle, with the sky above the horizon: quads whose
 // camera rays partly miss, on an image whose odd sides cut the last column
 // and row of quads in half. With relative_error 0 and a heap as large as
@@ -234,19 +288,21 @@ TEST(QuadCut, PartialQuadsAndMissedPixelsAreShaded) {
 
 // Each pixel's cut alone, or the quad's: a render names the one it made.
 TEST(QuadCut, CutSharingSettingPicksThePath) {
-    Scene s = test::room_scene(test::random_point_lights(100, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 2), 8);
+    // 400 lights: 399 interior nodes, more than a quad's 4 x 64 slots.
+    Scene s = test::room_scene(test::random_point_lights(400, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 2), 8);
     PreparedScene p = prepare_scene(std::move(s), 1);
+    ASSERT_GT(p.tree.cut_heap_capacity(1000), 4 * kDefaultCutHeap);
     RenderOptions o = test::options("lightcuts", 8);
     EXPECT_EQ(o.cut_sharing, "auto");
     EXPECT_TRUE(render_cpu(p, o).stats.quad_cuts);
     o.cut_sharing = "pixel";
     const RenderResult pixel = render_cpu(p, o);
     EXPECT_FALSE(pixel.stats.quad_cuts);
-    EXPECT_EQ(pixel.stats.heap_slots, std::min(kDefaultCutHeap, p.tree.cut_heap_capacity(o.max_cut)));
+    EXPECT_EQ(pixel.stats.heap_slots, kDefaultCutHeap);
     o.cut_sharing = "quad";
     const RenderResult quad = render_cpu(p, o);
     EXPECT_TRUE(quad.stats.quad_cuts);
-    EXPECT_EQ(quad.stats.heap_slots, std::min(4 * kDefaultCutHeap, p.tree.cut_heap_capacity(o.max_cut)));
+    EXPECT_EQ(quad.stats.heap_slots, 4 * kDefaultCutHeap);
     o.method = "stochastic";  // cuts each pixel alone
     EXPECT_FALSE(render_cpu(p, o).stats.quad_cuts);
     o.method = "lightcuts";

@@ -69,7 +69,8 @@ struct RenderOptions {
     float relative_error = 0.02f;
     std::uint32_t max_cut = 1000;
     std::uint32_t cut_heap = kDefaultCutHeap;  // lightcuts: cut-heap capacity K per shaded point
-                                               // (per quad where quads share cuts)
+                                               // (where quads share cuts, a quad's heap pools its
+                                               // four points' K slots)
     std::string cut_sharing = "auto";  // lightcuts: "pixel", "quad" (CPU only) or "auto"
                                        // (cut_sharing_problem, lightcuts/settings.h)
     std::uint32_t seed = 1;
@@ -94,7 +95,8 @@ struct RenderStats {
     bool quad_cuts = false;                 // lightcuts: 2x2 quads of pixels shared each cut
                                             // (cut_sharing; then the heap is a quad's)
     std::uint32_t heap_slots = 0;           // lightcuts: cut-heap slots per shaded point (GPU: in
-                                            // shared memory), min(cut_heap, what the tree can fill)
+                                            // shared memory), min(cut_heap, what the tree can fill);
+                                            // per quad where quad_cuts: min(4 cut_heap, ...)
     std::uint64_t heap_frozen_samples = 0;  // lightcuts: samples whose cut froze clusters out of a
                                             // full heap
     std::uint64_t heap_paused_samples = 0;  // GPU: samples whose heap waited in global memory

@@ -30,7 +30,8 @@ struct LightcutsReport {
     bool quad_cuts = false;                   // CPU: the pixels of each 2x2 quad shared a cut (and a
                                               // heap); cut sizes are then the quads' (cut_sharing)
     std::uint32_t heap_slots = 0;             // slots a heap gets: K, or less where the tree
-                                              // cannot fill K (GPU: in shared memory)
+                                              // cannot fill K (GPU: in shared memory); a quad's
+                                              // heap (quad_cuts): 4K, or less
     std::uint64_t heap_bytes = 0;             // GPU: shared memory the heaps of a workgroup take
     bool heap_private = false;                // GPU: each heap in its invocation's private memory instead
     std::uint32_t workgroup_size = 0;         // GPU: invocations per workgroup
