@@ -16,6 +16,21 @@ namespace {
 
 using Kernel = cpu::ShadeKernel;
 
+// A shaded point at x with a random normal, a view direction on its side
+// and a random material: Lambert, or GGX of roughness down to 10^-3, made
+// Disney where asked. `k` needs a material array (lc_make_surface's).
+Kernel::SurfacePoint random_point(Kernel& k, std::mt19937& rng, glm::vec3 x, bool disney) {
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const glm::vec3 n = test::random_unit(rng);
+    glm::vec3 wo = test::random_unit(rng);
+    if (glm::dot(wo, n) < 0.0f) wo = -wo;
+    Kernel::SurfacePoint s = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f));
+    const glm::vec3 kd(u(rng), u(rng), u(rng)), ks(u(rng), u(rng), u(rng));
+    s.mat = u(rng) < 0.5f ? test::lambert(kd) : test::glossy(kd, ks, std::pow(10.0f, -3.0f * u(rng)));
+    if (disney) s.mat.flags |= gpu::kMaterialDisney;
+    return s;
+}
+
 // Over random clusters (points, VPLs, oriented and directional ones,
 // leaves) and quads of random points with random materials (Lambert, GGX,
 // Disney) and random active lanes, quad_errors gives lc_cluster_error's
@@ -50,14 +65,7 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
         for (Kernel::SurfacePoint& s : sp) {
             glm::vec3 x = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 6.0f;
             if (u(rng) < 0.1f) x = glm::vec3(node.min_x, node.min_y + 0.5f * (node.max_y - node.min_y), node.max_z);
-            const glm::vec3 n = test::random_unit(rng);
-            glm::vec3 wo = test::random_unit(rng);
-            if (glm::dot(wo, n) < 0.0f) wo = -wo;
-            s = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f));
-            const glm::vec3 kd(u(rng), u(rng), u(rng));
-            const glm::vec3 ks(u(rng), u(rng), u(rng));
-            s.mat = u(rng) < 0.5f ? test::lambert(kd) : test::glossy(kd, ks, std::pow(10.0f, -3.0f * u(rng)));
-            if (disney) s.mat.flags |= gpu::kMaterialDisney;
+            s = random_point(k, rng, x, disney);
         }
         const float min_distance2 = u(rng) < 0.5f ? 1e-8f : 0.05f;
         float errors[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
@@ -114,13 +122,7 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
             // Some points on the light itself (no direction), some close.
             const float spread = u(rng) < 0.3f ? 0.01f : 6.0f;
             const glm::vec3 x = u(rng) < 0.02f ? at : at + (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * spread;
-            glm::vec3 wo = test::random_unit(rng);
-            const glm::vec3 n = test::random_unit(rng);
-            if (glm::dot(wo, n) < 0.0f) wo = -wo;
-            s = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f));
-            const glm::vec3 kd(u(rng), u(rng), u(rng)), ks(u(rng), u(rng), u(rng));
-            s.mat = u(rng) < 0.5f ? test::lambert(kd) : test::glossy(kd, ks, std::pow(10.0f, -3.0f * u(rng)));
-            if (disney) s.mat.flags |= gpu::kMaterialDisney;
+            s = random_point(k, rng, x, disney);
         }
         const float min_distance2 = u(rng) < 0.5f ? 1e-8f : 0.05f;
         glm::vec3 unit[4], wi[4];
