@@ -2,9 +2,12 @@
 # Scale: a room of COUNT point lights (default 10^7) rendered on the CPU path
 # and through Vulkan on lavapipe, at SIZE x SIZE (default 128) with the
 # scene's settings otherwise (lightcuts, 1 spp, 2% error, max cut 1000).
-# Prints, per device: loading the light file, building the light tree, the
+# Prints, per render (the CPU at its defaults, the CPU cutting each pixel
+# alone, Vulkan): loading the light file, building the light tree, the
 # render, the peak resident memory of the process, and the buffer sizes that
-# grow with the light count; then the difference between the two images.
+# grow with the light count; then the difference between the Vulkan image
+# and the CPU's with a cut per pixel, which is the same image up to rounding
+# (the CPU's default shares each cut between the pixels of a 2x2 quad).
 # docs/results/scale.md has the figures and how to read them.
 #
 # The light file (586 MB at 10^7) is made once with scripts/gen_lights.py
@@ -45,13 +48,16 @@ PY
 VK_DRIVER_FILES="$lvp" "$exe" render "$scene" -o "$out/warm-up.exr" --device vulkan --width 8 --height 8 \
   --no-png >/dev/null 2>&1 || true
 rm -f "$out/warm-up.exr"
-for device in cpu vulkan; do
+for run in cpu cpu_pixel vulkan; do
+  device="${run%_pixel}"
   env=()
+  args=()
   [ "$device" = vulkan ] && env=(VK_DRIVER_FILES="$lvp")
+  [ "$run" = cpu_pixel ] && args=(--cut-sharing pixel)
   env "${env[@]}" /usr/bin/time -f "peak resident memory %M KiB, wall %e s, user %U s, sys %S s" \
-    "$exe" render "$scene" -o "$out/$device.exr" --device "$device" --width "$size" --height "$size" \
-    --stats "$out/$device.json" 2>&1 | grep -v '^\s*$'
-  python3 - "$out/$device.json" "$count" <<'PY'
+    "$exe" render "$scene" -o "$out/$run.exr" --device "$device" --width "$size" --height "$size" \
+    --stats "$out/$run.json" "${args[@]}" 2>&1 | grep -v '^\s*$'
+  python3 - "$out/$run.json" "$count" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1])); n = int(sys.argv[2]); sec = s["seconds"]
 print(f"  load {sec['load']:.2f} s, light tree {sec['light_tree_build']:.2f} s, render {sec['render']:.2f} s")
@@ -61,4 +67,4 @@ print(f"  lights {b.get('lights', 0) / 2**20:.1f} MiB + light-tree nodes {b.get(
       f" = {per_light / n:.1f} bytes per light; all buffers {sum(b.values()) / 2**20:.1f} MiB")
 PY
 done
-"$exe" compare "$out/vulkan.exr" "$out/cpu.exr"
+"$exe" compare "$out/vulkan.exr" "$out/cpu_pixel.exr"
