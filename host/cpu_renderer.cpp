@@ -66,6 +66,16 @@ glm::vec3 shade_point(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Method
     return k.lc_shade_brute_packets(sp, frame.light_count, frame.min_distance2, ss);
 }
 
+// Adds one camera sample's shading stats to the worker's counters; true if
+// its cut froze clusters.
+bool tally(Worker& t, const cpu::ShadeKernel::ShadeStats& ss) {
+    t.shadow_rays += ss.shadow_rays;
+    t.max_cut_hits += ss.hit_max_cut;
+    t.cut_indirect += ss.cut_indirect;
+    t.frozen_samples += ss.frozen > 0u ? 1u : 0u;
+    return ss.frozen > 0u;
+}
+
 PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Method method, std::uint32_t x,
                         std::uint32_t y, Worker& t) {
     glm::vec3 sum(0.0f);
@@ -80,11 +90,7 @@ PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Meth
         cpu::ShadeKernel::ShadeStats ss{};
         sum += shade_point(k, frame, method, sp, k.lc_sample_stream(frame.seed, x, y, s), ss);
         cut_sum += ss.cut_size;
-        t.shadow_rays += ss.shadow_rays;
-        t.max_cut_hits += ss.hit_max_cut;
-        t.cut_indirect += ss.cut_indirect;
-        t.frozen_samples += ss.frozen > 0u ? 1u : 0u;
-        froze += ss.frozen > 0u ? 1u : 0u;
+        froze += tally(t, ss) ? 1u : 0u;
     }
     return {sum / float(frame.spp), float(double(cut_sum) / frame.spp), float(double(froze) / frame.spp)};
 }
@@ -115,11 +121,7 @@ void shade_quad(cpu::ShadeKernel& k, const gpu::FrameParams& frame, std::uint32_
             if ((active >> q & 1u) == 0u) continue;
             sum[q] += radiance[q];
             cut_sum[q] += ss[q].cut_size;
-            t.shadow_rays += ss[q].shadow_rays;
-            t.max_cut_hits += ss[q].hit_max_cut;
-            t.cut_indirect += ss[q].cut_indirect;
-            t.frozen_samples += ss[q].frozen > 0u ? 1u : 0u;
-            froze[q] += ss[q].frozen > 0u ? 1u : 0u;
+            froze[q] += tally(t, ss[q]) ? 1u : 0u;
         }
     }
     for (std::uint32_t q = 0; q < 4u; ++q)
@@ -161,9 +163,10 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     const bool quads = cpu_shares_cuts(options.method, options.cut_sharing);
     // A quad's heap pools its four points' K slots: the same number of
     // slots per point (a quad's slot holds the four points' bounds and
-    // contributions, 76 bytes against a point's 20). (With K slots a quad, the union of four points' refinements
-    // froze far more: on the stress tests' million lights the error against
-    // brute force was 0.0259 against a cut per pixel's 0.0169; pooled, 0.0140.)
+    // contributions, 76 bytes against a point's 20). With K slots a quad,
+    // the union of four points' refinements froze far more: on the stress
+    // tests' million lights the error against brute force was 0.0259,
+    // against a cut per pixel's 0.0169; pooled, 0.0140.
     const std::uint32_t heap_slots = prepared.tree.cut_heap_slots(
         frame.max_cut, quads ? std::uint32_t(std::min<std::uint64_t>(std::uint64_t(cpu::kQuadLanes) * options.cut_heap,
                                                                      std::numeric_limits<std::uint32_t>::max()))
@@ -175,6 +178,12 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     std::atomic<std::uint32_t> tiles_done{0};
     Progress progress(options.progress);
 
+    const auto store = [&](std::uint32_t x, std::uint32_t y, const PixelResult& px) {
+        result.image.set(x, y, px.radiance);
+        if (!lightcuts) return;
+        stats.cut_size[std::size_t(y) * frame.width + x] = px.cut_size;
+        stats.heap_froze[std::size_t(y) * frame.width + x] = px.heap_froze;
+    };
     for_each_tile(tile_count, workers, [&](std::uint32_t tile, Worker& t) {
         cpu::ShadeKernel k = cpu::make_shade_kernel(prepared, &t.heap);
         const std::uint32_t x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
@@ -185,24 +194,15 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
                     shade_quad(k, frame, x, y, t, px);
                     for (std::uint32_t q = 0; q < 4u; ++q) {
                         const std::uint32_t qx = x + (q & 1u), qy = y + (q >> 1u);
-                        if (qx >= frame.width || qy >= frame.height) continue;
-                        result.image.set(qx, qy, px[q].radiance);
-                        stats.cut_size[std::size_t(qy) * frame.width + qx] = px[q].cut_size;
-                        stats.heap_froze[std::size_t(qy) * frame.width + qx] = px[q].heap_froze;
+                        if (qx < frame.width && qy < frame.height) store(qx, qy, px[q]);
                     }
                 }
             progress.update(double(tiles_done.fetch_add(1) + 1) / tile_count);
             return;
         }
         for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); ++y)
-            for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); ++x) {
-                const PixelResult px = shade_pixel(k, frame, method, x, y, t);
-                result.image.set(x, y, px.radiance);
-                if (lightcuts) {
-                    stats.cut_size[std::size_t(y) * frame.width + x] = px.cut_size;
-                    stats.heap_froze[std::size_t(y) * frame.width + x] = px.heap_froze;
-                }
-            }
+            for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); ++x)
+                store(x, y, shade_pixel(k, frame, method, x, y, t));
         progress.update(double(tiles_done.fetch_add(1) + 1) / tile_count);
     });
     progress.finish();

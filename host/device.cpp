@@ -26,8 +26,8 @@ RenderResult render(const PreparedScene& prepared, const RenderOptions& options,
     if (choice.device == "cpu") return render_cpu(prepared, options);
     if (choice.device == "vulkan") return render_vulkan(prepared, options, choice.vulkan);
 
-    // auto: the path tracer and quad-shared cuts run on the CPU only. Otherwise a named device is
-    // always tried, and only real GPU hardware
+    // auto: the path tracer and quad-shared cuts run on the CPU only.
+    // Otherwise a named device is always tried, and only real GPU hardware
     // beats the CPU path (lavapipe on the same cores is several times slower).
     if (options.method == "path") return render_cpu(prepared, options);
     if (options.method == "lightcuts" && options.cut_sharing == "quad") {
