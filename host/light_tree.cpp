@@ -341,33 +341,6 @@ void point_costs(const PointKeys& k, std::size_t i, std::size_t j0, float* cost)
     }
 }
 
-// The nearest partner of smallest cost among an interior cluster's window:
-// cost[kWindow - d] is the cost of partner i - d, cost[kWindow + d] that of
-// i + d (cost[kWindow] is not read). Ties go as in best_partner. Returns
-// kInvalidIndex if no cost is below infinity (all NaN or infinite).
-std::size_t nearest_smallest(const float* cost, std::size_t i) {
-    constexpr float inf = std::numeric_limits<float>::infinity();
-    // The smallest in 4 lanes (vector minimums), then across them; NaN
-    // never wins a comparison, so it is never the smallest.
-    float lane[4] = {inf, inf, inf, inf};
-    for (std::size_t t = 0; t < 2 * kWindow; t += 4)
-        for (std::size_t l = 0; l < 4; ++l) {
-            const float c = cost[t + (t >= std::size_t(kWindow) ? 1 : 0) + l];
-            lane[l] = c < lane[l] ? c : lane[l];
-        }
-    const float smallest = std::min(std::min(lane[0], lane[1]), std::min(lane[2], lane[3]));
-    if (!(smallest < inf)) return gpu::kInvalidIndex;
-    // The nearest partner of that cost; both sides at the same distance:
-    // the tie rule of best_partner.
-    for (std::size_t d = 1; d <= std::size_t(kWindow); ++d) {
-        const bool left = cost[kWindow - d] == smallest;
-        const bool right = cost[kWindow + d] == smallest;
-        if (left && right) return (i / d) % 2 == 0 ? i + d : i - d;
-        if (left || right) return right ? i + d : i - d;
-    }
-    return gpu::kInvalidIndex;  // not reached: some cost equals the smallest
-}
-
 // best_partner for a cluster within kWindow of either end of the keys,
 // over PointKeys, with the costs in float; also for interior clusters
 // whose window holds no finite cost.
@@ -398,38 +371,94 @@ std::size_t best_partner_points_edge(const PointKeys& k, std::size_t i) {
     return best_j;
 }
 
+// Walter 2005 §4.1 without the cone term, in float, for the clusters
+// [i, i + count) and each one's d-th successor: out[t] for cluster i + t.
+// (The restrict-qualified copies of the arrays let the compiler vectorize.)
+void successor_costs(const PointKeys& k, std::size_t i, std::size_t count, std::size_t d, float* __restrict out) {
+    const float* __restrict lx = k.lo_x.data() + i;
+    const float* __restrict ly = k.lo_y.data() + i;
+    const float* __restrict lz = k.lo_z.data() + i;
+    const float* __restrict hx = k.hi_x.data() + i;
+    const float* __restrict hy = k.hi_y.data() + i;
+    const float* __restrict hz = k.hi_z.data() + i;
+    const float* __restrict wt = k.weight.data() + i;
+    for (std::size_t t = 0; t < count; ++t) {
+        const float dx = std::max(hx[t], hx[t + d]) - std::min(lx[t], lx[t + d]);
+        const float dy = std::max(hy[t], hy[t + d]) - std::min(ly[t], ly[t + d]);
+        const float dz = std::max(hz[t], hz[t + d]) - std::min(lz[t], lz[t + d]);
+        out[t] = (wt[t] + wt[t + d]) * (dx * dx + dy * dy + dz * dz);
+    }
+}
+
 // best_partner for trees without a cone term, over PointKeys, for the
 // clusters [begin, end): the same choices, tie rule included, with the
 // costs in float. The metric is symmetric to the last bit (max, min and
 // the weights' sum do not depend on the order of their operands, except
 // for the sign of a zero difference, which squaring drops), so each pair's
-// cost is computed once: row r of `ahead` holds the costs of cluster
-// r0 + r to its kWindow successors (vectorized), and a cluster's costs to
-// its predecessors are read from theirs.
+// cost is computed once. The work runs over blocks of clusters, and each
+// step over a block's clusters at once, in vector instructions: row d of
+// `ahead` holds the costs of the clusters from r0 on to their d-th
+// successors; a cluster's smallest cost is the smallest of its row entries
+// and of its predecessors' entries that name it; then bit d - 1 of its
+// masks says which of the partners at distance d have that cost.
 void best_partners_points(const PointKeys& k, std::uint32_t* best, std::size_t begin, std::size_t end) {
-    const std::size_t n = k.weight.size();
-    constexpr std::size_t kBlock = 256;  // rows of `ahead` stay in the L1 cache
+    constexpr float inf = std::numeric_limits<float>::infinity();
     constexpr std::size_t w = kWindow;
-    static thread_local std::vector<float> ahead;
-    ahead.resize((kBlock + w) * w);
+    constexpr std::size_t kBlock = 256;         // a block's rows stay in the L1 cache
+    constexpr std::size_t kRow = kBlock + w;    // clusters b0 - w .. b1 - 1
+    static_assert(kWindow <= 32, "a 32-bit mask per side");
+    const std::size_t n = k.weight.size();
+    alignas(64) static thread_local float ahead[w][kRow];
+    alignas(64) float smallest[kBlock];
+    alignas(64) std::uint32_t left_mask[kBlock], right_mask[kBlock];
     for (std::size_t b0 = begin; b0 < end; b0 += kBlock) {
         const std::size_t b1 = std::min(end, b0 + kBlock);
-        const std::size_t r0 = b0 >= w ? b0 - w : 0;
-        // Rows of the clusters whose successors' windows are complete.
-        for (std::size_t i = r0; i < b1 && i + w < n; ++i) point_costs<kWindow>(k, i, i + 1, &ahead[(i - r0) * w]);
-        for (std::size_t i = b0; i < b1; ++i) {
-            std::size_t j = gpu::kInvalidIndex;
-            if (i >= w && i + w < n) {
-                float cost[2 * kWindow + 1];
-                for (std::size_t d = 1; d <= w; ++d) {
-                    cost[w + d] = ahead[(i - r0) * w + d - 1];
-                    cost[w - d] = ahead[(i - d - r0) * w + d - 1];
+        // The interior clusters of the block, whose windows are whole.
+        const std::size_t i0 = std::max(b0, w), i1 = std::max(i0, std::min(b1, n - std::min(n, w)));
+        if (i0 < i1) {
+            const std::size_t r0 = i0 - w;  // cluster of each row's first entry
+            for (std::size_t d = 1; d <= w; ++d) successor_costs(k, r0, i1 - r0, d, ahead[d - 1]);
+            const std::size_t m = i1 - i0;
+            for (std::size_t t = 0; t < m; ++t) smallest[t] = inf;
+            // NaN never wins a comparison, so it is never the smallest.
+            for (std::size_t d = 1; d <= w; ++d) {
+                const float* right = ahead[d - 1] + w;    // cost of i0 + t to i0 + t + d
+                const float* left = ahead[d - 1] + w - d;  // cost of i0 + t - d to i0 + t
+                for (std::size_t t = 0; t < m; ++t) {
+                    smallest[t] = left[t] < smallest[t] ? left[t] : smallest[t];
+                    smallest[t] = right[t] < smallest[t] ? right[t] : smallest[t];
                 }
-                j = nearest_smallest(cost, i);
             }
-            if (j == gpu::kInvalidIndex) j = best_partner_points_edge(k, i);
-            best[i] = static_cast<std::uint32_t>(j);
+            for (std::size_t t = 0; t < m; ++t) left_mask[t] = right_mask[t] = 0u;
+            for (std::size_t d = 1; d <= w; ++d) {
+                const float* right = ahead[d - 1] + w;
+                const float* left = ahead[d - 1] + w - d;
+                const std::uint32_t bit = 1u << (d - 1);
+                for (std::size_t t = 0; t < m; ++t) {
+                    left_mask[t] |= left[t] == smallest[t] ? bit : 0u;
+                    right_mask[t] |= right[t] == smallest[t] ? bit : 0u;
+                }
+            }
+            // The nearest partner of that cost; both sides at the same
+            // distance: the tie rule of best_partner.
+            for (std::size_t t = 0; t < m; ++t) {
+                const std::size_t i = i0 + t;
+                const std::uint32_t either = left_mask[t] | right_mask[t];
+                if (!(smallest[t] < inf) || either == 0u) {
+                    best[i] = static_cast<std::uint32_t>(best_partner_points_edge(k, i));
+                    continue;
+                }
+                const std::size_t d = std::size_t(__builtin_ctz(either)) + 1;
+                const bool left = (left_mask[t] >> (d - 1) & 1u) != 0u;
+                const bool right = (right_mask[t] >> (d - 1) & 1u) != 0u;
+                const bool go_right = left && right ? (i / d) % 2 == 0 : right;
+                best[i] = static_cast<std::uint32_t>(go_right ? i + d : i - d);
+            }
         }
+        for (std::size_t i = b0; i < std::min(b1, i0); ++i)
+            best[i] = static_cast<std::uint32_t>(best_partner_points_edge(k, i));
+        for (std::size_t i = std::max(b0, i1); i < b1; ++i)
+            best[i] = static_cast<std::uint32_t>(best_partner_points_edge(k, i));
     }
 }
 
