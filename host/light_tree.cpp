@@ -628,6 +628,12 @@ void flatten(const UninitializedVector<Cluster>& all, std::size_t leaf_count, st
     const std::uint32_t type_bits = type << gpu::kNodeTypeShift;
     // Input light index -> leaf-order index, for the representatives.
     std::vector<std::uint32_t> remap(input.size(), gpu::kInvalidIndex);
+    // Leaf-order light index - base_light -> input light index: the walk
+    // notes each leaf's light, a pass after it copies them (reading a light
+    // where the walk finds its leaf stalled it on a cache miss every leaf,
+    // two thirds of its time for 10^7 lights; the pass reads ahead).
+    UninitializedVector<std::uint32_t> leaf_input;
+    leaf_input.resize(leaf_count);
 
     // A subtree to write: its root's build id and slot, the first slot of
     // the pairs below it and its first light.
@@ -650,7 +656,7 @@ void flatten(const UninitializedVector<Cluster>& all, std::size_t leaf_count, st
         if (c.left == gpu::kInvalidIndex) {
             n.left = gpu::kInvalidIndex;
             n.flags = gpu::kNodeLeaf | node_bits;
-            tree.lights[it.light] = input[c.rep];
+            leaf_input[it.light - base_light] = c.rep;
             remap[c.rep] = it.light;
             return false;
         }
@@ -700,9 +706,16 @@ void flatten(const UninitializedVector<Cluster>& all, std::size_t leaf_count, st
     for (unsigned t = 1; t < threads; ++t) pool.emplace_back(walk);
     walk();
     for (auto& th : pool) th.join();
+    parallel_for(leaf_count, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t l = begin; l < end; ++l) {
+            if (l + 16 < end) __builtin_prefetch(&input[leaf_input[l + 16]]);
+            tree.lights[base_light + l] = input[leaf_input[l]];
+        }
+    });
     const std::size_t slots = 2 * leaf_count - 1;
     parallel_for(slots, [&](std::size_t begin, std::size_t end) {
         for (std::size_t s = begin; s < end; ++s) {
+            if (s + 16 < end) __builtin_prefetch(&remap[tree.nodes[base_slot + s + 16].rep_light]);
             gpu::LightNode& n = tree.nodes[base_slot + s];
             n.rep_light = remap[n.rep_light];
         }
