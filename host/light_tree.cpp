@@ -529,6 +529,13 @@ std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
             std::size_t out = kept_before[t];
             auto id = static_cast<std::uint32_t>(first_id + merged_before[t]);
             for (std::size_t i = begin; i < end; ++i) {
+                // A round's clusters come from all the rounds before it, so
+                // from all over `all`: ask for the records well ahead.
+                if (i + 8 < end) {
+                    const char* ahead = reinterpret_cast<const char*>(&build.all[active[i + 8]]);
+                    __builtin_prefetch(ahead);
+                    __builtin_prefetch(ahead + sizeof(Cluster) - 1);
+                }
                 const std::size_t j = best[i];
                 if (best[j] != i) {
                     next[out] = active[i];
