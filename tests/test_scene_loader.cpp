@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -21,6 +22,7 @@
 #include "lightcuts/scene.h"
 #include "test_util.h"
 #include "lightcuts/settings.h"
+#include "scene/csv_lights.h"
 
 namespace lc {
 namespace {
@@ -970,8 +972,74 @@ const CsvError kCsvErrors[] = {
      "extent along y exceeds the float range (3.4e38)"},
 };
 
+// The reader parses a file in chunks on every core (host/scene/csv_lights.cpp);
+// cut into chunks of a few bytes, each case must fail at the same line
+// with the same message as in one piece.
+TEST_P(PointsCsvError, SameErrorInChunks) {
+    const CsvError& c = GetParam();
+    TempDir dir;
+    const fs::path file = dir.write(std::string(c.name) + ".csv", c.text);
+    const std::string whole = input_error_of([&] { load_points_csv(file); });
+    for (std::size_t chunk_bytes : {1u, 2u, 3u, 5u, 8u, 13u}) {
+        SCOPED_TRACE(chunk_bytes);
+        const std::string chunked = input_error_of([&] {
+            loader::LightLimits limits;
+            loader::read_points_csv(file, limits, chunk_bytes);
+        });
+        EXPECT_EQ(chunked, whole);
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Cases, PointsCsvError, ::testing::ValuesIn(kCsvErrors),
                          [](const ::testing::TestParamInfo<CsvError>& info) { return std::string(info.param.name); });
+
+// Chunks of any size give the lights of the file in its order: a header,
+// comments, blank lines, CRLF, a byte order mark and a last line with no
+// newline, wherever the cuts fall.
+TEST(PointsCsv, SameLightsInChunks) {
+    TempDir dir;
+    std::string text = "\xEF\xBB\xBF# lights\r\n\n  x , y , z , r , g , b\r\n";
+    for (int i = 0; i < 200; ++i) {
+        text += std::to_string(i) + "," + std::to_string(-i) + ",0.5," + std::to_string(i % 7) + ",1,2";
+        text += i % 5 == 0 ? " # a comment\r\n" : "\n";
+        if (i % 11 == 0) text += "\n   \n# x,y,z,r,g,b\n";
+    }
+    text += "9,9,9,1,1,1";  // no newline at the end
+    const fs::path file = dir.write("chunks.csv", text);
+    const std::vector<gpu::Light> whole = load_points_csv(file);
+    ASSERT_EQ(whole.size(), 201u);
+    for (std::size_t chunk_bytes : {1u, 7u, 64u, 1000u}) {
+        SCOPED_TRACE(chunk_bytes);
+        loader::LightLimits limits;
+        const std::vector<gpu::Light> chunked = loader::read_points_csv(file, limits, chunk_bytes);
+        ASSERT_EQ(chunked.size(), whole.size());
+        EXPECT_EQ(std::memcmp(chunked.data(), whole.data(), whole.size() * sizeof(gpu::Light)), 0);
+    }
+    EXPECT_EQ(whole.back().x, 9.0f);
+    EXPECT_EQ(whole[199].y, -199.0f);
+}
+
+// A header-like line anywhere but first is an error at its line, however
+// the file is cut; the error is the first in file order even when a later
+// chunk fails too.
+TEST(PointsCsv, FirstErrorInFileOrderInChunks) {
+    TempDir dir;
+    std::string text = "x,y,z,r,g,b\n";
+    for (int i = 0; i < 50; ++i) text += "1,2,3,4,5,6\n";
+    text += "x,y,z,r,g,b\n";                 // line 52
+    for (int i = 0; i < 50; ++i) text += "1,2,3,4,5,6\n";
+    text += "1,2,3,4,oops,6\n";              // line 103
+    const fs::path file = dir.write("late_header.csv", text);
+    for (std::size_t chunk_bytes : {1u, 12u, 100u, 600u, 1u << 20}) {
+        SCOPED_TRACE(chunk_bytes);
+        const std::string message = input_error_of([&] {
+            loader::LightLimits limits;
+            loader::read_points_csv(file, limits, chunk_bytes);
+        });
+        EXPECT_NE(message.find("line 52: "), std::string::npos) << message;
+        EXPECT_NE(message.find("'x' is not a number"), std::string::npos) << message;
+    }
+}
 
 TEST(PointsCsv, MissingFileIsAnInputError) {
     const std::string message = input_error_of([] { load_points_csv(kFixtures / "nonexistent.csv"); });

@@ -1,14 +1,18 @@
 // The points_csv and spots_csv readers: a hand-written parser over the whole
-// file in memory (10^6 lines in well under a second; docs/scene-format.md).
+// file in memory, its chunks parsed on every core (10^6 lines in well under
+// a second; docs/scene-format.md).
 #include "csv_lights.h"
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <exception>
 #include <string>
 #include <string_view>
+#include <thread>
 
 #include "input_file.h"
 #include "light_records.h"
@@ -141,50 +145,165 @@ gpu::Light make_light(const Format& format, const std::array<float, kMaxColumns>
     return l;
 }
 
-std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::path& file, LightLimits& limits) {
+// A stretch of the file's lines, parsed on its own (read_csv).
+struct Chunk {
+    std::string_view text;             // whole lines
+    std::size_t first_line = 1;        // the line number of its first line
+    std::vector<gpu::Light> lights;    // its lights up to its first error
+    std::size_t first_content = 0;     // line number of its first content line; 0: none
+    bool first_may_be_header = false;  // that line is all non-numbers: not parsed (see read_csv)
+    std::exception_ptr error;          // its first error
+};
+
+// Calls fn(line_number, line) for each content line of the chunk: comments
+// cut off, blanks trimmed, empty lines skipped; stops where fn returns false.
+template <typename Fn>
+void for_each_content_line(const Chunk& chunk, Fn fn) {
+    std::size_t line_number = chunk.first_line;
+    for (std::size_t pos = 0; pos < chunk.text.size(); ++line_number) {
+        std::size_t eol = chunk.text.find('\n', pos);
+        if (eol == std::string_view::npos) eol = chunk.text.size();
+        std::string_view line = chunk.text.substr(pos, eol - pos);
+        pos = eol + 1;
+        if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+        line = trim(line);
+        if (!line.empty() && !fn(line_number, line)) return;
+    }
+}
+
+void parse_chunk(const Format& format, const std::string& name, Chunk& chunk) {
+    // ~30 bytes per point line is typical; reserving avoids regrowth.
+    chunk.lights.reserve(chunk.text.size() / (format.columns * 5) + 1);
+    try {
+        for_each_content_line(chunk, [&](std::size_t line_number, std::string_view line) {
+            const Fields fields = split_fields(line);
+            if (chunk.first_content == 0) {
+                chunk.first_content = line_number;
+                // Only the file's first content line may be a header; which
+                // chunk holds it is known once all are parsed.
+                chunk.first_may_be_header = is_header(fields);
+                if (chunk.first_may_be_header) return true;
+            }
+            chunk.lights.push_back(make_light(format, parse_row(format, fields, name, line_number), name, line_number));
+            return true;
+        });
+    } catch (...) {
+        chunk.error = std::current_exception();
+    }
+}
+
+// The line number of the chunk's light `index` (its lights are its content
+// lines but a skipped header).
+std::size_t line_of_light(const Chunk& chunk, std::size_t index) {
+    std::size_t found = 0;
+    for_each_content_line(chunk, [&](std::size_t line_number, std::string_view) {
+        if (line_number == chunk.first_content && chunk.first_may_be_header) return true;
+        if (index-- == 0) {
+            found = line_number;
+            return false;
+        }
+        return true;
+    });
+    return found;
+}
+
+// Runs fn(i) for i in [0, n) on up to one thread per core.
+template <typename Fn>
+void for_each_index(std::size_t n, Fn fn) {
+    const std::size_t threads = std::min<std::size_t>(n, std::max(1u, std::thread::hardware_concurrency()));
+    std::atomic<std::size_t> next{0};
+    auto work = [&] {
+        for (std::size_t i; (i = next.fetch_add(1)) < n;) fn(i);
+    };
+    std::vector<std::thread> pool;
+    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+    work();
+    for (std::thread& t : pool) t.join();
+}
+
+// The file is cut into chunks of about chunk_bytes at line ends, parsed on
+// every core; then the lights go through `limits` in file order. The first
+// problem in file order is the one reported, as a reading line by line
+// would: a chunk stops at its first error, and the limits are checked only
+// up to the first chunk that stopped.
+std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::path& file, LightLimits& limits,
+                                 std::size_t chunk_bytes) {
     const std::string name = display(file);
     const std::string text = read_input_file(file);
-    std::vector<gpu::Light> lights;
-    // ~30 bytes per point line is typical; reserving avoids regrowth for 10^6 lights.
-    lights.reserve(text.size() / (format.columns * 5) + 1);
-
     std::string_view all(text);
     // A UTF-8 byte order mark (spreadsheets write one) is not part of line 1.
     if (all.substr(0, 3) == "\xEF\xBB\xBF") all.remove_prefix(3);
-    std::size_t line_number = 0;
-    bool seen_content = false;
-    for (std::size_t pos = 0; pos < all.size();) {
-        std::size_t eol = all.find('\n', pos);
-        if (eol == std::string_view::npos) eol = all.size();
-        std::string_view line = all.substr(pos, eol - pos);
-        pos = eol + 1;
-        ++line_number;
 
-        if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-        line = trim(line);
-        if (line.empty()) continue;
-        const Fields fields = split_fields(line);
-        const bool first_content = !seen_content;
-        seen_content = true;
-        if (first_content && is_header(fields)) continue;
-
-        const gpu::Light light = make_light(format, parse_row(format, fields, name, line_number), name, line_number);
-        if (const LightLimits::Problem p = limits.add(light); p.fault != LightLimits::Fault::none) {
-            throw InputError(name, line_field(line_number), p.text);
+    chunk_bytes = std::max<std::size_t>(chunk_bytes, 1);
+    std::vector<Chunk> chunks;
+    for (std::size_t begin = 0; begin < all.size();) {
+        std::size_t end = all.size();
+        if (all.size() - begin > chunk_bytes) {
+            const std::size_t eol = all.find('\n', begin + chunk_bytes - 1);
+            if (eol != std::string_view::npos) end = eol + 1;
         }
-        lights.push_back(light);
+        chunks.emplace_back().text = all.substr(begin, end - begin);
+        begin = end;
     }
+    // Line numbers: each chunk starts after the newlines of those before it.
+    std::vector<std::size_t> newlines(chunks.size());
+    for_each_index(chunks.size(), [&](std::size_t c) {
+        newlines[c] = std::size_t(std::count(chunks[c].text.begin(), chunks[c].text.end(), '\n'));
+    });
+    for (std::size_t c = 1; c < chunks.size(); ++c) chunks[c].first_line = chunks[c - 1].first_line + newlines[c - 1];
+    for_each_index(chunks.size(), [&](std::size_t c) { parse_chunk(format, name, chunks[c]); });
+
+    // A header is only the file's first content line, and only if nothing
+    // in it is a number, so that a typo in the first data line is still an
+    // error. Any other chunk's first line that looked like one is a line of
+    // data that is not a number.
+    bool seen_content = false;
+    for (Chunk& chunk : chunks) {
+        if (chunk.first_content == 0) continue;
+        if (seen_content && chunk.first_may_be_header) {
+            chunk.lights.clear();
+            chunk.first_may_be_header = false;
+            for_each_content_line(chunk, [&](std::size_t line_number, std::string_view line) {
+                try {
+                    parse_row(format, split_fields(line), name, line_number);
+                } catch (...) {
+                    chunk.error = std::current_exception();
+                }
+                return false;
+            });
+        }
+        seen_content = true;
+    }
+
+    std::size_t count = 0;
+    for (const Chunk& chunk : chunks) {
+        for (std::size_t i = 0; i < chunk.lights.size(); ++i) {
+            if (const LightLimits::Problem p = limits.add(chunk.lights[i]); p.fault != LightLimits::Fault::none)
+                throw InputError(name, line_field(line_of_light(chunk, i)), p.text);
+        }
+        if (chunk.error) std::rethrow_exception(chunk.error);
+        count += chunk.lights.size();
+    }
+    std::vector<gpu::Light> lights(count);
+    std::vector<std::size_t> first(chunks.size(), 0);
+    for (std::size_t c = 1; c < chunks.size(); ++c) first[c] = first[c - 1] + chunks[c - 1].lights.size();
+    for_each_index(chunks.size(), [&](std::size_t c) {
+        std::copy(chunks[c].lights.begin(), chunks[c].lights.end(), lights.begin() + std::ptrdiff_t(first[c]));
+        chunks[c].lights = {};
+    });
     return lights;
 }
 
 }  // namespace
 
-std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file, LightLimits& limits) {
-    return read_csv(kPoints, file, limits);
+std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file, LightLimits& limits,
+                                        std::size_t chunk_bytes) {
+    return read_csv(kPoints, file, limits, chunk_bytes);
 }
 
-std::vector<gpu::Light> read_spots_csv(const std::filesystem::path& file, LightLimits& limits) {
-    return read_csv(kSpots, file, limits);
+std::vector<gpu::Light> read_spots_csv(const std::filesystem::path& file, LightLimits& limits,
+                                       std::size_t chunk_bytes) {
+    return read_csv(kSpots, file, limits, chunk_bytes);
 }
 
 }  // namespace loader

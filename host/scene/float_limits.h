@@ -102,6 +102,7 @@ public:
 
 private:
     Box box_;
+    bool box_checked_ = false;  // extent_problem(box_) was "" for this box
     std::array<glm::dvec3, gpu::kLightTypeCount> totals_{};
 };
 
