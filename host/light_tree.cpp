@@ -8,8 +8,8 @@
 // kFast is locally-ordered clustering (Walter et al. 2008; the PLOC variant
 // of Meister and Bittner 2018): clusters sorted along a Morton curve, each
 // picks its best partner within a window of kWindow neighbours each side,
-// mutual best pairs merge, repeat. O(n log n) for the sort plus O(n * window)
-// per round; the rounds shrink geometrically.
+// mutual best pairs merge, repeat. A radix sort of the Morton keys, then
+// O(n * window) per round; the rounds shrink geometrically.
 //
 // kExact is exhaustive greedy: always merge the globally cheapest pair.
 // Each cluster caches its best partner; a merge rescans only the clusters
