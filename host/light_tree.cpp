@@ -298,8 +298,8 @@ std::size_t best_partner(const Build& b, const std::vector<CostKey>& keys, std::
 
 // The boxes and weights of the clusters of a round in Morton order, one
 // array per coordinate, for trees without a cone term: the metric then
-// needs nothing else, and best_partner_points reads a window of partners
-// as contiguous floats that the compiler turns into vector instructions.
+// needs nothing else, and best_partners_points reads the partners of a
+// block of clusters as contiguous floats, in vector instructions.
 struct PointKeys {
     std::vector<float> lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, weight;
     void resize(std::size_t n) {
@@ -320,24 +320,22 @@ struct PointKeys {
     }
 };
 
-// Walter 2005 §4.1 without the cone term, in float, for keys[i] and the
-// partners [j0, j0 + count): cost[k] for partner j0 + k.
-template <std::size_t kCount>
-void point_costs(const PointKeys& k, std::size_t i, std::size_t j0, float* cost) {
-    const float lx = k.lo_x[i], ly = k.lo_y[i], lz = k.lo_z[i];
-    const float hx = k.hi_x[i], hy = k.hi_y[i], hz = k.hi_z[i], w = k.weight[i];
-    const float* __restrict jlx = k.lo_x.data() + j0;
-    const float* __restrict jly = k.lo_y.data() + j0;
-    const float* __restrict jlz = k.lo_z.data() + j0;
-    const float* __restrict jhx = k.hi_x.data() + j0;
-    const float* __restrict jhy = k.hi_y.data() + j0;
-    const float* __restrict jhz = k.hi_z.data() + j0;
-    const float* __restrict jw = k.weight.data() + j0;
-    for (std::size_t t = 0; t < kCount; ++t) {
-        const float dx = std::max(hx, jhx[t]) - std::min(lx, jlx[t]);
-        const float dy = std::max(hy, jhy[t]) - std::min(ly, jly[t]);
-        const float dz = std::max(hz, jhz[t]) - std::min(lz, jlz[t]);
-        cost[t] = (w + jw[t]) * (dx * dx + dy * dy + dz * dz);
+// Walter 2005 §4.1 without the cone term, in float, for the clusters
+// [i, i + count) and each one's d-th successor: out[t] for cluster i + t.
+// (The restrict-qualified copies of the arrays let the compiler vectorize.)
+void successor_costs(const PointKeys& k, std::size_t i, std::size_t count, std::size_t d, float* __restrict out) {
+    const float* __restrict lx = k.lo_x.data() + i;
+    const float* __restrict ly = k.lo_y.data() + i;
+    const float* __restrict lz = k.lo_z.data() + i;
+    const float* __restrict hx = k.hi_x.data() + i;
+    const float* __restrict hy = k.hi_y.data() + i;
+    const float* __restrict hz = k.hi_z.data() + i;
+    const float* __restrict wt = k.weight.data() + i;
+    for (std::size_t t = 0; t < count; ++t) {
+        const float dx = std::max(hx[t], hx[t + d]) - std::min(lx[t], lx[t + d]);
+        const float dy = std::max(hy[t], hy[t + d]) - std::min(ly[t], ly[t + d]);
+        const float dz = std::max(hz[t], hz[t + d]) - std::min(lz[t], lz[t + d]);
+        out[t] = (wt[t] + wt[t + d]) * (dx * dx + dy * dy + dz * dz);
     }
 }
 
@@ -350,7 +348,8 @@ std::size_t best_partner_points_edge(const PointKeys& k, std::size_t i) {
     float cost[2 * kWindow + 1];
     const std::size_t jb = i >= std::size_t(kWindow) ? i - kWindow : 0;
     const std::size_t je = std::min(n, i + kWindow + 1);
-    for (std::size_t j = jb; j < je; ++j) point_costs<1>(k, i, j, cost + (j - jb));
+    for (std::size_t j = jb; j < je; ++j)
+        if (j != i) successor_costs(k, std::min(i, j), 1, j > i ? j - i : i - j, cost + (j - jb));
     cost[i - jb] = inf;
     float smallest = inf;
     for (std::size_t t = 0; t < je - jb; ++t) smallest = cost[t] < smallest ? cost[t] : smallest;
@@ -369,25 +368,6 @@ std::size_t best_partner_points_edge(const PointKeys& k, std::size_t i) {
         best_j = j;
     }
     return best_j;
-}
-
-// Walter 2005 §4.1 without the cone term, in float, for the clusters
-// [i, i + count) and each one's d-th successor: out[t] for cluster i + t.
-// (The restrict-qualified copies of the arrays let the compiler vectorize.)
-void successor_costs(const PointKeys& k, std::size_t i, std::size_t count, std::size_t d, float* __restrict out) {
-    const float* __restrict lx = k.lo_x.data() + i;
-    const float* __restrict ly = k.lo_y.data() + i;
-    const float* __restrict lz = k.lo_z.data() + i;
-    const float* __restrict hx = k.hi_x.data() + i;
-    const float* __restrict hy = k.hi_y.data() + i;
-    const float* __restrict hz = k.hi_z.data() + i;
-    const float* __restrict wt = k.weight.data() + i;
-    for (std::size_t t = 0; t < count; ++t) {
-        const float dx = std::max(hx[t], hx[t + d]) - std::min(lx[t], lx[t + d]);
-        const float dy = std::max(hy[t], hy[t + d]) - std::min(ly[t], ly[t + d]);
-        const float dz = std::max(hz[t], hz[t + d]) - std::min(lz[t], lz[t + d]);
-        out[t] = (wt[t] + wt[t + d]) * (dx * dx + dy * dy + dz * dz);
-    }
 }
 
 // best_partner for trees without a cone term, over PointKeys, for the
