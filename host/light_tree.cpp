@@ -66,30 +66,62 @@ struct Cluster {
     // nor lose the small ones (the loader checks each type's total fits a float).
     glm::dvec3 intensity;
     double weight;         // luminance of intensity, the metric's I_C
-    EmissionCone cone;     // as stored: axis quantized, theta_o widened to match
-    std::uint32_t axis_packed;
     std::uint32_t rep;     // index into the input light array
     std::uint32_t left, right;  // build ids; kInvalidIndex for leaves
     std::uint32_t leaves : 31;  // the lights below (flatten() numbers the nodes by them)
     std::uint32_t rep_from_right : 1;
 };
 static_assert(std::is_trivially_default_constructible_v<Cluster>);
-static_assert(sizeof(Cluster) == 104, "2n clusters of 10^7 lights take 2 GB: keep the record small");
+static_assert(sizeof(Cluster) == 72, "2n clusters of 10^7 lights take 1.4 GB: keep the record small");
+
+// A cluster's emission cone, as stored: axis quantized (axis_packed, as the
+// nodes hold it), theta_o widened to match.
+struct ClusterCone {
+    EmissionCone cone;
+    std::uint32_t axis_packed;
+};
+
+ClusterCone cone_record(const EmissionCone& cone) {
+    ClusterCone c;
+    c.cone = quantized(cone, c.axis_packed);
+    return c;
+}
 
 // One tree in the making: every cluster so far (leaves first) and what the
 // merges need.
 struct Build {
     UninitializedVector<Cluster> all;
+    // The clusters' cones by build id, kept only where some light of the
+    // tree has a cone (spots, oriented lights, VPLs); without, every
+    // cluster's is `everywhere` (the union of cones that emit everywhere
+    // emits everywhere), and the clusters are 30% smaller.
+    UninitializedVector<ClusterCone> cones;
+    ClusterCone everywhere = cone_record(EmissionCone::everywhere());
     std::uint32_t seed = 0;
     // c^2 of the metric's cone term: 0 for lights that emit everywhere.
     double cone_weight = 0.0;
+
+    const ClusterCone& cone(std::uint32_t id) const { return cones.empty() ? everywhere : cones[id]; }
 };
 
+// What merge_cost reads of a cluster. The fast builder gathers these in
+// Morton order every round, so a window of partners is contiguous memory,
+// not clusters scattered over Build::all (gathering cut the build of 10^6 lights
+// from 3.45 s to 2.79 s).
+struct CostKey {
+    glm::vec3 lo, hi;
+    double weight;
+    EmissionCone cone;
+};
+
+CostKey cost_key(const Build& b, std::uint32_t id) {
+    const Cluster& c = b.all[id];
+    return CostKey{c.lo, c.hi, c.weight, b.cone(id).cone};
+}
+
 // Walter 2005 §4.1: I_C * (alpha_C^2 + c^2 (1 - cos beta_C)^2) for the
-// cluster a and b would make.
-// (Cluster, or the CostKey the fast builder gathers: the same fields.)
-template <typename C>
-double merge_cost(const Build& b, const C& x, const C& y) {
+// cluster x and y would make.
+double merge_cost(const Build& b, const CostKey& x, const CostKey& y) {
     glm::dvec3 d = glm::dvec3(glm::max(x.hi, y.hi)) - glm::dvec3(glm::min(x.lo, y.lo));
     double size = glm::dot(d, d);
     if (b.cone_weight > 0.0) {
@@ -114,7 +146,7 @@ void merge_into(Build& build, std::uint32_t a, std::uint32_t b, std::uint32_t id
     c.hi = glm::max(ca.hi, cb.hi);
     c.intensity = ca.intensity + cb.intensity;
     c.weight = ca.weight + cb.weight;
-    c.cone = quantized(cone_union(ca.cone, cb.cone), c.axis_packed);
+    if (!build.cones.empty()) build.cones[id] = cone_record(cone_union(build.cones[a].cone, build.cones[b].cone));
     c.left = a;
     c.right = b;
     double u = gpu::lc_unit_float(gpu::lc_hash(seed ^ gpu::lc_hash(id)));
@@ -128,6 +160,7 @@ void merge_into(Build& build, std::uint32_t a, std::uint32_t b, std::uint32_t id
 void merge(Build& build, std::uint32_t a, std::uint32_t b) {
     const auto id = static_cast<std::uint32_t>(build.all.size());
     build.all.emplace_back();
+    if (!build.cones.empty()) build.cones.emplace_back();
     merge_into(build, a, b, id);
 }
 
@@ -138,7 +171,6 @@ double leaf_weight(const gpu::Light& l) { return gpu::lc_luminance(glm::vec3(l.r
 Cluster leaf_of(const gpu::Light& l, std::size_t index) {
     Cluster c;
     c.lo = c.hi = tree_point(l);
-    c.cone = quantized(EmissionCone::of_light(l), c.axis_packed);
     c.intensity = glm::dvec3(l.r, l.g, l.b);
     c.weight = leaf_weight(l);
     c.rep = std::uint32_t(index);
@@ -249,16 +281,6 @@ void radix_sort(std::vector<std::pair<std::uint64_t, std::uint32_t>>& keyed, int
     }
     if (from != keyed.data()) std::copy(from, from + n, keyed.data());
 }
-
-// What merge_cost reads of a cluster. The fast builder gathers these in
-// Morton order every round, so a window of partners is contiguous memory,
-// not clusters scattered over Build::all (gathering cut the build of 10^6 lights
-// from 3.45 s to 2.79 s).
-struct CostKey {
-    glm::vec3 lo, hi;
-    double weight;
-    EmissionCone cone;
-};
 
 // The cheapest partner of keys[i] within kWindow positions each side.
 //
@@ -467,10 +489,7 @@ std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
         } else {
             keys.resize(n);
             parallel_for(n, [&](std::size_t begin, std::size_t end) {
-                for (std::size_t i = begin; i < end; ++i) {
-                    const Cluster& c = build.all[active[i]];
-                    keys[i] = CostKey{c.lo, c.hi, c.weight, c.cone};
-                }
+                for (std::size_t i = begin; i < end; ++i) keys[i] = cost_key(build, active[i]);
             });
             parallel_for(n, [&](std::size_t begin, std::size_t end) {
                 for (std::size_t i = begin; i < end; ++i)
@@ -503,6 +522,7 @@ std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
         const std::size_t merged = merged_before[threads];
         const auto first_id = static_cast<std::uint32_t>(build.all.size());
         build.all.resize(build.all.size() + merged);
+        if (!build.cones.empty()) build.cones.resize(build.all.size());
         next.resize(kept_before[threads]);
         if (points) next_point_keys.resize(next.size());
         parallel_for_ranges(n, [&](std::size_t begin, std::size_t end, unsigned t) {
@@ -556,7 +576,7 @@ std::uint32_t cluster_exact(Build& build, std::vector<std::uint32_t> active) {
         best_cost[i] = inf;
         for (std::size_t j = 0; j < active.size(); ++j) {
             if (j == i) continue;
-            double c = merge_cost(build, all[active[i]], all[active[j]]);
+            double c = merge_cost(build, cost_key(build, active[i]), cost_key(build, active[j]));
             if (c < best_cost[i]) {
                 best_cost[i] = c;
                 best[i] = static_cast<std::uint32_t>(j);
@@ -587,7 +607,7 @@ std::uint32_t cluster_exact(Build& build, std::vector<std::uint32_t> active) {
             if (best[i] == a || best[i] == b) {
                 rescan(i);
             } else {
-                double c = merge_cost(build, all[active[i]], all[active[a]]);
+                double c = merge_cost(build, cost_key(build, active[i]), cost_key(build, active[a]));
                 if (c < best_cost[i]) {
                     best_cost[i] = c;
                     best[i] = static_cast<std::uint32_t>(a);
@@ -609,9 +629,9 @@ std::uint32_t cluster_exact(Build& build, std::vector<std::uint32_t> active) {
 // takes 2(L - 1) slots below its root and L lights, so its right child's
 // subtree starts 2 L_left slots and L_left lights after its left child's.
 // The top of the tree is cut into subtrees that way, and threads walk them.
-void flatten(const UninitializedVector<Cluster>& all, std::size_t leaf_count, std::span<const gpu::Light> input,
-             std::uint32_t root, std::uint32_t type, std::uint32_t base_slot, std::uint32_t base_light,
-             LightTree& tree) {
+void flatten(const Build& build, std::size_t leaf_count, std::span<const gpu::Light> input, std::uint32_t root,
+             std::uint32_t type, std::uint32_t base_slot, std::uint32_t base_light, LightTree& tree) {
+    const UninitializedVector<Cluster>& all = build.all;
     const std::uint32_t type_bits = type << gpu::kNodeTypeShift;
     // Input light index -> leaf-order index, for the representatives.
     std::vector<std::uint32_t> remap(input.size(), gpu::kInvalidIndex);
@@ -635,11 +655,12 @@ void flatten(const UninitializedVector<Cluster>& all, std::size_t leaf_count, st
         n.intensity_g = float(c.intensity.y);
         n.intensity_b = float(c.intensity.z);
         n.rep_light = c.rep;  // remapped to leaf order below
-        n.axis_oct = c.axis_packed;
-        n.cos_theta_o = c.cone.emits_everywhere() ? -1.0f : std::cos(c.cone.theta_o);
-        n.cos_theta_e = std::cos(c.cone.theta_e);
-        n.falloff_width = c.cone.falloff_width;
-        const std::uint32_t node_bits = type_bits | (c.cone.two_sided ? gpu::kNodeTwoSided : 0u);
+        const ClusterCone& cone = build.cone(it.id);
+        n.axis_oct = cone.axis_packed;
+        n.cos_theta_o = cone.cone.emits_everywhere() ? -1.0f : std::cos(cone.cone.theta_o);
+        n.cos_theta_e = std::cos(cone.cone.theta_e);
+        n.falloff_width = cone.cone.falloff_width;
+        const std::uint32_t node_bits = type_bits | (cone.cone.two_sided ? gpu::kNodeTwoSided : 0u);
         if (c.left == gpu::kInvalidIndex) {
             n.left = gpu::kInvalidIndex;
             n.flags = gpu::kNodeLeaf | node_bits;
@@ -834,8 +855,8 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
                 if (!of_type(lights[i]) || !(leaf_weight(lights[i]) > 0.0)) continue;
                 std::uint64_t key = 0;
                 if (sorted && with_axis) {
-                    const Cluster c = leaf_of(lights[i], i);
-                    key = leaf_key(c.lo, c.cone.axis, lo, extent, true);
+                    key = leaf_key(tree_point(lights[i]), cone_record(EmissionCone::of_light(lights[i])).cone.axis,
+                                   lo, extent, true);
                 } else if (sorted) {
                     key = leaf_key(tree_point(lights[i]), glm::vec3(0.0f), lo, extent, false);
                 }
@@ -849,12 +870,18 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
         if (sorted) radix_sort(keyed, with_axis ? 60 : 30);  // leaf_key: 10 bits a coordinate
         reserve_huge(all, 2 * leaf_count);
         all.resize(leaf_count);
+        if (has_cones) {
+            reserve_huge(build.cones, 2 * leaf_count);
+            build.cones.resize(leaf_count);
+        }
         parallel_for(leaf_count, [&](std::size_t begin, std::size_t end) {
             for (std::size_t k = begin; k < end; ++k) {
                 // The lights are read in Morton order, so from all over
                 // memory: ask for one well ahead.
                 if (k + 16 < end) __builtin_prefetch(&lights[keyed[k + 16].second]);
-                all[k] = leaf_of(lights[keyed[k].second], keyed[k].second);
+                const gpu::Light& light = lights[keyed[k].second];
+                all[k] = leaf_of(light, keyed[k].second);
+                if (has_cones) build.cones[k] = cone_record(EmissionCone::of_light(light));
             }
         });
         keyed = {};
@@ -868,7 +895,7 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
         tree.lights.resize(tree.lights.size() + leaf_count);
         tree.roots[type] = base;
         // The light indices of each tree follow those of the one before.
-        flatten(all, leaf_count, lights, root, type, base, base_light, tree);
+        flatten(build, leaf_count, lights, root, type, base, base_light, tree);
     }
     tree.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return tree;
