@@ -153,7 +153,7 @@ void merge_into(Build& build, std::uint32_t a, std::uint32_t b, std::uint32_t id
     double p_left = c.weight > 0.0 ? ca.weight / c.weight : 0.5;
     c.rep_from_right = u >= p_left;
     c.rep = c.rep_from_right ? cb.rep : ca.rep;
-    c.leaves = ca.leaves + cb.leaves;
+    c.leaves = (ca.leaves + cb.leaves) & 0x7FFFFFFFu;  // at most 2^31 - 1 lights (build_light_tree)
 }
 
 // Merges clusters a and b into a new cluster appended to `all`.
