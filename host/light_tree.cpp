@@ -230,7 +230,8 @@ std::uint64_t morton_key(const std::uint32_t* q, int dims) {
 // term: the window of partners then holds lights that are near and face
 // alike.
 // (`point` is the leaf's box's, lo = hi; `axis` its stored cone axis, read
-// only with the axis.)
+// only with the axis. 0.5 * (point + point) is the box's centre as it was
+// computed from lo + hi: not `point` where |point| > FLT_MAX / 2.)
 std::uint64_t leaf_key(glm::vec3 point, glm::vec3 axis, glm::vec3 lo, glm::vec3 extent, bool with_axis) {
     const glm::vec3 t = glm::clamp((0.5f * (point + point) - lo) / extent, 0.0f, 1.0f) * 1023.0f;
     const glm::vec3 a = glm::clamp(0.5f * (axis + 1.0f), 0.0f, 1.0f) * 1023.0f;
@@ -259,9 +260,11 @@ void radix_sort(std::vector<std::pair<std::uint64_t, std::uint32_t>>& keyed, int
     std::vector<std::size_t> next(std::size_t(threads) * kBuckets);  // thread t's next place for digit d
     for (int shift = 0; shift < key_bits; shift += kDigitBits) {
         auto digit = [shift](const Pair& p) { return std::size_t(p.first >> shift) & (kBuckets - 1); };
+        // Zeroed here, not by each thread: a thread whose range is empty
+        // never runs, and its row must still count nothing.
+        std::fill(next.begin(), next.end(), std::size_t(0));
         parallel_for_ranges(n, [&](std::size_t begin, std::size_t end, unsigned t) {
             std::size_t* count = &next[std::size_t(t) * kBuckets];
-            std::fill(count, count + kBuckets, std::size_t(0));
             for (std::size_t i = begin; i < end; ++i) ++count[digit(from[i])];
         });
         // Digit-major, thread-minor: thread t's pairs of a digit follow
@@ -394,10 +397,11 @@ std::size_t best_partner_points_edge(const PointKeys& k, std::size_t i) {
 
 // best_partner for trees without a cone term, over PointKeys, for the
 // clusters [begin, end): the same choices, tie rule included, with the
-// costs in float. The metric is symmetric to the last bit (max, min and
-// the weights' sum do not depend on the order of their operands, except
-// for the sign of a zero difference, which squaring drops), so each pair's
-// cost is computed once. The work runs over blocks of clusters, and each
+// costs in float. The metric is symmetric to the last bit for finite
+// coordinates (max, min and the weights' sum do not depend on the order of
+// their operands, except for the sign of a zero difference, which squaring
+// drops; the loader refuses NaN positions), so each pair's cost is
+// computed once. The work runs over blocks of clusters, and each
 // step over a block's clusters at once, in vector instructions: row d of
 // `ahead` holds the costs of the clusters from r0 on to their d-th
 // successors; a cluster's smallest cost is the smallest of its row entries
@@ -446,7 +450,7 @@ void best_partners_points(const PointKeys& k, std::uint32_t* best, std::size_t b
             for (std::size_t t = 0; t < m; ++t) {
                 const std::size_t i = i0 + t;
                 const std::uint32_t either = left_mask[t] | right_mask[t];
-                if (!(smallest[t] < inf) || either == 0u) {
+                if (!(smallest[t] < inf)) {  // no finite cost: the general rule
                     best[i] = static_cast<std::uint32_t>(best_partner_points_edge(k, i));
                     continue;
                 }

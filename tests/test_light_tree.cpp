@@ -216,6 +216,27 @@ TEST(LightTree, SameTreeWhateverTheThreadCount) {
     }
 }
 
+// The same over the leaves' own passes (the Morton keys' radix sort, the
+// merges): 4097 lit point lights make one tree of 4097 leaves, which 128
+// threads split into ranges of 33, leaving the last three threads none (the
+// sort once read those threads' counts from its previous pass, past the end
+// of its arrays).
+TEST(LightTree, SameTreeWhenSomeThreadsGetNoLeaves) {
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-5.0f, 5.0f), w(0.1f, 2.0f);
+    std::vector<gpu::Light> lights;
+    for (int i = 0; i < 4097; ++i) lights.push_back(test::point_light({u(rng), u(rng), u(rng)}, {w(rng), w(rng), w(rng)}));
+    const LightTree one = build_light_tree(lights, 5, TreeBuilder::kFast, 1.0, 1);
+    check_tree(one, lights);
+    for (unsigned threads : {2u, 100u, 128u}) {
+        SCOPED_TRACE(threads);
+        const LightTree t = build_light_tree(lights, 5, TreeBuilder::kFast, 1.0, threads);
+        ASSERT_EQ(t.nodes.size(), one.nodes.size());
+        EXPECT_EQ(std::memcmp(t.nodes.data(), one.nodes.data(), one.nodes.size() * sizeof(gpu::LightNode)), 0);
+        EXPECT_EQ(std::memcmp(t.lights.data(), one.lights.data(), one.lights.size() * sizeof(gpu::Light)), 0);
+    }
+}
+
 TEST(LightTree, EmptyInputGivesNoTree) {
     LightTree t = build_light_tree({}, 1);
     EXPECT_TRUE(t.nodes.empty());

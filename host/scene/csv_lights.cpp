@@ -147,23 +147,22 @@ gpu::Light make_light(const Format& format, const std::array<float, kMaxColumns>
 
 // A stretch of the file's lines, parsed on its own (read_csv).
 struct Chunk {
-    std::string_view text;             // whole lines
-    std::size_t first_line = 1;        // the line number of its first line
-    std::vector<gpu::Light> lights;    // its lights up to its first error
-    std::size_t first_content = 0;     // line number of its first content line; 0: none
-    bool first_may_be_header = false;  // that line is all non-numbers: not parsed (see read_csv)
-    std::exception_ptr error;          // its first error
+    std::string_view text;           // whole lines
+    std::size_t first_line = 1;      // the line number of its first line
+    std::vector<gpu::Light> lights;  // its lights up to its first error
+    std::exception_ptr error;        // its first error
 };
 
-// Calls fn(line_number, line) for each content line of the chunk: comments
-// cut off, blanks trimmed, empty lines skipped; stops where fn returns false.
+// Calls fn(line_number, line) for each content line of `text`, whose first
+// line is line `first_line`: comments cut off, blanks trimmed, empty lines
+// skipped; stops where fn returns false.
 template <typename Fn>
-void for_each_content_line(const Chunk& chunk, Fn fn) {
-    std::size_t line_number = chunk.first_line;
-    for (std::size_t pos = 0; pos < chunk.text.size(); ++line_number) {
-        std::size_t eol = chunk.text.find('\n', pos);
-        if (eol == std::string_view::npos) eol = chunk.text.size();
-        std::string_view line = chunk.text.substr(pos, eol - pos);
+void for_each_content_line(std::string_view text, std::size_t first_line, Fn fn) {
+    std::size_t line_number = first_line;
+    for (std::size_t pos = 0; pos < text.size(); ++line_number) {
+        std::size_t eol = text.find('\n', pos);
+        if (eol == std::string_view::npos) eol = text.size();
+        std::string_view line = text.substr(pos, eol - pos);
         pos = eol + 1;
         if (const auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
         line = trim(line);
@@ -175,16 +174,9 @@ void parse_chunk(const Format& format, const std::string& name, Chunk& chunk) {
     // ~30 bytes per point line is typical; reserving avoids regrowth.
     chunk.lights.reserve(chunk.text.size() / (format.columns * 5) + 1);
     try {
-        for_each_content_line(chunk, [&](std::size_t line_number, std::string_view line) {
-            const Fields fields = split_fields(line);
-            if (chunk.first_content == 0) {
-                chunk.first_content = line_number;
-                // Only the file's first content line may be a header; which
-                // chunk holds it is known once all are parsed.
-                chunk.first_may_be_header = is_header(fields);
-                if (chunk.first_may_be_header) return true;
-            }
-            chunk.lights.push_back(make_light(format, parse_row(format, fields, name, line_number), name, line_number));
+        for_each_content_line(chunk.text, chunk.first_line, [&](std::size_t line_number, std::string_view line) {
+            chunk.lights.push_back(
+                make_light(format, parse_row(format, split_fields(line), name, line_number), name, line_number));
             return true;
         });
     } catch (...) {
@@ -192,17 +184,13 @@ void parse_chunk(const Format& format, const std::string& name, Chunk& chunk) {
     }
 }
 
-// The line number of the chunk's light `index` (its lights are its content
-// lines but a skipped header).
+// The line number of the chunk's light `index`: its index-th content line.
 std::size_t line_of_light(const Chunk& chunk, std::size_t index) {
     std::size_t found = 0;
-    for_each_content_line(chunk, [&](std::size_t line_number, std::string_view) {
-        if (line_number == chunk.first_content && chunk.first_may_be_header) return true;
-        if (index-- == 0) {
-            found = line_number;
-            return false;
-        }
-        return true;
+    for_each_content_line(chunk.text, chunk.first_line, [&](std::size_t line_number, std::string_view) {
+        if (index-- > 0) return true;
+        found = line_number;
+        return false;
     });
     return found;
 }
@@ -221,11 +209,11 @@ void for_each_index(std::size_t n, Fn fn) {
     for (std::thread& t : pool) t.join();
 }
 
-// The file is cut into chunks of about chunk_bytes at line ends, parsed on
-// every core; then the lights go through `limits` in file order. The first
-// problem in file order is the one reported, as a reading line by line
-// would: a chunk stops at its first error, and the limits are checked only
-// up to the first chunk that stopped.
+// The file, but a header, is cut into chunks of about chunk_bytes at line
+// ends, parsed on every core; then the lights go through `limits` in file
+// order. The first problem in file order is the one reported, as a reading
+// line by line would: a chunk stops at its first error, and the limits are
+// checked only up to the first chunk that stopped.
 std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::path& file, LightLimits& limits,
                                  std::size_t chunk_bytes) {
     const std::string name = display(file);
@@ -233,6 +221,20 @@ std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::pa
     std::string_view all(text);
     // A UTF-8 byte order mark (spreadsheets write one) is not part of line 1.
     if (all.substr(0, 3) == "\xEF\xBB\xBF") all.remove_prefix(3);
+
+    // A header is only the first content line, and only if nothing in it is
+    // a number, so that a typo in the first data line is still an error:
+    // skipped here, before the rest is cut into chunks.
+    std::size_t first_line = 1;
+    for_each_content_line(all, 1, [&](std::size_t line_number, std::string_view line) {
+        if (is_header(split_fields(line))) {
+            for (; first_line <= line_number; ++first_line) {
+                const std::size_t eol = all.find('\n');
+                all.remove_prefix(eol == std::string_view::npos ? all.size() : eol + 1);
+            }
+        }
+        return false;
+    });
 
     chunk_bytes = std::max<std::size_t>(chunk_bytes, 1);
     std::vector<Chunk> chunks;
@@ -250,30 +252,9 @@ std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::pa
     for_each_index(chunks.size(), [&](std::size_t c) {
         newlines[c] = std::size_t(std::count(chunks[c].text.begin(), chunks[c].text.end(), '\n'));
     });
+    if (!chunks.empty()) chunks[0].first_line = first_line;
     for (std::size_t c = 1; c < chunks.size(); ++c) chunks[c].first_line = chunks[c - 1].first_line + newlines[c - 1];
     for_each_index(chunks.size(), [&](std::size_t c) { parse_chunk(format, name, chunks[c]); });
-
-    // A header is only the file's first content line, and only if nothing
-    // in it is a number, so that a typo in the first data line is still an
-    // error. Any other chunk's first line that looked like one is a line of
-    // data that is not a number.
-    bool seen_content = false;
-    for (Chunk& chunk : chunks) {
-        if (chunk.first_content == 0) continue;
-        if (seen_content && chunk.first_may_be_header) {
-            chunk.lights.clear();
-            chunk.first_may_be_header = false;
-            for_each_content_line(chunk, [&](std::size_t line_number, std::string_view line) {
-                try {
-                    parse_row(format, split_fields(line), name, line_number);
-                } catch (...) {
-                    chunk.error = std::current_exception();
-                }
-                return false;
-            });
-        }
-        seen_content = true;
-    }
 
     std::size_t count = 0;
     for (const Chunk& chunk : chunks) {
