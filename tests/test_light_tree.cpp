@@ -237,6 +237,35 @@ TEST(LightTree, SameTreeWhenSomeThreadsGetNoLeaves) {
     }
 }
 
+// Spots and oriented lights (one-sided, two-sided) keep each cluster's
+// cone beside its record, written by the merges on every thread: the same
+// trees on any thread count, with more leaves per tree than one thread
+// takes alone (4096).
+TEST(LightTree, SameConeTreesWhateverTheThreadCount) {
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<float> u(-5.0f, 5.0f), w(0.1f, 2.0f), a(5.0f, 40.0f);
+    std::vector<gpu::Light> lights;
+    for (int i = 0; i < 15000; ++i) {
+        const glm::vec3 p(u(rng), u(rng), u(rng)), axis(u(rng), u(rng), u(rng) + 0.01f), c(w(rng), w(rng), w(rng));
+        if (i % 3 == 0) {
+            const float inner = a(rng);
+            lights.push_back(test::spot_light(p, axis, c, inner, inner + a(rng)));
+        } else {
+            lights.push_back(test::oriented_light(p, axis, c, i % 3 == 2));
+        }
+    }
+    const LightTree one = build_light_tree(lights, 9, TreeBuilder::kFast, 1.0, 1);
+    ASSERT_EQ(one.nodes.size(), std::size_t(2 * 5000 - 1 + 2 * 10000 - 1));  // a spot tree, an oriented tree
+    for (unsigned threads : {2u, 7u, 128u}) {
+        SCOPED_TRACE(threads);
+        const LightTree t = build_light_tree(lights, 9, TreeBuilder::kFast, 1.0, threads);
+        ASSERT_EQ(t.nodes.size(), one.nodes.size());
+        EXPECT_EQ(t.roots, one.roots);
+        EXPECT_EQ(std::memcmp(t.nodes.data(), one.nodes.data(), one.nodes.size() * sizeof(gpu::LightNode)), 0);
+        EXPECT_EQ(std::memcmp(t.lights.data(), one.lights.data(), one.lights.size() * sizeof(gpu::Light)), 0);
+    }
+}
+
 TEST(LightTree, EmptyInputGivesNoTree) {
     LightTree t = build_light_tree({}, 1);
     EXPECT_TRUE(t.nodes.empty());
