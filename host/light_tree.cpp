@@ -622,6 +622,18 @@ std::uint32_t cluster_exact(Build& build, std::vector<std::uint32_t> active) {
     return active[0];
 }
 
+// A cluster's cone as a LightNode stores it.
+struct NodeCone {
+    std::uint32_t axis_oct;
+    float cos_theta_o, cos_theta_e, falloff_width;
+    std::uint32_t flags;  // kNodeTwoSided or 0
+};
+
+NodeCone node_cone(const ClusterCone& c) {
+    return NodeCone{c.axis_packed, c.cone.emits_everywhere() ? -1.0f : std::cos(c.cone.theta_o),
+                    std::cos(c.cone.theta_e), c.cone.falloff_width, c.cone.two_sided ? gpu::kNodeTwoSided : 0u};
+}
+
 // Writes the tree of build id `root` into nodes [base_slot, base_slot + 2n - 1)
 // and its lights into [base_light, base_light + n) (both already sized). The root
 // takes base_slot; the two children of each interior node take the next
@@ -637,6 +649,8 @@ void flatten(const Build& build, std::size_t leaf_count, std::span<const gpu::Li
              std::uint32_t type, std::uint32_t base_slot, std::uint32_t base_light, LightTree& tree) {
     const UninitializedVector<Cluster>& all = build.all;
     const std::uint32_t type_bits = type << gpu::kNodeTypeShift;
+    // Every node's, in a tree without cones: worked out once.
+    const NodeCone everywhere = node_cone(build.everywhere);
     // Input light index -> leaf-order index, for the representatives.
     std::vector<std::uint32_t> remap(input.size(), gpu::kInvalidIndex);
     // Leaf-order light index - base_light -> input light index: the walk
@@ -659,12 +673,12 @@ void flatten(const Build& build, std::size_t leaf_count, std::span<const gpu::Li
         n.intensity_g = float(c.intensity.y);
         n.intensity_b = float(c.intensity.z);
         n.rep_light = c.rep;  // remapped to leaf order below
-        const ClusterCone& cone = build.cone(it.id);
-        n.axis_oct = cone.axis_packed;
-        n.cos_theta_o = cone.cone.emits_everywhere() ? -1.0f : std::cos(cone.cone.theta_o);
-        n.cos_theta_e = std::cos(cone.cone.theta_e);
-        n.falloff_width = cone.cone.falloff_width;
-        const std::uint32_t node_bits = type_bits | (cone.cone.two_sided ? gpu::kNodeTwoSided : 0u);
+        const NodeCone cone = build.cones.empty() ? everywhere : node_cone(build.cones[it.id]);
+        n.axis_oct = cone.axis_oct;
+        n.cos_theta_o = cone.cos_theta_o;
+        n.cos_theta_e = cone.cos_theta_e;
+        n.falloff_width = cone.falloff_width;
+        const std::uint32_t node_bits = type_bits | cone.flags;
         if (c.left == gpu::kInvalidIndex) {
             n.left = gpu::kInvalidIndex;
             n.flags = gpu::kNodeLeaf | node_bits;
