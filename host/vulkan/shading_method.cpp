@@ -85,7 +85,8 @@ public:
         // The refinements, the step that finds the cut final, and the fresh
         // draws of the heap's clusters.
         max_steps_ = refinements + 1 + (stochastic ? std::uint64_t(heap_slots_) * frame.light_samples : 0);
-        if (tuning.refinements_per_dispatch > 0) budget_ = tuning.refinements_per_dispatch;
+        if (tuning.refinements_per_dispatch > 0 && max_steps_ > tuning.whole_cut_steps)
+            budget_ = tuning.refinements_per_dispatch;
     }
 
     KernelCode kernel() const override {

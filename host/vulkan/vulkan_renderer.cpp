@@ -85,8 +85,10 @@ Tuning device_tuning(const Context& ctx, Tuning tuning) {
         tuning.specialize_on_host = cpu ? Tuning::HostSpecialization::kOn : Tuning::HostSpecialization::kOff;
     if (tuning.heap_memory == Tuning::HeapMemory::kAuto)
         tuning.heap_memory = cpu ? Tuning::HeapMemory::kPrivate : Tuning::HeapMemory::kShared;
-    if (tuning.presplit_on_llvmpipe && tuning.refinements_per_dispatch == 0 && driver_limits_loops(ctx))
+    if (tuning.presplit_on_llvmpipe && tuning.refinements_per_dispatch == 0 && driver_limits_loops(ctx)) {
         tuning.refinements_per_dispatch = Tuning::kLlvmpipeRefinements;
+        tuning.whole_cut_steps = Tuning::kLlvmpipeWholeCutSteps;
+    }
     return tuning;
 }
 

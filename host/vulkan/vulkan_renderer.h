@@ -30,6 +30,10 @@ struct Tuning {
     // stochastic cluster shaded).
     std::uint32_t lights_per_dispatch = 0;
     std::uint32_t refinements_per_dispatch = 0;
+    // With refinements_per_dispatch set: a render whose cuts take at most
+    // this many steps (max_cut + 1 at most) runs them whole in one dispatch
+    // instead (0: never). The llvmpipe presplit sets it.
+    std::uint32_t whole_cut_steps = 0;
     // On llvmpipe (lavapipe), whose loop limit cuts deep cuts short,
     // Lightcuts starts with kLlvmpipeRefinements steps per dispatch when
     // refinements_per_dispatch is 0, instead of finding the split by a
@@ -45,11 +49,17 @@ struct Tuning {
     // The refinement budget Lightcuts starts with on llvmpipe. Each
     // refinement's loop trips (the heap's levels, the search of a full heap,
     // a shadow ray's walk) count against the 65535-trip limit; 512 stay
-    // under it on the shipped scenes, where all but 0.3% of the room's cuts
-    // then finish in one dispatch, their heaps never leaving shared memory
-    // (docs/results/lavapipe.md, §10). A scene that needs less gets it by
-    // a retry (shading_method.cpp: a quarter of the budget each time).
+    // under it on the shipped scenes and on ones whose rays take many more
+    // trips (a retry makes it finer where not: shading_method.cpp, a
+    // quarter of the budget each time). But a cut at the default max_cut
+    // (1000) takes at most 1001 steps, and every shipped scene at its own
+    // size renders such cuts whole in one dispatch with no failed pass:
+    // up to kLlvmpipeWholeCutSteps steps, no cut is split, and no heap
+    // leaves its invocation (with 512, 0.3% of the room's cuts and 10 to
+    // 17% of the panels' and the gallery's waited in global memory between
+    // dispatches; docs/results/lavapipe.md, §12).
     static constexpr std::uint32_t kLlvmpipeRefinements = 512;
+    static constexpr std::uint32_t kLlvmpipeWholeCutSteps = 1024;
 
     // Split every scene array into chunks of at most this many bytes, as is
     // otherwise done only for arrays larger than one buffer may be (0: no

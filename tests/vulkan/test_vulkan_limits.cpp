@@ -348,6 +348,41 @@ TEST_F(Vulkan, PrivateHeapsGiveTheImagesOfSharedHeaps) {
     }
 }
 
+// At the default max_cut (1000) a cut takes at most 1001 steps, and on
+// llvmpipe the renderer runs such cuts whole in one dispatch
+// (Tuning::whole_cut_steps), so no heap waits in global memory between
+// dispatches: here cuts refined at error 0 over 20000 lights take more
+// than the 512 steps a dispatch would otherwise take, with no pass thrown
+// away to the loop limit. Other devices run every cut in one dispatch.
+TEST_F(Vulkan, CutsAtTheDefaultMaxCutStayInOneDispatch) {
+    Scene s;
+    s.materials = {test::lambert({0.6f, 0.5f, 0.4f})};
+    test::add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
+    test::add_box(s, {-1.0f, 0.0f, -1.0f}, {-0.3f, 0.6f, -0.3f}, 0);
+    test::add_box(s, {0.4f, 0.0f, 0.2f}, {0.9f, 0.4f, 0.8f}, 0);
+    s.lights = test::random_point_lights(20000, {-2, 0.5f, -2}, {2, 2, 2}, 10.0f, 66);
+    s.camera = test::camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 50.0f, 4, 4);
+    update_bounds(s);
+    const PreparedScene p = prepare_scene(std::move(s), 1);
+    RenderOptions o = options("lightcuts", 4, 4);
+    o.relative_error = 0.0f;
+    ASSERT_EQ(o.max_cut, 1000u);
+    const RenderResult g = gpu(p, o);
+    expect_lightcuts_matches(p, o, g);
+    EXPECT_GT(*std::max_element(g.stats.cut_size.begin(), g.stats.cut_size.end()), 512.0f);
+    EXPECT_EQ(g.stats.heap_paused_samples, 0u);
+    EXPECT_EQ(g.stats.loop_limit_retries, 0u);
+
+    // Split at 512 steps a dispatch (kLlvmpipeRefinements) where the
+    // driver limits loops: the same image, the deeper cuts paused.
+    vk::Tuning split;
+    split.whole_cut_steps = 0;
+    split.refinements_per_dispatch = vk::Tuning::kLlvmpipeRefinements;
+    const RenderResult h = gpu(p, o, split);
+    EXPECT_EQ(max_relative_difference(h.image, g.image, "split at 512 steps", 0.0), 0.0);
+    EXPECT_GT(h.stats.heap_paused_samples, 0u);
+}
+
 // Cuts refined at error 0 over 20000 lights: each refinement loops over
 // heap levels, the search for the smallest entry of a full heap (64 slots)
 // and a shadow ray's BVH nodes and triangles, here about 130 trips a ray
