@@ -65,11 +65,13 @@ public:
         // Walter 2005 §4 keeps a max-heap of the refinable clusters of the
         // cut, here bounded by K = render.cut_heap (shared/lightcuts.h,
         // lc_heap_push); the tree bounds it too, whatever max_cut says. All
-        // K slots of every invocation live in shared memory.
+        // K slots of every invocation live in shared memory, which limits
+        // K, or (Tuning::heap_memory, CPU devices) in each invocation's own
+        // private array, which does not.
         heap_slots_ = tree.cut_heap_slots(frame.max_cut, cut_heap);
         const std::uint64_t bytes =
             std::uint64_t(heap_slots_) * gpu::kWorkgroupSize * sizeof(gpu::CutEntry);
-        if (bytes > shared_memory_bytes)
+        if (tuning.heap_memory != Tuning::HeapMemory::kPrivate && bytes > shared_memory_bytes)
             throw std::runtime_error(
                 "cut_heap " + std::to_string(cut_heap) + " needs " + std::to_string(bytes) +
                 " bytes of shared memory per workgroup (" + std::to_string(gpu::kWorkgroupSize) +

@@ -76,14 +76,34 @@ TEST_F(Vulkan, CutHeapLargerThanSharedMemoryIsRefusedClearly) {
     PreparedScene p = prepare_scene(std::move(s), 1);
     RenderOptions o = options("lightcuts", 8, 8);
     o.cut_heap = 1000;  // 1000 slots x 8 bytes x 64 invocations = 512 000 bytes
+    vk::Tuning shared;
+    shared.heap_memory = vk::Tuning::HeapMemory::kShared;
     try {
-        gpu(p, o);
+        gpu(p, o, shared);
         FAIL() << "expected an exception";
     } catch (const std::runtime_error& e) {
         const std::string what = e.what();
         EXPECT_NE(what.find("cut_heap 1000 needs 512000 bytes of shared memory"), std::string::npos) << what;
         EXPECT_NE(what.find("so at most cut_heap "), std::string::npos) << what;
     }
+}
+
+// A heap in each invocation's private memory (the default on CPU devices)
+// is not limited by shared memory: the same K renders there, as the CPU
+// reference does with it.
+TEST_F(Vulkan, PrivateCutHeapLargerThanSharedMemoryRenders) {
+    Scene s = random_scene(62, 0, 0, 8, 8);
+    s.lights = test::random_point_lights(3000, {-3, 0.5f, -3}, {3, 3, 3}, 20.0f, 62);
+    update_bounds(s);
+    PreparedScene p = prepare_scene(std::move(s), 1);
+    RenderOptions o = options("lightcuts", 8, 8);
+    o.cut_heap = 1000;
+    vk::Tuning own;
+    own.heap_memory = vk::Tuning::HeapMemory::kPrivate;
+    const RenderResult g = gpu(p, o, own);
+    EXPECT_TRUE(g.stats.heap_private);
+    EXPECT_GT(std::uint64_t(g.stats.heap_slots) * gpu::kWorkgroupSize * sizeof(gpu::CutEntry), 32768u);
+    expect_lightcuts_matches(p, o, g);
 }
 
 // Start every pixel's 64-bit counters at `start` (lo/hi words), run one
