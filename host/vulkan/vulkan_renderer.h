@@ -31,12 +31,15 @@ struct Tuning {
     std::uint32_t lights_per_dispatch = 0;
     std::uint32_t refinements_per_dispatch = 0;
     // With refinements_per_dispatch set: a render whose cuts take at most
-    // this many steps (max_cut + 1 at most) runs them whole in one dispatch
-    // instead (0: never). The llvmpipe presplit sets it.
+    // this many steps (the refinements max_cut and the tree allow, one more
+    // to find the cut final, and stochastic's fresh draws) runs each cut
+    // whole in one dispatch instead (0: never). The llvmpipe presplit sets
+    // it.
     std::uint32_t whole_cut_steps = 0;
     // On llvmpipe (lavapipe), whose loop limit cuts deep cuts short,
-    // Lightcuts starts with kLlvmpipeRefinements steps per dispatch when
-    // refinements_per_dispatch is 0, instead of finding the split by a
+    // Lightcuts is split from the start when refinements_per_dispatch is 0
+    // (kLlvmpipeRefinements steps per dispatch, or whole cuts up to
+    // kLlvmpipeWholeCutSteps steps), instead of finding the split by a
     // failed pass over a tile. False: only a failed pass splits the work.
     bool presplit_on_llvmpipe = true;
 

@@ -385,8 +385,8 @@ TEST_F(Vulkan, CutsAtTheDefaultMaxCutStayInOneDispatch) {
     EXPECT_EQ(g.stats.heap_paused_samples, 0u);
     EXPECT_EQ(g.stats.loop_limit_retries, 0u);
 
-    // Split at 512 steps a dispatch (kLlvmpipeRefinements) where the
-    // driver limits loops: the same image, the deeper cuts paused.
+    // Split at 512 steps a dispatch (kLlvmpipeRefinements, llvmpipe's split
+    // before; forced on any device): the same image, the deeper cuts paused.
     vk::Tuning split;
     split.whole_cut_steps = 0;
     split.refinements_per_dispatch = vk::Tuning::kLlvmpipeRefinements;
