@@ -122,13 +122,17 @@ public:
             cut_size_ += 1u;
         }
         refine_all();
+        // Each point's sum over the heap's clusters in heap order, each
+        // cluster's node read once for the four.
+        vec3 sum[kQuadLanes];
+        for (uint p = 0; p < kQuadLanes; ++p) sum[p] = fixed_[p];
+        for (uint i = 0; i < size_; ++i) {
+            const QuadEntry& e = entries_[slot_[i]];
+            const vec3 intensity = k_.lc_node_intensity(k_.light_nodes[e.node]);
+            for (uint p = 0; p < kQuadLanes; ++p) sum[p] += e.unit[p] * intensity;
+        }
         for (uint p = 0; p < kQuadLanes; ++p) {
-            vec3 sum = fixed_[p];
-            for (uint i = 0; i < size_; ++i) {
-                const QuadEntry& e = entries_[slot_[i]];
-                sum += e.unit[p] * k_.lc_node_intensity(k_.light_nodes[e.node]);
-            }
-            radiance[p] = sum;
+            radiance[p] = sum[p];
             stats[p].cut_size = cut_size_;
             stats[p].cut_indirect = cut_indirect_;
             stats[p].hit_max_cut = hit_max_cut_;

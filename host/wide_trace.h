@@ -186,7 +186,9 @@ __attribute__((target("avx2"))) bool trace_any_wide8(Kernel& kernel, const WideB
     std::uint32_t sp = 0;
     stack[sp++] = 0u;
     const WideRay ray = wide_ray(kernel, org, dir, t_max);
-    const glm::vec3 inv = kernel.lc_safe_inverse(dir);
+    // The inverse direction wide_ray found (lc_safe_inverse, three
+    // divisions), read back from its lanes.
+    const glm::vec3 inv(_mm_cvtss_f32(ray.ix), _mm_cvtss_f32(ray.iy), _mm_cvtss_f32(ray.iz));
     const __m256 ox = _mm256_set1_ps(org.x), oy = _mm256_set1_ps(org.y), oz = _mm256_set1_ps(org.z);
     const __m256 ix = _mm256_set1_ps(inv.x), iy = _mm256_set1_ps(inv.y), iz = _mm256_set1_ps(inv.z);
     const __m256 far_limit = _mm256_set1_ps(t_max), zero = _mm256_setzero_ps();
