@@ -93,6 +93,9 @@ public:
         }
     }
 
+    // Triangles dropped as degenerate that were not so before the transform.
+    std::size_t degenerate_by_transform() const { return degenerate_by_transform_; }
+
     // Returns how many of the shape's triangles were kept.
     std::size_t add_shape(const tinyobj::shape_t& shape) {
         const tinyobj::mesh_t& mesh = shape.mesh;
@@ -121,6 +124,7 @@ private:
     bool override_;
     std::size_t mtl_count_;
     std::uint32_t material_base_;
+    std::size_t degenerate_by_transform_ = 0;
 
     // The MTL's texture maps (docs/scene-format.md): map_Kd scales the
     // albedo (base colour), map_Ke the emission (black or absent Ke counts
@@ -188,11 +192,14 @@ private:
         return gpu::TriangleUvs{uv[0], uv[1], uv[2], uv[3], uv[4], uv[5]};
     }
 
-    glm::vec3 position(int index) const {
+    // The vertex as the OBJ gives it, and placed by the transform.
+    glm::vec3 raw_position(int index) const {
         const auto k = static_cast<std::size_t>(index) * 3;
-        return glm::vec3(transform_.position * glm::vec4(static_cast<float>(attrib_.vertices[k]),
-                                                         static_cast<float>(attrib_.vertices[k + 1]),
-                                                         static_cast<float>(attrib_.vertices[k + 2]), 1.0f));
+        return glm::vec3(static_cast<float>(attrib_.vertices[k]), static_cast<float>(attrib_.vertices[k + 1]),
+                         static_cast<float>(attrib_.vertices[k + 2]));
+    }
+    glm::vec3 position(int index) const {
+        return glm::vec3(transform_.position * glm::vec4(raw_position(index), 1.0f));
     }
 
     glm::vec3 normal(int index) const {
@@ -236,6 +243,10 @@ private:
         if (shape_of == TriangleShape::too_large) throw InputError(obj_name_, face_name(f, shape), kTriangleTooLarge);
         if (shape_of == TriangleShape::degenerate) {
             ++target_.scene.degenerate_triangles_dropped;
+            const std::array<glm::vec3, 3> raw{raw_position(idx[0].vertex_index), raw_position(idx[1].vertex_index),
+                                               raw_position(idx[2].vertex_index)};
+            glm::vec3 raw_face;
+            if (triangle_shape(raw, raw_face) != TriangleShape::degenerate) ++degenerate_by_transform_;
             return false;
         }
         for (const glm::vec3& p : v) target_.geometry.grow(glm::dvec3(p));
@@ -268,6 +279,9 @@ void load_obj(const std::filesystem::path& file, const MeshTransform& transform,
     FaceConverter faces(reader, transform, override_material, target, file, obj_name);
     std::size_t kept = 0;
     for (const tinyobj::shape_t& shape : reader.GetShapes()) kept += faces.add_shape(shape);
+    if (kept == 0 && faces.degenerate_by_transform() > 0 && !transform.field.empty())
+        throw InputError(transform.scene_file, transform.field,
+                         "makes every triangle of " + obj_name + " degenerate (a scale too small for floats?)");
     if (kept == 0) throw InputError(obj_name, "", "no usable triangles (after dropping degenerate ones)");
 }
 

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <string>
 
 #include <glm/glm.hpp>
 
@@ -17,6 +18,9 @@ struct MeshTransform {
     glm::mat4 position{1.0f};
     glm::mat3 normal{1.0f};
     bool mirrors = false;  // odd number of negative scales flips winding
+    // Where it was written (the scene file and its field, e.g.
+    // "meshes[1].transform"), for an error it causes; empty for none.
+    std::string scene_file, field;
 };
 
 // The scene under construction, as the meshes see it.
@@ -29,7 +33,9 @@ struct MeshTarget {
 // Appends the OBJ's triangles (transformed; degenerate ones dropped and
 // counted) and its MTL materials, or the one override material, to
 // target.scene. Throws InputError naming the OBJ and the place in it; also
-// when the geometry so far would be too large for floats (float_limits.h).
+// when the geometry so far would be too large for floats (float_limits.h),
+// and naming the transform's field when it alone makes every triangle
+// degenerate (a scale too small for floats).
 void load_obj(const std::filesystem::path& file, const MeshTransform& transform,
               const std::optional<gpu::Material>& override_material, MeshTarget& target);
 

@@ -189,6 +189,8 @@ private:
         t.position = m;
         t.normal = glm::inverseTranspose(glm::mat3(m));
         t.mirrors = scale.x * scale.y * scale.z < 0.0f;
+        t.scene_file = in_.file();
+        t.field = path;
         return t;
     }
 
