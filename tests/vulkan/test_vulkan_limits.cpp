@@ -360,6 +360,18 @@ TEST_F(Vulkan, PrivateHeapsGiveTheImagesOfSharedHeaps) {
     }
 }
 
+// A grey floor with two boxes on it, seen from above at 4x4 pixels; no
+// lights yet.
+Scene floor_with_boxes() {
+    Scene s;
+    s.materials = {test::lambert({0.6f, 0.5f, 0.4f})};
+    test::add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
+    test::add_box(s, {-1.0f, 0.0f, -1.0f}, {-0.3f, 0.6f, -0.3f}, 0);
+    test::add_box(s, {0.4f, 0.0f, 0.2f}, {0.9f, 0.4f, 0.8f}, 0);
+    s.camera = test::camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 50.0f, 4, 4);
+    return s;
+}
+
 // At the default max_cut (1000) a cut takes at most 1001 steps, and on
 // llvmpipe the renderer runs such cuts whole in one dispatch
 // (Tuning::whole_cut_steps), so no heap waits in global memory between
@@ -367,13 +379,8 @@ TEST_F(Vulkan, PrivateHeapsGiveTheImagesOfSharedHeaps) {
 // than the 512 steps a dispatch would otherwise take, with no pass thrown
 // away to the loop limit. Other devices run every cut in one dispatch.
 TEST_F(Vulkan, CutsAtTheDefaultMaxCutStayInOneDispatch) {
-    Scene s;
-    s.materials = {test::lambert({0.6f, 0.5f, 0.4f})};
-    test::add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
-    test::add_box(s, {-1.0f, 0.0f, -1.0f}, {-0.3f, 0.6f, -0.3f}, 0);
-    test::add_box(s, {0.4f, 0.0f, 0.2f}, {0.9f, 0.4f, 0.8f}, 0);
+    Scene s = floor_with_boxes();
     s.lights = test::random_point_lights(20000, {-2, 0.5f, -2}, {2, 2, 2}, 10.0f, 66);
-    s.camera = test::camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 50.0f, 4, 4);
     update_bounds(s);
     const PreparedScene p = prepare_scene(std::move(s), 1);
     RenderOptions o = options("lightcuts", 4, 4);
@@ -404,11 +411,7 @@ TEST_F(Vulkan, CutsAtTheDefaultMaxCutStayInOneDispatch) {
 // (Tuning::presplit_on_llvmpipe); without that, the failed pass must split
 // it.
 TEST_F(Vulkan, LoopLimitSplitsLightcutsAutomatically) {
-    Scene s;
-    s.materials = {test::lambert({0.6f, 0.5f, 0.4f})};
-    test::add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
-    test::add_box(s, {-1.0f, 0.0f, -1.0f}, {-0.3f, 0.6f, -0.3f}, 0);
-    test::add_box(s, {0.4f, 0.0f, 0.2f}, {0.9f, 0.4f, 0.8f}, 0);
+    Scene s = floor_with_boxes();
     test::add_box(s, {-0.5f, 0.8f, 0.5f}, {0.0f, 1.0f, 1.0f}, 0);
     // 300 needles: long thin triangles across the room, which the shadow
     // rays pass without touching but whose boxes they all enter: the BVH
@@ -420,7 +423,6 @@ TEST_F(Vulkan, LoopLimitSplitsLightcutsAutomatically) {
         test::add_triangle(s, a, b, b + glm::vec3(0.0f, 0.001f, 0.0f), 0);
     }
     s.lights = test::random_point_lights(20000, {-2, 0.5f, -2}, {2, 2, 2}, 10.0f, 65);
-    s.camera = test::camera({0.0f, 2.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 50.0f, 4, 4);
     update_bounds(s);
     const PreparedScene p = prepare_scene(std::move(s), 1);
     RenderOptions o = options("lightcuts", 4, 4);
