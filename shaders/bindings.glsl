@@ -165,6 +165,14 @@ struct PushConstants {
     // constant, not a specialization constant: it follows the image size,
     // and a new pipeline per size costs seconds of compilation on lavapipe.
     uint heap_save_stride;
+    // Workgroup j of a dispatch shades the tile's block of invocations
+    // (j * group_stride) mod (workgroups); group_stride is coprime to the
+    // count, so every block once. 1 on GPUs. llvmpipe (lavapipe) hands each
+    // of its threads one contiguous range of a dispatch's workgroups, so in
+    // tile order one thread would get the top of the tile and another the
+    // bottom; a stride near the count over the golden ratio gives every
+    // range blocks from all over the tile (lc_group_stride, tile_pass.cpp).
+    uint group_stride;
 };
 
 #ifdef __cplusplus

@@ -138,9 +138,12 @@ LightNode lc_light_node(uint i) {
 #include "shared/shading.h"
 
 // Index of this invocation's pixel inside the tile, or kInvalidIndex for the
-// invocations of the last workgroup that lie past the tile.
+// invocations of the last block that lie past the tile. Workgroups take the
+// tile's blocks of gl_WorkGroupSize.x pixels in the order of
+// push.group_stride.
 uint lc_tile_pixel() {
-    uint i = gl_GlobalInvocationID.x;
+    uint block = (gl_WorkGroupID.x * push.group_stride) % gl_NumWorkGroups.x;
+    uint i = block * gl_WorkGroupSize.x + gl_LocalInvocationIndex;
     return i < push.tile_width * push.tile_height ? i : kInvalidIndex;
 }
 

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <numeric>
+#include <utility>
 
 namespace lc::vk {
 
@@ -15,13 +17,45 @@ constexpr VkAccessFlags kShaderReadWrite = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS
 
 }  // namespace
 
+std::uint32_t lc_group_stride(std::uint32_t groups) {
+    // (groups - 1) * stride must stay below 2^32 in the kernels' arithmetic.
+    if (groups < 3u || groups > 65536u) return 1u;
+    // Of the strides within 64 of groups / golden ratio, the one whose
+    // ratio to groups has the smallest largest partial quotient in its
+    // continued fraction (1/phi's are all 1), the nearest of those: any run
+    // of j then spreads j * stride mod groups evenly over the tile, where a
+    // ratio close to a simple fraction (53/88 ~ 3/5) clusters it. Euclid's
+    // algorithm gives the quotients and the gcd, which must be 1.
+    const double centre = groups * 0.6180339887498949;
+    std::uint32_t best = 1u, best_quotient = UINT32_MAX;
+    double best_distance = 0.0;
+    const std::uint32_t c = std::uint32_t(centre);
+    const std::uint32_t lo = c > 64u ? c - 64u : 1u, hi = std::min(groups - 1u, c + 64u);
+    for (std::uint32_t stride = lo; stride <= hi; ++stride) {
+        std::uint32_t a = groups, b = stride, largest = 0u;
+        while (b != 0u) {
+            largest = std::max(largest, a / b);
+            a = std::exchange(b, a % b);
+        }
+        if (a != 1u) continue;  // not coprime
+        const double distance = std::abs(double(stride) - centre);
+        if (largest < best_quotient || (largest == best_quotient && distance < best_distance)) {
+            best = stride;
+            best_quotient = largest;
+            best_distance = distance;
+        }
+    }
+    return best;
+}
+
 TilePass::TilePass(const Context& ctx, const GpuResources& resources, const Kernels& kernels,
-                   const ShadingMethod& method, Timestamps& timestamps)
+                   const ShadingMethod& method, Timestamps& timestamps, bool spread_groups)
     : vkd_(ctx.fn()),
       resources_(resources),
       kernels_(kernels),
       method_(method),
-      timestamps_(timestamps) {}
+      timestamps_(timestamps),
+      spread_groups_(spread_groups) {}
 
 void TilePass::barrier(VkCommandBuffer cmd, VkPipelineStageFlags src_stage, VkAccessFlags src,
                        VkPipelineStageFlags dst_stage, VkAccessFlags dst) const {
@@ -56,6 +90,7 @@ void TilePass::record(VkCommandBuffer cmd, const gpu::PushConstants& tile, bool 
     push.cut_flags = 0;
     push.refine_budget = gpu::kUnlimitedRefinements;
     push.heap_save_stride = resources_.tiles().invocations;
+    push.group_stride = spread_groups_ ? lc_group_stride(groups) : 1u;
     VkPipelineLayout layout = resources_.pipeline_layout();
     VkDescriptorSet set = resources_.descriptor_set();
     vkd_.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);

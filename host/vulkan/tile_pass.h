@@ -23,8 +23,10 @@ struct PassTiming {
 
 class TilePass {
 public:
+    // spread_groups: workgroups take the tile's blocks in the order of
+    // lc_group_stride instead of tile order (PushConstants::group_stride).
     TilePass(const Context& ctx, const GpuResources& resources, const Kernels& kernels,
-             const ShadingMethod& method, Timestamps& timestamps);
+             const ShadingMethod& method, Timestamps& timestamps, bool spread_groups);
 
     // Records the pass of sample tile.sample_index over the tile that `tile`
     // names (its tile_* fields; the rest is filled per dispatch). `first`:
@@ -46,6 +48,13 @@ private:
     const Kernels& kernels_;
     const ShadingMethod& method_;
     Timestamps& timestamps_;  // 0 before camera rays, then one after every dispatch
+    bool spread_groups_;
 };
+
+// The stride of PushConstants::group_stride for a dispatch of `groups`
+// workgroups: coprime to groups and near groups / golden ratio, so that
+// every contiguous range of workgroups shades blocks spread over the whole
+// tile; 1 (tile order) for fewer than 3 workgroups or more than 65536.
+std::uint32_t lc_group_stride(std::uint32_t groups);
 
 }  // namespace lc::vk

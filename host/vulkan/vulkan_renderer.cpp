@@ -22,7 +22,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // The GLSL push-constant block of shaders/kernel.glsl.
-static_assert(sizeof(gpu::PushConstants) == 40);
+static_assert(sizeof(gpu::PushConstants) == 44);
 static_assert(offsetof(gpu::PushConstants, sample_index) == 16);
 static_assert(offsetof(gpu::PushConstants, refine_budget) == 32);
 // The std430 layouts of bindings.glsl's records: 4-byte scalars only.
@@ -136,7 +136,8 @@ RenderSetup::RenderSetup(const Context& context, const PreparedScene& prepared,
                tuning.force_clearcoat || prepared.has_clearcoat, resources.texel_reads(),
                resources.chunks(), tuning.specialize_on_host == Tuning::HostSpecialization::kOn,
                tuning.heap_memory == Tuning::HeapMemory::kPrivate}),
-      pass(context, resources, kernels, *method, timestamps) {}
+      pass(context, resources, kernels, *method, timestamps,
+           tuning.spread_groups_on_cpu && context.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU) {}
 
 RenderSetup::~RenderSetup() { ctx.fn().vkDeviceWaitIdle(ctx.device().get()); }
 
@@ -163,6 +164,7 @@ Tuning Tuning::from_environment() {
         tuning.split_bytes = std::strtoull(v, nullptr, 10);
     if (const char* v = std::getenv("LC_VK_CHUNK_BUFFERS")) tuning.chunk_buffers = std::string(v) == "1";
     if (const char* v = std::getenv("LC_VK_HOST_IMPORT")) tuning.host_import = std::string(v) != "0";
+    if (const char* v = std::getenv("LC_VK_SPREAD_GROUPS")) tuning.spread_groups_on_cpu = std::string(v) != "0";
     if (const char* v = std::getenv("LC_VK_TEXEL_READS")) {
         const std::string mode = v;
         if (mode == "on") tuning.texel_reads = Tuning::TexelReads::kOn;

@@ -42,6 +42,11 @@ struct Tuning {
     // kLlvmpipeWholeCutSteps steps), instead of finding the split by a
     // failed pass over a tile. False: only a failed pass splits the work.
     bool presplit_on_llvmpipe = true;
+    // On CPU devices, workgroups take a tile's blocks spread over the tile
+    // (lc_group_stride, host/vulkan/tile_pass.h) rather than in tile order:
+    // lavapipe gives each thread one contiguous range of a dispatch's
+    // workgroups. GPUs keep tile order.
+    bool spread_groups_on_cpu = true;
 
     // One dispatch on a GPU stays well under any display watchdog.
     static constexpr double kGpuTargetMs = 30.0;

@@ -2,6 +2,7 @@
 // large for any buffer, per-pixel counters past 2^32, and the automatic
 // re-split of the work when lavapipe cuts the kernels' loops short.
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "bindings.glsl"
 #include "render_setup.h"
 #include "test_util.h"
+#include "tile_pass.h"
 #include "vulkan_test_support.h"
 
 namespace lc {
@@ -324,6 +326,71 @@ TEST(TilePixels, EveryPixelOnceInBlocksOfFourByTwo) {
                 }
             }
         }
+}
+
+// lc_group_stride: workgroup j shades block (j * stride) mod groups, which
+// must take every block exactly once and stay within 32-bit arithmetic.
+// lavapipe hands each of its T threads one contiguous share of the
+// workgroups; each share (T = 2, 4, 8) must hold between half and 1.5 times
+// its even part of every quarter of the tile (where that part is at least 4
+// blocks), not one end of the tile.
+TEST(TilePixels, GroupStrideTakesEveryBlockOnceSpreadOverTheTile) {
+    std::vector<std::uint32_t> counts;
+    for (std::uint32_t g = 1; g <= 600; ++g) counts.push_back(g);
+    for (const std::uint32_t g : {1000u, 4096u, 6561u, 30030u, 65536u}) counts.push_back(g);
+    for (const std::uint32_t groups : counts) {
+        SCOPED_TRACE(std::to_string(groups) + " workgroups");
+        const std::uint32_t stride = vk::lc_group_stride(groups);
+        ASSERT_LE(std::uint64_t(groups - 1) * stride, std::uint64_t(UINT32_MAX));
+        std::vector<int> seen(groups, 0);
+        for (std::uint32_t j = 0; j < groups; ++j) ++seen[(j * stride) % groups];
+        ASSERT_TRUE(std::all_of(seen.begin(), seen.end(), [](int c) { return c == 1; }));
+        for (const std::uint32_t threads : {2u, 4u, 8u}) {
+            for (std::uint32_t t = 0; t < threads; ++t) {
+                const std::uint32_t first = groups * t / threads, last = groups * (t + 1) / threads;
+                for (std::uint32_t q = 0; q < 4; ++q) {
+                    const std::uint32_t lo = groups * q / 4, hi = groups * (q + 1) / 4;
+                    const double even = double(last - first) * (hi - lo) / groups;
+                    if (even < 4.0) continue;
+                    std::uint32_t in = 0;
+                    for (std::uint32_t j = first; j < last; ++j) {
+                        const std::uint32_t block = (j * stride) % groups;
+                        in += block >= lo && block < hi ? 1u : 0u;
+                    }
+                    EXPECT_NEAR(in / even, 1.0, 0.5) << "thread " << t << " of " << threads << ", quarter " << q;
+                }
+            }
+        }
+    }
+    EXPECT_EQ(vk::lc_group_stride(65537u), 1u);  // past 32-bit products: tile order
+}
+
+// Workgroups spread over the tile (lavapipe's default) shade the same
+// pixels as in tile order: the same images and counts for every method, on
+// a tile whose last workgroup is partly past it, over several tiles, and
+// with cuts continued over several dispatches.
+TEST_F(Vulkan, SpreadWorkgroupsGiveTheImagesOfTileOrder) {
+    const PreparedScene p = prepare_scene(random_scene(73, 300, 2, 23, 17), 1);
+    for (const char* method : {"brute", "lightcuts", "sampled", "stochastic"}) {
+        for (const std::uint32_t budget : {0u, 4u}) {
+            if (budget > 0 && std::string(method) != "lightcuts") continue;
+            SCOPED_TRACE(std::string(method) + ", refinements per dispatch " + std::to_string(budget));
+            const RenderOptions o = options(method, 23, 17);
+            vk::Tuning spread, ordered;
+            spread.spread_groups_on_cpu = true;
+            ordered.spread_groups_on_cpu = false;
+            spread.refinements_per_dispatch = ordered.refinements_per_dispatch = budget;
+            spread.max_tile_pixels = ordered.max_tile_pixels = 23 * 17 - 64;  // two tiles
+            const RenderResult a = gpu(p, o, spread);
+            const RenderResult b = gpu(p, o, ordered);
+            EXPECT_EQ(max_relative_difference(a.image, b.image, std::string("spread workgroups ") + method, 0.0), 0.0);
+            EXPECT_EQ(a.stats.shadow_rays, b.stats.shadow_rays);
+            EXPECT_EQ(a.stats.cut_size, b.stats.cut_size);
+            EXPECT_EQ(a.stats.heap_paused_samples, b.stats.heap_paused_samples);
+            if (std::string(method) == "lightcuts") expect_lightcuts_matches(p, o, a);
+            if (std::string(method) == "brute") expect_brute_matches(p, o, a);
+        }
+    }
 }
 
 // The cut heaps in each invocation's private memory (Tuning::heap_memory;
