@@ -256,6 +256,17 @@ TEST(Gltf, UnsupportedPartsAreSkippedWithOneNoteEach) {
         EXPECT_TRUE(has_note(s, note)) << note;
 }
 
+// A node whose transform flattens its mesh to nothing (tools hide objects
+// with a scale of 0) is left out with a note naming it; the scene's other
+// instance of the same mesh is drawn. With nothing else left the load fails
+// naming the node (GltfBadInput, bad_scale_tiny).
+TEST(Gltf, NodeScaledToNothingIsLeftOutWithANote) {
+    const Scene s = load("hidden_node.gltf");
+    EXPECT_EQ(s.triangles.size(), 1u);
+    EXPECT_EQ(s.degenerate_triangles_dropped, 1u);
+    EXPECT_TRUE(has_note(s, "nodes[2]: its transform makes every triangle of meshes[0] degenerate"));
+}
+
 TEST(Gltf, EmissiveMaterialAloneLightsTheScene) {
     const Scene s = load("emissive_only.gltf");
     EXPECT_TRUE(s.lights.empty());
@@ -322,6 +333,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_negative_view.gltf", "accessors[0].bufferView: must be a whole number >= 0, not -5"},
         BadCase{"bad_aspect_zero.gltf", "cameras[0].perspective.aspectRatio: must be above 0, not 0"},
         BadCase{"bad_projective_matrix.gltf", "nodes[0].matrix: its last row (elements 3, 7, 11, 15) must be 0, 0, 0, 1"},
+        BadCase{"bad_scale_tiny.gltf", "nodes[0]: its transform makes every triangle of its mesh degenerate"},
         BadCase{"missing.gltf", "file not found"}),
     [](const ::testing::TestParamInfo<BadCase>& info) {
         std::string name = info.param.file;

@@ -115,6 +115,9 @@ public:
         for (std::size_t i = 0; i < roots.size(); ++i)
             visit(roots[i], base, "scenes[" + std::to_string(std::max(model_.defaultScene, 0)) + "].nodes[" +
                                       std::to_string(i) + "]");
+        if (kept_ == 0 && !flattened_.empty())
+            fail(flattened_, "its transform makes every triangle of its mesh degenerate (a scale of 0, or one too "
+                             "small for floats?), and no other triangle is left");
         if (kept_ == 0) fail("", "no usable triangles (after dropping degenerate ones)");
         return std::move(contents_);
     }
@@ -130,6 +133,8 @@ private:
     std::vector<bool> visited_;
     GltfContents contents_;
     std::size_t kept_ = 0;
+    std::size_t degenerate_by_transform_ = 0;  // triangles that only the transform made degenerate
+    std::string flattened_;  // the first node whose transform left nothing of its mesh
 
     [[noreturn]] void fail(const std::string& field, const std::string& problem) const {
         throw InputError(name_, field, problem);
@@ -179,9 +184,18 @@ private:
         t.normal = glm::mat3(glm::inverseTranspose(glm::dmat3(world)));
         t.mirrors = glm::determinant(glm::dmat3(world)) < 0.0;
         const tinygltf::Mesh& mesh = model_.meshes[std::size_t(index)];
+        const std::size_t kept = kept_, flattened = degenerate_by_transform_;
         for (std::size_t p = 0; p < mesh.primitives.size(); ++p)
             add_primitive(mesh.primitives[p], "meshes[" + std::to_string(index) + "].primitives[" + std::to_string(p) + "]",
                           t);
+        // A node scaled to nothing (tools hide objects with a scale of 0) is
+        // left out with a note; the walk fails on it only if nothing else
+        // is left.
+        if (kept_ == kept && degenerate_by_transform_ > flattened) {
+            notes_.add(node, "its transform makes every triangle of meshes[" + std::to_string(index) +
+                                 "] degenerate; the node is not drawn");
+            if (flattened_.empty()) flattened_ = node;
+        }
     }
 
     // The primitive's corners as index triples (glTF 3.7.2.1 for strips and fans).
@@ -255,6 +269,9 @@ private:
         if (shape == TriangleShape::too_large) fail(field, kTriangleTooLarge);
         if (shape == TriangleShape::degenerate) {
             ++target_.scene.degenerate_triangles_dropped;
+            std::array<glm::vec3, 3> raw{p[c[0]], p[c[1]], p[c[2]]};
+            glm::vec3 raw_face;
+            if (triangle_shape(raw, raw_face) != TriangleShape::degenerate) ++degenerate_by_transform_;
             return false;
         }
         for (const glm::vec3& q : v) target_.geometry.grow(glm::dvec3(q));

@@ -339,6 +339,12 @@ def bad_cases():
         d["scenes"][0]["nodes"].append(len(d["nodes"]) - 1)))
     variant("bad_projective_matrix", lambda d: d["nodes"][0].update(
         matrix=[1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0]))
+    # The only mesh node scaled below what a float triangle can hold.
+    variant("bad_scale_tiny", lambda d: d["nodes"][0].update(scale=[1e-30, 1e-30, 1e-30]))
+    # Not bad: a second instance of the mesh hidden by a scale of 0 (as
+    # tools hide objects), left out with a note.
+    variant("hidden_node", lambda d: (d["nodes"].append({"mesh": 0, "scale": [0, 0, 0]}),
+                                      d["scenes"][0]["nodes"].append(len(d["nodes"]) - 1)))
     return cases
 
 
