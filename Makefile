@@ -10,8 +10,16 @@ SCENE ?= scenes/room/room.json
 deps:
 	@./scripts/install-deps.sh
 
-# Generated scene data (not committed): the HDR sky and the gallery's spots.
-scenes: deps scenes/sky/sky.exr scenes/gallery/spots_1e4.csv
+# Generated scene data (not committed): the HDR sky, the gallery's spots and
+# the light sets of the room at 10^3 to 10^5 lights (room_1e3/1e4/1e5.json).
+ROOM_LIGHTS = scenes/room/lights_1e3.csv scenes/room/lights_1e4.csv scenes/room/lights_1e5.csv
+scenes: deps scenes/sky/sky.exr scenes/gallery/spots_1e4.csv $(ROOM_LIGHTS)
+
+LIGHTS_1e3 = 1000
+LIGHTS_1e4 = 10000
+LIGHTS_1e5 = 100000
+scenes/room/lights_%.csv: scripts/gen_lights.py
+	@python3 scripts/gen_lights.py --shape room --count $(LIGHTS_$*) --out $@
 
 scenes/sky/sky.exr: scripts/make_sky.py
 	@python3 scripts/make_sky.py >/dev/null
