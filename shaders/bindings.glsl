@@ -171,7 +171,7 @@ struct PushConstants {
     // of its threads one contiguous range of a dispatch's workgroups, so in
     // tile order one thread would get the top of the tile and another the
     // bottom; a stride near the count over the golden ratio gives every
-    // range blocks from all over the tile (lc_group_stride, tile_pass.cpp).
+    // range blocks from all over the tile (workgroup_stride, tile_pass.cpp).
     uint group_stride;
 };
 

@@ -17,7 +17,7 @@ constexpr VkAccessFlags kShaderReadWrite = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS
 
 }  // namespace
 
-std::uint32_t lc_group_stride(std::uint32_t groups) {
+std::uint32_t workgroup_stride(std::uint32_t groups) {
     // (groups - 1) * stride must stay below 2^32 in the kernels' arithmetic.
     if (groups < 3u || groups > 65536u) return 1u;
     // Of the strides within 64 of groups / golden ratio, the one whose
@@ -90,7 +90,7 @@ void TilePass::record(VkCommandBuffer cmd, const gpu::PushConstants& tile, bool 
     push.cut_flags = 0;
     push.refine_budget = gpu::kUnlimitedRefinements;
     push.heap_save_stride = resources_.tiles().invocations;
-    push.group_stride = spread_groups_ ? lc_group_stride(groups) : 1u;
+    push.group_stride = spread_groups_ ? workgroup_stride(groups) : 1u;
     VkPipelineLayout layout = resources_.pipeline_layout();
     VkDescriptorSet set = resources_.descriptor_set();
     vkd_.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1, &set, 0, nullptr);

@@ -24,7 +24,7 @@ struct PassTiming {
 class TilePass {
 public:
     // spread_groups: workgroups take the tile's blocks in the order of
-    // lc_group_stride instead of tile order (PushConstants::group_stride).
+    // workgroup_stride instead of tile order (PushConstants::group_stride).
     TilePass(const Context& ctx, const GpuResources& resources, const Kernels& kernels,
              const ShadingMethod& method, Timestamps& timestamps, bool spread_groups);
 
@@ -55,6 +55,6 @@ private:
 // workgroups: coprime to groups and near groups / golden ratio, so that
 // every contiguous range of workgroups shades blocks spread over the whole
 // tile; 1 (tile order) for fewer than 3 workgroups or more than 65536.
-std::uint32_t lc_group_stride(std::uint32_t groups);
+std::uint32_t workgroup_stride(std::uint32_t groups);
 
 }  // namespace lc::vk

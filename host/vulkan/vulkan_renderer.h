@@ -43,7 +43,7 @@ struct Tuning {
     // failed pass over a tile. False: only a failed pass splits the work.
     bool presplit_on_llvmpipe = true;
     // On CPU devices, workgroups take a tile's blocks spread over the tile
-    // (lc_group_stride, host/vulkan/tile_pass.h) rather than in tile order:
+    // (workgroup_stride, host/vulkan/tile_pass.h) rather than in tile order:
     // lavapipe gives each thread one contiguous range of a dispatch's
     // workgroups. GPUs keep tile order.
     bool spread_groups_on_cpu = true;

@@ -328,7 +328,7 @@ TEST(TilePixels, EveryPixelOnceInBlocksOfFourByTwo) {
         }
 }
 
-// lc_group_stride: workgroup j shades block (j * stride) mod groups, which
+// workgroup_stride: workgroup j shades block (j * stride) mod groups, which
 // must take every block exactly once and stay within 32-bit arithmetic.
 // lavapipe hands each of its T threads one contiguous share of the
 // workgroups; each share (T = 2, 4, 8) must hold between half and 1.5 times
@@ -340,7 +340,7 @@ TEST(TilePixels, GroupStrideTakesEveryBlockOnceSpreadOverTheTile) {
     for (const std::uint32_t g : {1000u, 4096u, 6561u, 30030u, 65536u}) counts.push_back(g);
     for (const std::uint32_t groups : counts) {
         SCOPED_TRACE(std::to_string(groups) + " workgroups");
-        const std::uint32_t stride = vk::lc_group_stride(groups);
+        const std::uint32_t stride = vk::workgroup_stride(groups);
         ASSERT_LE(std::uint64_t(groups - 1) * stride, std::uint64_t(UINT32_MAX));
         std::vector<int> seen(groups, 0);
         for (std::uint32_t j = 0; j < groups; ++j) ++seen[(j * stride) % groups];
@@ -362,7 +362,7 @@ TEST(TilePixels, GroupStrideTakesEveryBlockOnceSpreadOverTheTile) {
             }
         }
     }
-    EXPECT_EQ(vk::lc_group_stride(65537u), 1u);  // past 32-bit products: tile order
+    EXPECT_EQ(vk::workgroup_stride(65537u), 1u);  // past 32-bit products: tile order
 }
 
 // Workgroups spread over the tile (lavapipe's default) shade the same
