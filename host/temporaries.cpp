@@ -56,7 +56,11 @@ void untrack_temporary(int handle) noexcept {
 }
 
 void remove_temporaries_on_signal() {
-    for (int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    // Besides the three that stop a program from outside: SIGQUIT (Ctrl-\),
+    // SIGPIPE (a message to a pipe whose reader has gone, as in
+    // `lightcuts render ... 2>&1 | head`) and SIGXFSZ (a write past the
+    // file-size limit, `ulimit -f`).
+    for (int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGXFSZ}) {
         struct sigaction current {};
         if (::sigaction(signal_number, nullptr, &current) != 0 || current.sa_handler == SIG_IGN) continue;
         struct sigaction action {};

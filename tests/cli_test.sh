@@ -198,6 +198,13 @@ mkdir "$long" && cp "$mini" "$root/tests/data/scenes/tri.obj" "$long/"
   fail "a stats file over the size limit did not fail the render"
 grep -q "big.json" "$tmp/log_big.txt" || fail "the failed stats write said: $(cat "$tmp/log_big.txt")"
 no_output big "a stats write that failed after the render"
+# The same write with SIGXFSZ at its default action, which ends the process
+# (status 128 + 25) and, through the render's handler, removes what it wrote.
+status=0
+{ (ulimit -c 0; ulimit -f 1; exec "$exe" render "$long/minimal.json" -o "$tmp/big.exr" --width 1 --height 1 \
+  --device cpu --method lightcuts --stats "$tmp/big.json") >/dev/null 2>&1; } 2>/dev/null || status=$?
+[ "$status" -eq 153 ] || fail "a render past the file size limit exited with status $status, not 153 (SIGXFSZ)"
+no_output big "a render ended by SIGXFSZ"
 
 # A rename that fails after the render: the stats file's path becomes a folder
 # while the render runs (after its temporary is reserved). The image written

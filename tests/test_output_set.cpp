@@ -3,6 +3,7 @@
 // files the outputs would have replaced are as they were.
 #include <algorithm>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -10,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <gmock/gmock.h>
@@ -95,18 +97,24 @@ TEST_F(OutputSetTest, SignalLeavesNoTemporaries) {
     const std::string style = GTEST_FLAG_GET(death_test_style);
     GTEST_FLAG_SET(death_test_style, "fast");
     write(at("b.txt"), "old");
-    auto render_then_signal = [&](bool handled) {
+    auto render_then_signal = [&](bool handled, int signal_number) {
+        // SIGQUIT and SIGXFSZ would dump core into this folder.
+        const rlimit no_core{0, 0};
+        setrlimit(RLIMIT_CORE, &no_core);
         if (handled) remove_temporaries_on_signal();
         OutputSet set;
         write(set.add(at("a.txt"), "first"), "A");
         set.add(at("b.txt"), "second");
-        std::raise(SIGTERM);
+        std::raise(signal_number);
     };
-    EXPECT_EXIT(render_then_signal(true), ::testing::KilledBySignal(SIGTERM), "");
-    EXPECT_EQ(entries(), (std::set<std::string>{"b.txt"}));
-    EXPECT_EQ(read(at("b.txt")), "old");
+    for (int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGXFSZ}) {
+        SCOPED_TRACE(strsignal(signal_number));
+        EXPECT_EXIT(render_then_signal(true, signal_number), ::testing::KilledBySignal(signal_number), "");
+        EXPECT_EQ(entries(), (std::set<std::string>{"b.txt"}));
+        EXPECT_EQ(read(at("b.txt")), "old");
+    }
 
-    EXPECT_EXIT(render_then_signal(false), ::testing::KilledBySignal(SIGTERM), "");
+    EXPECT_EXIT(render_then_signal(false, SIGPIPE), ::testing::KilledBySignal(SIGPIPE), "");
     EXPECT_EQ(entries().size(), 3u) << "without the handler the two temporaries stay";
     GTEST_FLAG_SET(death_test_style, style);
 }
