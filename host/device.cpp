@@ -34,12 +34,14 @@ RenderResult render(const PreparedScene& prepared, const RenderOptions& options,
         say(choice, "cut_sharing \"quad\" runs on the CPU only; rendering on the CPU");
         return render_cpu(prepared, options);
     }
-    if (choice.vulkan.gpu.empty() && !vulkan_hardware_device_present()) {
-        say(choice, list_vulkan_devices().empty()
-                        ? "no Vulkan device; rendering on the CPU"
-                        : "only a software Vulkan device is present; rendering on the CPU "
-                          "(device \"vulkan\" uses it anyway)");
-        return render_cpu(prepared, options);
+    if (choice.vulkan.gpu.empty()) {
+        const VulkanDevices found = choice.devices.valid() ? choice.devices.get() : find_vulkan_devices();
+        if (!found.hardware) {
+            say(choice, found.names.empty() ? "no Vulkan device; rendering on the CPU"
+                                            : "only a software Vulkan device is present; rendering on the CPU "
+                                              "(device \"vulkan\" uses it anyway)");
+            return render_cpu(prepared, options);
+        }
     }
     try {
         return render_vulkan(prepared, options, choice.vulkan);

@@ -357,16 +357,15 @@ std::vector<vk::PhysicalDeviceInfo> present_devices() {
 
 }  // namespace
 
-std::vector<std::string> list_vulkan_devices() {
-    std::vector<std::string> names;
-    for (const vk::PhysicalDeviceInfo& d : present_devices()) names.emplace_back(d.properties.deviceName);
-    return names;
+VulkanDevices find_vulkan_devices() {
+    VulkanDevices found;
+    for (const vk::PhysicalDeviceInfo& d : present_devices()) {
+        found.names.emplace_back(d.properties.deviceName);
+        if (d.refusal.empty() && d.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) found.hardware = true;
+    }
+    return found;
 }
 
-bool vulkan_hardware_device_present() {
-    for (const vk::PhysicalDeviceInfo& d : present_devices())
-        if (d.refusal.empty() && d.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) return true;
-    return false;
-}
+std::vector<std::string> list_vulkan_devices() { return find_vulkan_devices().names; }
 
 }  // namespace lc

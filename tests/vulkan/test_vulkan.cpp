@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <future>
 #include <random>
 #include <string>
 
@@ -72,6 +73,27 @@ TEST_F(Vulkan, NoMatchingDeviceListsTheDevicesAndWhy) {
     }
     v.gpu = "99";
     EXPECT_THROW(render_vulkan(p, options("brute", 8, 8), v), std::runtime_error);
+}
+
+// Device "auto" decides from an answer of find_vulkan_devices given early
+// (the CLI asks while the scene loads) instead of asking again: told of no
+// device, or of a software one only, it renders on the CPU and says which,
+// whatever this machine has.
+TEST(DeviceChoiceAuto, DecidesFromTheDevicesFoundEarly) {
+    PreparedScene p = prepare_scene(random_scene(6, 4, 0, 8, 8), 1);
+    const RenderOptions o = options("lightcuts", 8, 8);
+    for (const VulkanDevices& told : {VulkanDevices{}, VulkanDevices{{"a software rasterizer"}, false}}) {
+        std::promise<VulkanDevices> answer;
+        answer.set_value(told);
+        DeviceChoice choice;
+        choice.devices = answer.get_future().share();
+        std::string said;
+        choice.note = [&](const std::string& line) { said = line; };
+        EXPECT_EQ(render(p, o, choice).stats.device, "cpu");
+        EXPECT_EQ(said, told.names.empty() ? "no Vulkan device; rendering on the CPU"
+                                           : "only a software Vulkan device is present; rendering on the CPU "
+                                             "(device \"vulkan\" uses it anyway)");
+    }
 }
 
 // Cuts shared by quads of pixels are the CPU's alone: the Vulkan renderer
