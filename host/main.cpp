@@ -99,7 +99,7 @@ void print_load_notes(const std::string& file, const lc::Scene& scene) {
 
 int run_render(RenderArgs a) {
     // Device "auto" renders through Vulkan only on a GPU, and finding out
-    // loads every installed Vulkan driver (0.05 to 0.1 s where Mesa's are
+    // loads every installed Vulkan driver (0.08 s where Mesa's are
     // installed): that is done while the scene loads. Unless the command
     // line already rules Vulkan out (the scene's render block may still do
     // so; the answer then goes unread).
