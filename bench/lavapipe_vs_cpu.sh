@@ -5,16 +5,21 @@
 # defaults. Prints the render-call time of each (pipelines and uploads
 # included), the GPU time of the kernels, and the two ratios.
 #
-#   bench/lavapipe_vs_cpu.sh [ROUNDS] [BINARY...]
+#   bench/lavapipe_vs_cpu.sh [--size N] [ROUNDS] [BINARY...]
 #
 # ROUNDS defaults to 2, BINARY to build/host/lightcuts; give two binaries
 # (e.g. one built from an older commit in a worktree) to compare before and
 # after in the same run. Scenes: the room with 10^4 and 10^5 lights at
-# 128x128, the textured glTF scene at its own size. The first render after
+# N x N (default 128), the textured glTF scene at its own size. The Vulkan
+# render call has a fixed part (the driver's loading, the kernels'
+# compilation: about 0.2 s on lavapipe) that a larger N makes smaller
+# against the rest. The first render after
 # a build also compiles the kernels into Mesa's shader cache; run once to
 # warm it, or read the second round.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
+side=128
+if [ "${1:-}" = "--size" ]; then side="$2"; shift 2; fi
 rounds="${1:-2}"
 shift || true
 binaries=("$@")
@@ -27,7 +32,7 @@ echo "| round | scene | binary | CPU s | Vulkan s | kernels s | Vulkan/CPU | ker
 echo "|---|---|---|---|---|---|---|---|---|"
 for round in $(seq 1 "$rounds"); do
   for scene in scenes/room/room_1e4.json scenes/room/room_1e5.json scenes/gltf/textured.gltf; do
-    size=(--width 128 --height 128)
+    size=(--width "$side" --height "$side")
     case "$scene" in *.gltf) size=() ;; esac
     for exe in "${binaries[@]}"; do
       for device in cpu vulkan; do

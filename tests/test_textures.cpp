@@ -280,6 +280,74 @@ TEST(ObjTextures, MissingOrBrokenTextureNamesTheFiles) {
     }
 }
 
+// A PNG chunk: its length, type, data and CRC-32 (big-endian).
+std::string png_chunk(const std::string& type, const std::string& data, std::uint32_t length) {
+    auto be32 = [](std::uint32_t v) {
+        return std::string{char(v >> 24), char(v >> 16 & 0xFF), char(v >> 8 & 0xFF), char(v & 0xFF)};
+    };
+    std::uint32_t crc = 0xFFFFFFFFu;
+    for (const char c : type + data) {
+        crc ^= std::uint8_t(c);
+        for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+    }
+    return be32(length) + type + data + be32(~crc);
+}
+
+// A PNG of a signature, an IHDR chunk declaring width x height RGBA8 and,
+// before IEND, `middle`: no pixels, which is all a look at the size reads.
+std::string png_header(std::uint32_t width, std::uint32_t height, const std::string& middle = "") {
+    std::string ihdr;
+    for (const std::uint32_t v : {width, height})
+        ihdr += std::string{char(v >> 24), char(v >> 16 & 0xFF), char(v >> 8 & 0xFF), char(v & 0xFF)};
+    ihdr += std::string{8, 6, 0, 0, 0};  // 8 bits, RGBA, deflate, no filter variant, not interlaced
+    return std::string("\x89PNG\r\n\x1A\n", 8) + png_chunk("IHDR", ihdr, 13) + middle + png_chunk("IEND", "", 0);
+}
+
+// An image whose header declares more texels than textures may hold is
+// refused from its header, before stb_image allocates its pixels (a 1 MB
+// PNG of 16384 x 16384 zeros took 2 GB and 8.5 s to be refused after
+// decoding); so is a PNG whose chunk claims more bytes than the file has
+// (stb_image reserved them first). Through an MTL and through glTF.
+TEST(TextureLimits, OversizedOrTruncatedImagesAreRefusedFromTheirHeaders) {
+    EXPECT_EQ(loader::encoded_image_problem(nullptr, 0), "");
+    const std::string small = png_header(2, 2);
+    EXPECT_EQ(loader::encoded_image_problem(reinterpret_cast<const unsigned char*>(small.data()), small.size()), "");
+
+    TempDir dir;
+    dir.write("big.png", png_header(16384, 16384));
+    dir.write("cut.png", png_header(2, 2, png_chunk("IDAT", "x", 1u << 30)));
+    dir.write("quad.obj", kTexturedObj);
+    const std::filesystem::path scene = dir.write("scene.json", quad_scene_json());
+    const std::string obj = (dir.path() / "quad.obj").lexically_normal().string();
+    for (const char* image : {"big.png", "cut.png"}) {
+        dir.write("quad.mtl", std::string("newmtl paint\nKd 1 1 1\nmap_Kd ") + image + "\n");
+        try {
+            load_scene(scene);
+            FAIL() << "no error for " << image;
+        } catch (const InputError& e) {
+            const std::string message = e.what();
+            EXPECT_EQ(message.rfind(obj + ": material 'paint'.map_Kd: texture '", 0), 0u) << message;
+            EXPECT_NE(message.find(image == std::string("big.png")
+                                       ? "big.png' is 16384 x 16384 texels, more than the 134217728 that "
+                                         "textures may hold in all"
+                                       : "cut.png' is a corrupt or truncated PNG: chunk 2 claims 1073741824 "
+                                         "bytes, 25 are left"),
+                      std::string::npos)
+                << message;
+        }
+    }
+    const std::filesystem::path gltf =
+        dir.write("big.gltf", R"({"asset": {"version": "2.0"}, "images": [{"uri": "big.png"}]})");
+    try {
+        load_scene(gltf);
+        FAIL() << "no error for the glTF";
+    } catch (const InputError& e) {
+        EXPECT_EQ(std::string(e.what()), gltf.lexically_normal().string() +
+                                             ": tinygltf: images[0] is 16384 x 16384 texels, more than the "
+                                             "134217728 that textures may hold in all");
+    }
+}
+
 // Two triangles share an emissive material whose texture is white on its
 // left half and black on its right; one triangle maps into each half. The
 // samples all go to the white one, and carry its power.

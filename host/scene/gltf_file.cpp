@@ -9,6 +9,7 @@
 #include "gltf_types.h"
 #include "input_file.h"
 #include "lightcuts/error.h"
+#include "textures.h"
 
 namespace lc::loader {
 namespace {
@@ -76,6 +77,19 @@ std::string decoded_uri(const std::string& uri) {
     return out;
 }
 
+// tinygltf's own image loader (stb_image) after a look at the image's
+// header: one larger than the scene's textures may hold is refused before
+// its pixels are allocated (encoded_image_problem).
+bool load_image_checked(tinygltf::Image* image, const int index, std::string* err, std::string* warn,
+                        int req_width, int req_height, const unsigned char* bytes, int size, void* user_data) {
+    const std::string problem = encoded_image_problem(bytes, std::size_t(std::max(size, 0)));
+    if (!problem.empty()) {
+        if (err != nullptr) *err += "images[" + std::to_string(index) + "] " + problem + "\n";
+        return false;
+    }
+    return tinygltf::LoadImageData(image, index, err, warn, req_width, req_height, bytes, size, user_data);
+}
+
 }  // namespace
 
 tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
@@ -92,6 +106,7 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
     if (too_deep(json)) throw InputError(name, "", "JSON nested more than " + std::to_string(kMaxJsonDepth) + " levels deep");
 
     tinygltf::TinyGLTF gltf;
+    gltf.SetImageLoader(load_image_checked, nullptr);
     tinygltf::Model model;
     std::string err, warn;
     const std::string base = file.parent_path().empty() ? std::string(".") : file.parent_path().string();
