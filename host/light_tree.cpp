@@ -27,36 +27,15 @@
 #include <thread>
 #include <type_traits>
 
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
-
 #include <glm/glm.hpp>
 
 #include "light_bounds.h"
+#include "scene/huge_pages.h"
 
 namespace lc {
 namespace {
 
 constexpr int kWindow = 16;
-
-// Reserves room for n elements and asks the kernel to back it with
-// transparent huge pages (where they are enabled for madvise). The tree of
-// 10^7 lights touches 4 to 5 GB of fresh memory, and faulting it in by 4
-// KiB pages took a quarter of its build (docs/results/speed.md). Only an
-// advice: nothing else changes where it is not taken.
-template <typename Vector>
-void reserve_huge(Vector& v, std::size_t n) {
-    using T = typename Vector::value_type;
-    v.reserve(n);
-#ifdef __linux__
-    constexpr std::uintptr_t kHuge = std::uintptr_t(2) << 20;
-    const auto first = reinterpret_cast<std::uintptr_t>(v.data());
-    const std::uintptr_t begin = (first + kHuge - 1) & ~(kHuge - 1);
-    const std::uintptr_t end = (first + v.capacity() * sizeof(T)) & ~(kHuge - 1);
-    if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-#endif
-}
 
 // Left unwritten where made (Build::all does not zero its elements): the
 // leaves and merges write every field.

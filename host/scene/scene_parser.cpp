@@ -354,9 +354,12 @@ private:
         } else if (type == "points_csv" || type == "spots_csv") {
             in_.check_keys(j, path, {"type", "file"});
             const fs::path csv = existing_file(j, path, "file");
-            const std::vector<gpu::Light> loaded =
+            std::vector<gpu::Light> loaded =
                 type == "points_csv" ? read_points_csv(csv, limits_) : read_spots_csv(csv, limits_);
-            scene_.lights.insert(scene_.lights.end(), loaded.begin(), loaded.end());
+            if (scene_.lights.empty())
+                scene_.lights = std::move(loaded);  // no copy of a file of 10^7 lights
+            else
+                scene_.lights.insert(scene_.lights.end(), loaded.begin(), loaded.end());
         } else if (type == "environment") {
             parse_environment(j, path);
         } else {
