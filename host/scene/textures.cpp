@@ -54,7 +54,7 @@ std::string encoded_image_problem(const unsigned char* bytes, std::size_t size) 
         }
     }
     int w = 0, h = 0, channels = 0;
-    if (size > std::size_t(std::numeric_limits<int>::max()) ||
+    if (size == 0 || size > std::size_t(std::numeric_limits<int>::max()) ||
         stbi_info_from_memory(bytes, int(size), &w, &h, &channels) == 0)
         return "";
     if (std::uint64_t(w) * std::uint64_t(h) <= kMaxTexels) return "";
