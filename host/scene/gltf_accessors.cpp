@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <algorithm>
 
 #include <tiny_gltf.h>
@@ -15,6 +16,10 @@ namespace {
 
 // More elements than any scene the renderer can hold; keeps sizes in 64 bits.
 constexpr std::uint64_t kMaxElements = std::uint64_t(1) << 31;
+// An accessor without a bufferView is zeros (glTF 3.6.2.1; sparse values
+// may replace some): nothing in the file bounds its count, so it is held to
+// this many elements (a VEC3 of them takes 384 MiB here).
+constexpr std::uint64_t kMaxZeroElements = std::uint64_t(1) << 24;
 
 const char* component_type_name(int type) {
     switch (type) {
@@ -165,19 +170,26 @@ std::vector<double> GltfAccessors::components(int index, const std::string& fiel
     const std::uint64_t count = a.count;
     if (count > kMaxElements) fail(name + ".count", "is larger than " + std::to_string(kMaxElements));
 
+    if (a.bufferView < 0 && count > kMaxZeroElements)
+        fail(name + ".count", "is larger than " + std::to_string(kMaxZeroElements) +
+                                  " for an accessor without a bufferView (its elements are zeros the file does not hold)");
+
     const int n = component_count(type);
     const std::uint64_t size = component_size(a.componentType);
+    // The elements must lie in the buffer view before room is made for them:
+    // a count of 4 * 10^8 in a 20-byte file asked for 9.9 GB (fuzzing).
+    std::optional<ViewWindow> window;
+    if (a.bufferView >= 0)
+        window.emplace(model_, file_, a.bufferView, name + ".bufferView", a.byteOffset, count, size * std::uint64_t(n),
+                       true);
     std::vector<double> values(std::size_t(count) * std::size_t(n), 0.0);  // no bufferView: zeros (3.6.2.1)
     const auto read_into = [&](std::size_t element, const unsigned char* p) {
         for (int c = 0; c < n; ++c)
             values[element * std::size_t(n) + std::size_t(c)] =
                 read_component(p + size * std::uint64_t(c), a.componentType, a.normalized);
     };
-    if (a.bufferView >= 0) {
-        const ViewWindow window(model_, file_, a.bufferView, name + ".bufferView", a.byteOffset, count,
-                                size * std::uint64_t(n), true);
-        for (std::uint64_t i = 0; i < count; ++i) read_into(std::size_t(i), window.element(i));
-    }
+    if (window)
+        for (std::uint64_t i = 0; i < count; ++i) read_into(std::size_t(i), window->element(i));
     if (a.sparse.isSparse) {
         // glTF 3.6.2.3: `count` indices and the values that replace those elements.
         const std::string sparse = name + ".sparse";

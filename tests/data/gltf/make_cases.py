@@ -307,6 +307,12 @@ def bad_cases():
         d["meshes"][0]["primitives"][0]["indices"] = 1
     variant("bad_index_range", index_out_of_range)
     variant("bad_accessor_past_view", lambda d: d["accessors"][0].update(count=4))
+    # The largest count an accessor may have, in a 3-element buffer view:
+    # refused before room is made for 2^31 elements (51 GB as doubles).
+    variant("bad_accessor_count_huge", lambda d: d["accessors"][0].update(count=2**31))
+    # An accessor of zeros (no bufferView) one element past the limit.
+    variant("bad_zeros_count", lambda d: d["accessors"][0].update(count=2**24 + 1, bufferView=None) or
+            d["accessors"][0].pop("bufferView"))
     variant("bad_view_past_buffer", lambda d: d["bufferViews"][0].update(byteOffset=8))
 
     def nan_position(d):
