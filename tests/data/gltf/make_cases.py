@@ -311,8 +311,7 @@ def bad_cases():
     # refused before room is made for 2^31 elements (51 GB as doubles).
     variant("bad_accessor_count_huge", lambda d: d["accessors"][0].update(count=2**31))
     # An accessor of zeros (no bufferView) one element past the limit.
-    variant("bad_zeros_count", lambda d: d["accessors"][0].update(count=2**24 + 1, bufferView=None) or
-            d["accessors"][0].pop("bufferView"))
+    variant("bad_zeros_count", lambda d: (d["accessors"][0].update(count=2**24 + 1), d["accessors"][0].pop("bufferView")))
     variant("bad_view_past_buffer", lambda d: d["bufferViews"][0].update(byteOffset=8))
 
     def nan_position(d):
