@@ -240,7 +240,7 @@ bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
     vec3 inv_dir = lc_safe_inverse(dir);
     ShearedRay sheared = lc_shear_ray(dir);
 #ifdef LC_BVH4_WORD
-    uint stack[kBvh4StackSize];
+    uint stack[kBvh4StackSize + 1u]; // + 1: a slot that is not pushed is still written at stack[sp]
     uint sp = 0u;
     uint node = 0u;            // the node to test this trip, or kInvalidIndex
     uint leaf = kInvalidIndex; // the leaf to test this trip (a stack entry), or kInvalidIndex
@@ -266,31 +266,34 @@ bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
             vec4 t_near = max(max(min(t0x, t1x), min(t0y, t1y)), max(min(t0z, t1z), vec4(0.0f)));
             vec4 t_far = min(min(max(t0x, t1x), max(t0y, t1y)), min(max(t0z, t1z), vec4(t_max))) * 1.0000004f;
             node = kInvalidIndex;
+            // Every slot is written to stack[sp] and sp moves past those
+            // that are pushed: a store whatever the slot, so that llvmpipe's
+            // loop over the lanes for each store runs under the trip's lane
+            // mask, which seldom changes, instead of under each slot's own
+            // test, whose per-lane branches it mispredicted (half the
+            // kernel's time on a Zen 4 host; docs/results/lavapipe.md §15).
             for (uint s = 0u; s < 4u; ++s) {
                 uint entry = n.entry[s];
-                if (entry == kInvalidIndex || !(t_near[s] <= t_far[s])) continue;
+                bool enters = entry != kInvalidIndex && t_near[s] <= t_far[s];
                 bool is_leaf = (entry & kBvh4LeafEntry) != 0u;
-                if (!is_leaf && node == kInvalidIndex) {
-                    node = entry;
-                } else if (is_leaf && leaf == kInvalidIndex) {
-                    leaf = entry;
-                } else {
-                    stack[sp++] = entry;
-                }
+                bool takes_node = enters && !is_leaf && node == kInvalidIndex;
+                bool takes_leaf = enters && is_leaf && leaf == kInvalidIndex;
+                node = takes_node ? entry : node;
+                leaf = takes_leaf ? entry : leaf;
+                stack[sp] = entry;
+                sp += enters && !takes_node && !takes_leaf ? 1u : 0u;
             }
         }
         // Refill from the stack: a node where none is left to test, a leaf
-        // where none is pending (a leaf on top waits while one is).
-        if (node == kInvalidIndex && sp > 0u) {
-            uint top = stack[sp - 1u];
-            if ((top & kBvh4LeafEntry) == 0u) {
-                node = top;
-                --sp;
-            } else if (leaf == kInvalidIndex) {
-                leaf = top;
-                --sp;
-            }
-        }
+        // where none is pending (a leaf on top waits while one is). The top
+        // is read whatever the test, for the same reason (stack[0] where
+        // the stack is empty, unused then).
+        uint top = stack[max(sp, 1u) - 1u];
+        bool top_is_leaf = (top & kBvh4LeafEntry) != 0u;
+        bool pops = node == kInvalidIndex && sp > 0u && (!top_is_leaf || leaf == kInvalidIndex);
+        node = pops && !top_is_leaf ? top : node;
+        leaf = pops && top_is_leaf ? top : leaf;
+        sp -= pops ? 1u : 0u;
         if (node == kInvalidIndex && leaf == kInvalidIndex) break;
     }
     return false;
