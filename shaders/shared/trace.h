@@ -196,15 +196,31 @@ Bvh4Boxes lc_bvh4_node(uint i) {
     return n;
 }
 
-// A stack entry of lc_trace_any is a Bvh4Node's entry (types.h). No leaf
-// entry is kInvalidIndex: a leaf of four triangles starts at most at
-// kBvh4MaxTriangles - 4.
-// The stack holds the unvisited children of nodes on the current path, at
-// most one group per level. A visit pushes at most three (one child is
-// visited next, or becomes the pending leaf), or four where all four are
-// leaves and a leaf is still pending, which has no deeper level after it;
-// and no wide node is deeper than the binary tree's deepest.
-LC_KCONST uint kBvh4StackSize = 3u * kBvhStackSize + 1u;
+// lc_trace_any's stack holds groups: the children of a node that the ray
+// enters and that are still to visit, as the node's index times 16 plus a
+// bit for each of those child slots (bvh_build keeps the 4-wide nodes fewer
+// than 2^28). A node's children that are not visited at once go on the
+// stack as one group, so it holds at most one group per level, and no wide
+// node is deeper than the binary tree's deepest.
+LC_KCONST uint kBvh4StackSize = kBvhStackSize;
+LC_KCONST uint kBvh4GroupSlots = 15u;
+
+// Takes from a group's children still to visit (`left`: a bit for each
+// slot of the node's `entries`) the first inner child as the next node
+// where none is set, and the first leaf as the pending leaf where none is
+// pending. Returns the children left.
+uint lc_bvh4_take(uvec4 entries, uint left, LC_INOUT(uint) node, LC_INOUT(uint) leaf) {
+    for (uint s = 0u; s < 4u; ++s) {
+        bool is_leaf = (entries[s] & kBvh4LeafEntry) != 0u;
+        bool live = (left >> s & 1u) != 0u;
+        bool takes_node = live && !is_leaf && node == kInvalidIndex;
+        bool takes_leaf = live && is_leaf && leaf == kInvalidIndex;
+        node = takes_node ? entries[s] : node;
+        leaf = takes_leaf ? entries[s] : leaf;
+        left &= takes_node || takes_leaf ? ~(1u << s) : kBvh4GroupSlots;
+    }
+    return left;
+}
 #endif
 
 // Any hit with t in (0, t_max): true if something blocks the segment.
@@ -240,10 +256,11 @@ bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
     vec3 inv_dir = lc_safe_inverse(dir);
     ShearedRay sheared = lc_shear_ray(dir);
 #ifdef LC_BVH4_WORD
-    uint stack[kBvh4StackSize + 1u]; // + 1: a slot that is not pushed is still written at stack[sp]
+    uint stack[kBvh4StackSize + 1u]; // + 1: stack[sp] is written where nothing is pushed
+    stack[0] = 0u;                    // so that every slot read holds a node's index
     uint sp = 0u;
     uint node = 0u;            // the node to test this trip, or kInvalidIndex
-    uint leaf = kInvalidIndex; // the leaf to test this trip (a stack entry), or kInvalidIndex
+    uint leaf = kInvalidIndex; // the leaf to test this trip (a node entry), or kInvalidIndex
     while (true) {
 #ifdef LC_ON_TRIP
         LC_ON_TRIP();
@@ -255,6 +272,9 @@ bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
             // The leaf's next triangle: one fewer left, the first one on.
             leaf = (leaf & (3u << 29u)) != 0u ? leaf - (1u << 29u) + 1u : kInvalidIndex;
         }
+        // This trip's group: the children of `node` that the ray enters.
+        uint group = 0u;
+        uvec4 entries = uvec4(kInvalidIndex);
         if (node != kInvalidIndex) {
             Bvh4Boxes n = lc_bvh4_node(node);
             vec4 t0x = (n.lo_x - org.x) * inv_dir.x;
@@ -265,35 +285,31 @@ bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
             vec4 t1z = (n.hi_z - org.z) * inv_dir.z;
             vec4 t_near = max(max(min(t0x, t1x), min(t0y, t1y)), max(min(t0z, t1z), vec4(0.0f)));
             vec4 t_far = min(min(max(t0x, t1x), max(t0y, t1y)), min(max(t0z, t1z), vec4(t_max))) * 1.0000004f;
+            uint enters = 0u;
+            for (uint s = 0u; s < 4u; ++s)
+                enters |= n.entry[s] != kInvalidIndex && t_near[s] <= t_far[s] ? 1u << s : 0u;
+            group = node << 4u | enters;
+            entries = n.entry;
             node = kInvalidIndex;
-            // Every slot is written to stack[sp] and sp moves past those
-            // that are pushed: a store whatever the slot, so that llvmpipe's
-            // loop over the lanes for each store runs under the trip's lane
-            // mask, which seldom changes, instead of under each slot's own
-            // test, whose per-lane branches it mispredicted (half the
-            // kernel's time on a Zen 4 host; docs/results/lavapipe.md §15).
-            for (uint s = 0u; s < 4u; ++s) {
-                uint entry = n.entry[s];
-                bool enters = entry != kInvalidIndex && t_near[s] <= t_far[s];
-                bool is_leaf = (entry & kBvh4LeafEntry) != 0u;
-                bool takes_node = enters && !is_leaf && node == kInvalidIndex;
-                bool takes_leaf = enters && is_leaf && leaf == kInvalidIndex;
-                node = takes_node ? entry : node;
-                leaf = takes_leaf ? entry : leaf;
-                stack[sp] = entry;
-                sp += enters && !takes_node && !takes_leaf ? 1u : 0u;
-            }
         }
-        // Refill from the stack: a node where none is left to test, a leaf
-        // where none is pending (a leaf on top waits while one is). The top
-        // is read whatever the test, for the same reason (stack[0] where
-        // the stack is empty, unused then).
+        uint left = lc_bvh4_take(entries, group & kBvh4GroupSlots, node, leaf);
+        // With no node yet and nothing left of this trip's group, the group
+        // on top of the stack gives the next node or leaf (a leaf there
+        // waits while one is pending); otherwise what is left of this trip's
+        // group goes on the stack.
+        // One store a trip, made whatever the case, and one read of the top
+        // whatever the case (the entries of the stack's first slot where it
+        // is empty, unused then): llvmpipe turns each access to the stack,
+        // an array each lane indexes its own way, into a loop over the
+        // lanes, and one pushing each child (up to four stores a trip, each
+        // under its own test) took a quarter of the lightcuts kernel's time
+        // (docs/results/lavapipe.md, section 15).
         uint top = stack[max(sp, 1u) - 1u];
-        bool top_is_leaf = (top & kBvh4LeafEntry) != 0u;
-        bool pops = node == kInvalidIndex && sp > 0u && (!top_is_leaf || leaf == kInvalidIndex);
-        node = pops && !top_is_leaf ? top : node;
-        leaf = pops && top_is_leaf ? top : leaf;
-        sp -= pops ? 1u : 0u;
+        bool from_top = node == kInvalidIndex && left == 0u && sp > 0u;
+        uvec4 top_entries = LC_BVH4_WORD(top >> 4u, 3u);
+        uint top_left = lc_bvh4_take(top_entries, from_top ? top & kBvh4GroupSlots : 0u, node, leaf);
+        stack[from_top ? sp - 1u : sp] = from_top ? (top & ~kBvh4GroupSlots) | top_left : (group & ~kBvh4GroupSlots) | left;
+        sp = from_top ? (top_left != 0u ? sp : sp - 1u) : (left != 0u ? sp + 1u : sp);
         if (node == kInvalidIndex && leaf == kInvalidIndex) break;
     }
     return false;
