@@ -92,10 +92,18 @@ void lc_heap_replace_top(uint size, HeapEntry e) {
         // mispredicted at every other level); the entry is read once chosen
         // (on the CPU, copying whole entries to compare them made the
         // compiler write one field and read the entry back, a stalled
-        // store-to-load forward per level).
-        if (child + 1u < size) child += uint(LC_HEAP_LOAD(child + 1u).error > LC_HEAP_LOAD(child).error);
+        // store-to-load forward per level), and its error is the one already
+        // read, not read again (on llvmpipe each read of the heap at an
+        // index that differs between lanes is a loop over the lanes).
+        float child_error = LC_HEAP_LOAD(child).error;
+        if (child + 1u < size) {
+            float right_error = LC_HEAP_LOAD(child + 1u).error;
+            child += uint(right_error > child_error);
+            child_error = right_error > child_error ? right_error : child_error;
+        }
+        if (child_error <= e.error) break;
         HeapEntry c = LC_HEAP_LOAD(child);
-        if (c.error <= e.error) break;
+        c.error = child_error;
         LC_HEAP_STORE(i, c);
         i = child;
     }
