@@ -17,6 +17,8 @@
 #ifndef LC_HEAP_GLSL
 #define LC_HEAP_GLSL
 
+#extension GL_EXT_control_flow_attributes : require
+
 layout(constant_id = kSpecHeapSlots) const uint kHeapSlots = 1u;
 layout(constant_id = kSpecHeapPrivate) const bool kHeapPrivate = false;
 
@@ -49,7 +51,36 @@ void lc_heap_restore(uint heap_size) {
     for (uint slot = 0u; slot < heap_size; ++slot) lc_heap_store(slot, heap_save[lc_saved_slot(slot)]);
 }
 
+// lc_heap_smallest on a full heap, the only heap it is asked about
+// (lc_heap_push: from = K/2, to = K): for K up to 64 a loop the compiler
+// unrolls once K is specialized, so that each slot's index is the same
+// constant in every lane (llvmpipe reads a private array at an index that
+// may differ between lanes one lane at a time, at a constant index all the
+// lanes at once). Same slots, same order, same answer.
+uint lc_heap_smallest_full(uint from, uint to, float bound) {
+    uint smallest = kInvalidIndex;
+    float smallest_error = bound;
+    if (kHeapSlots <= 64u) {
+        [[unroll]] for (uint i = kHeapSlots / 2u; i < kHeapSlots; ++i) {
+            float error = lc_heap_load(i).error;
+            bool smaller = error < smallest_error; // false for a NaN error, as below
+            smallest = smaller ? i : smallest;
+            smallest_error = smaller ? error : smallest_error;
+        }
+        return smallest;
+    }
+    for (uint i = from; i < to; ++i) {
+        float error = lc_heap_load(i).error;
+        if (error < smallest_error) {
+            smallest_error = error;
+            smallest = i;
+        }
+    }
+    return smallest;
+}
+
 #define HeapEntry CutEntry
+#define LC_HEAP_SMALLEST(from, to, bound) lc_heap_smallest_full(from, to, bound)
 #define LC_HEAP_LOAD(i) lc_heap_load(i)
 #define LC_HEAP_STORE(i, e) lc_heap_store(i, e)
 #define LC_HEAP_CAPACITY kHeapSlots
