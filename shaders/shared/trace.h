@@ -300,10 +300,10 @@ bool lc_trace_any(vec3 org, vec3 dir, float t_max) {
         // One store a trip, made whatever the case, and one read of the top
         // whatever the case (the entries of the stack's first slot where it
         // is empty, unused then): llvmpipe turns each access to the stack,
-        // an array each lane indexes its own way, into a loop over the
-        // lanes, and one pushing each child (up to four stores a trip, each
-        // under its own test) took a quarter of the lightcuts kernel's time
-        // (docs/results/lavapipe.md, section 15).
+        // an array each lane indexes its own way, into a branch per lane,
+        // and pushing each child (up to four stores a trip, each under its
+        // own test) took 23 to 40% of the Lightcuts kernel's profile
+        // samples on a Zen 4 host (docs/results/lavapipe.md, section 15).
         uint top = stack[max(sp, 1u) - 1u];
         bool from_top = node == kInvalidIndex && left == 0u && sp > 0u;
         uvec4 top_entries = LC_BVH4_WORD(top >> 4u, 3u);
