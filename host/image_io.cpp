@@ -194,7 +194,7 @@ void write_exr(const fs::path& file, const Image& image) {
     write_via_temp(file, [&](const fs::path& tmp) { return write_bytes(tmp, bytes); });
 }
 
-Image read_exr(const fs::path& file) {
+Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
     const std::string name = file.string();
     EXRVersion version;
     if (ParseEXRVersionFromFile(&version, name.c_str()) != TINYEXR_SUCCESS)
@@ -208,6 +208,13 @@ Image read_exr(const fs::path& file) {
     if (ParseEXRHeaderFromFile(&header, &version, name.c_str(), &err) != TINYEXR_SUCCESS)
         throw InputError(name, "", exr_message(err, "cannot parse the OpenEXR header"));
     ExrHeaderGuard header_guard{&header};
+    const EXRBox2i& window = header.data_window;
+    const std::int64_t width = std::int64_t(window.max_x) - window.min_x + 1;
+    const std::int64_t height = std::int64_t(window.max_y) - window.min_y + 1;
+    if (width <= 0 || height <= 0) throw InputError(name, "", "image is empty");
+    if (std::uint64_t(width) * std::uint64_t(height) > max_pixels)
+        throw InputError(name, "", "is " + std::to_string(width) + " x " + std::to_string(height) +
+                                       " pixels, more than the " + std::to_string(max_pixels) + " it may hold");
 
     int rgb_channel[3] = {-1, -1, -1};
     for (int c = 0; c < header.num_channels; ++c) {

@@ -1,5 +1,6 @@
 // Image files (EXR, PNG, heat map) and the comparison metrics.
 #include <cerrno>
+#include <cstdint>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -125,6 +126,45 @@ TEST_F(ImageFiles, ReadExrReportsBadInputAsInputError) {
     const fs::path text = dir_ / "text.exr";
     std::ofstream(text) << "this is not an OpenEXR file\n";
     EXPECT_THROW(lc::read_exr(text), lc::InputError);
+}
+
+// An OpenEXR header's data window is checked against the limit before
+// tinyexr allocates the pixels it declares. The file here is a 2 x 2 image
+// whose header claims 30000 x 30000 (10.8 GB of RGB floats); without the
+// check tinyexr fails later, on the short offset table, with another
+// message (and a valid file of that size would be decoded in full).
+TEST_F(ImageFiles, ReadExrRefusesMorePixelsThanTheLimitFromTheHeader) {
+    const fs::path file = dir_ / "small.exr";
+    lc::write_exr(file, gray(2, 2, 0.5f));
+    EXPECT_EQ(lc::read_exr(file, 4).width, 2u);
+    try {
+        lc::read_exr(file, 3);
+        FAIL() << "expected InputError";
+    } catch (const lc::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("is 2 x 2 pixels, more than the 3 it may hold"), std::string::npos)
+            << e.what();
+    }
+
+    std::string bytes;
+    {
+        std::ifstream in(file, std::ios::binary);
+        bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    const std::string attribute("dataWindow\0box2i\0", 17);
+    const std::size_t at = bytes.find(attribute);
+    ASSERT_NE(at, std::string::npos);
+    const std::int32_t window[4] = {0, 0, 29999, 29999};  // min x, min y, max x, max y; size field first
+    std::memcpy(&bytes[at + attribute.size() + 4], window, sizeof(window));
+    const fs::path huge = dir_ / "huge.exr";
+    std::ofstream(huge, std::ios::binary) << bytes;
+    try {
+        lc::read_exr(huge);
+        FAIL() << "expected InputError";
+    } catch (const lc::InputError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find(huge.string()), std::string::npos) << message;
+        EXPECT_NE(message.find("is 30000 x 30000 pixels, more than the 268435456"), std::string::npos) << message;
+    }
 }
 
 TEST_F(ImageFiles, PngHasTheRightSizeAndPixels) {

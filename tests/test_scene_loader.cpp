@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -19,6 +20,7 @@
 #include <glm/glm.hpp>
 
 #include "lightcuts/error.h"
+#include "lightcuts/image.h"
 #include "lightcuts/scene.h"
 #include "test_util.h"
 #include "lightcuts/settings.h"
@@ -307,6 +309,33 @@ TEST(SceneLoader, CameraDistanceBeyondFloatIsNamed) {
  "meshes": [{"obj": "tri.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
     const std::string message = input_error_of([&] { load_scene(scene); });
     EXPECT_NE(message.find("camera.look_at: is too far from camera.position"), std::string::npos) << message;
+}
+
+// An environment map may hold 2^27 pixels (the images `compare` reads,
+// 2^28): the header's size is checked before tinyexr allocates the pixels.
+// Here a 2 x 2 map whose header claims 12000 x 12000.
+TEST(SceneLoader, EnvironmentMapLargerThanTheLimitIsRefusedFromItsHeader) {
+    TempDir dir;
+    fs::copy_file(kFixtures / "tri.obj", dir.path() / "tri.obj");
+    const fs::path map = dir.path() / "big.exr";
+    lc::Image small(2, 2);
+    lc::write_exr(map, small);
+    std::string bytes;
+    {
+        std::ifstream in(map, std::ios::binary);
+        bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    const std::string attribute("dataWindow\0box2i\0", 17);
+    const std::size_t at = bytes.find(attribute);
+    ASSERT_NE(at, std::string::npos);
+    const std::int32_t window[4] = {0, 0, 11999, 11999};  // after the attribute's 4-byte size
+    std::memcpy(&bytes[at + attribute.size() + 4], window, sizeof(window));
+    std::ofstream(map, std::ios::binary | std::ios::trunc) << bytes;
+    const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "tri.obj"}], "lights": [{"type": "environment", "file": "big.exr"}]})");
+    const std::string message = input_error_of([&] { load_scene(scene); });
+    EXPECT_NE(message.find("big.exr: is 12000 x 12000 pixels, more than the 134217728 it may hold"), std::string::npos)
+        << message;
 }
 
 TEST(SceneLoader, MaterialOverrideReplacesMtlForWholeMesh) {

@@ -34,6 +34,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// An environment map holds at most 2^27 pixels (a 16384 x 8192 lat-long
+// map: 1.5 GiB as RGB floats), the limit all textures share (kMaxTexels).
+constexpr std::uint64_t kMaxEnvironmentPixels = std::uint64_t(1) << 27;
+
 class SceneParser {
 public:
     explicit SceneParser(const fs::path& file) : file_(file), dir_(file.parent_path()), in_(display(file)) {}
@@ -399,7 +403,7 @@ private:
         Environment env;
         if (has_file) {
             const fs::path exr = existing_file(j, path, "file");
-            const Image map = read_exr(exr);
+            const Image map = read_exr(exr, kMaxEnvironmentPixels);
             loader::note_input_file(exr);
             env.width = map.width;
             env.height = map.height;

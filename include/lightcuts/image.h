@@ -38,7 +38,13 @@ inline float luminance(glm::vec3 c) { return gpu::lc_luminance(c); }
 // success, so a failed write never leaves a half-written file. They throw
 // std::runtime_error naming the file on failure.
 void write_exr(const std::filesystem::path& file, const Image& image);   // RGB float32
-Image read_exr(const std::filesystem::path& file);                        // throws InputError
+// Reads an OpenEXR file's RGB (HALF or FLOAT). Throws InputError naming the
+// file when it cannot be read, or when its header declares more than
+// max_pixels pixels (checked before anything is allocated for them: tinyexr
+// allocates what a header declares). The default is the largest image the
+// renderer writes, 16384 x 16384.
+inline constexpr std::uint64_t kMaxExrPixels = std::uint64_t(16384) * 16384;
+Image read_exr(const std::filesystem::path& file, std::uint64_t max_pixels = kMaxExrPixels);
 void write_png_rgb8(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
                     const std::vector<std::uint8_t>& rgb8);
 // Tone-mapped sRGB preview: exposure * value, clamped to [0,1], sRGB-encoded.
