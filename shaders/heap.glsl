@@ -56,25 +56,19 @@ void lc_heap_restore(uint heap_size) {
 // unrolls once K is specialized, so that each slot's index is the same
 // constant in every lane (llvmpipe reads a private array at an index that
 // may differ between lanes one lane at a time, at a constant index all the
-// lanes at once). Same slots, same order, same answer.
+// lanes at once); above that shared/lightcuts.h's loop. Same slots, same
+// order, same answer.
+uint lc_heap_smallest_scan(uint from, uint to, float bound);  // shared/lightcuts.h
+
 uint lc_heap_smallest_full(uint from, uint to, float bound) {
+    if (kHeapSlots > 64u) return lc_heap_smallest_scan(from, to, bound);
     uint smallest = kInvalidIndex;
     float smallest_error = bound;
-    if (kHeapSlots <= 64u) {
-        [[unroll]] for (uint i = kHeapSlots / 2u; i < kHeapSlots; ++i) {
-            float error = lc_heap_load(i).error;
-            bool smaller = error < smallest_error; // false for a NaN error, as below
-            smallest = smaller ? i : smallest;
-            smallest_error = smaller ? error : smallest_error;
-        }
-        return smallest;
-    }
-    for (uint i = from; i < to; ++i) {
+    [[unroll]] for (uint i = kHeapSlots / 2u; i < kHeapSlots; ++i) {
         float error = lc_heap_load(i).error;
-        if (error < smallest_error) {
-            smallest_error = error;
-            smallest = i;
-        }
+        bool smaller = error < smallest_error; // false for a NaN error, as in the loop
+        smallest = smaller ? i : smallest;
+        smallest_error = smaller ? error : smallest_error;
     }
     return smallest;
 }

@@ -18,6 +18,7 @@
 
 #include "lightcuts/error.h"
 #include "lightcuts/image.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
@@ -145,18 +146,9 @@ TEST_F(ImageFiles, ReadExrRefusesMorePixelsThanTheLimitFromTheHeader) {
             << e.what();
     }
 
-    std::string bytes;
-    {
-        std::ifstream in(file, std::ios::binary);
-        bytes.assign(std::istreambuf_iterator<char>(in), {});
-    }
-    const std::string attribute("dataWindow\0box2i\0", 17);
-    const std::size_t at = bytes.find(attribute);
-    ASSERT_NE(at, std::string::npos);
-    const std::int32_t window[4] = {0, 0, 29999, 29999};  // min x, min y, max x, max y; size field first
-    std::memcpy(&bytes[at + attribute.size() + 4], window, sizeof(window));
     const fs::path huge = dir_ / "huge.exr";
-    std::ofstream(huge, std::ios::binary) << bytes;
+    fs::copy_file(file, huge);
+    lc::test::set_exr_data_window(huge, 29999, 29999);
     try {
         lc::read_exr(huge);
         FAIL() << "expected InputError";

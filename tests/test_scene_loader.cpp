@@ -320,17 +320,7 @@ TEST(SceneLoader, EnvironmentMapLargerThanTheLimitIsRefusedFromItsHeader) {
     const fs::path map = dir.path() / "big.exr";
     lc::Image small(2, 2);
     lc::write_exr(map, small);
-    std::string bytes;
-    {
-        std::ifstream in(map, std::ios::binary);
-        bytes.assign(std::istreambuf_iterator<char>(in), {});
-    }
-    const std::string attribute("dataWindow\0box2i\0", 17);
-    const std::size_t at = bytes.find(attribute);
-    ASSERT_NE(at, std::string::npos);
-    const std::int32_t window[4] = {0, 0, 11999, 11999};  // after the attribute's 4-byte size
-    std::memcpy(&bytes[at + attribute.size() + 4], window, sizeof(window));
-    std::ofstream(map, std::ios::binary | std::ios::trunc) << bytes;
+    test::set_exr_data_window(map, 11999, 11999);
     const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
  "meshes": [{"obj": "tri.obj"}], "lights": [{"type": "environment", "file": "big.exr"}]})");
     const std::string message = input_error_of([&] { load_scene(scene); });

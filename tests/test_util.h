@@ -3,9 +3,13 @@
 
 #include <atomic>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -15,6 +19,24 @@
 #include "lightcuts/scene.h"
 
 namespace lc::test {
+
+// Rewrites an OpenEXR file's data window (its header's "dataWindow"
+// attribute) to (0, 0) .. (max_x, max_y), leaving its pixels as they are:
+// a small file whose header declares a large image.
+inline void set_exr_data_window(const std::filesystem::path& file, std::int32_t max_x, std::int32_t max_y) {
+    std::string bytes;
+    {
+        std::ifstream in(file, std::ios::binary);
+        bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    const std::string attribute("dataWindow\0box2i\0", 17);
+    const std::size_t at = bytes.find(attribute);
+    if (at == std::string::npos || at + attribute.size() + 20 > bytes.size())
+        throw std::runtime_error(file.string() + ": no dataWindow attribute");
+    const std::int32_t window[4] = {0, 0, max_x, max_y};  // after the attribute's 4-byte size
+    std::memcpy(&bytes[at + attribute.size() + 4], window, sizeof(window));
+    std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
+}
 
 // A fresh directory under the system temp dir, removed with everything in it.
 class TempDir {

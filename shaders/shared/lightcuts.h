@@ -118,11 +118,7 @@ void lc_heap_pop(LC_INOUT(uint) size) {
 
 // The slot in [from, to) with the smallest error, the first of equals,
 // if that error is below `bound`; kInvalidIndex if none is.
-uint lc_heap_smallest(uint from, uint to, float bound) {
-#ifdef LC_HEAP_SMALLEST
-    // The includer's own search (the CPU's SSE one), the same answer.
-    return LC_HEAP_SMALLEST(from, to, bound);
-#else
+uint lc_heap_smallest_scan(uint from, uint to, float bound) {
     uint smallest = kInvalidIndex;
     float smallest_error = bound;
     for (uint i = from; i < to; ++i) {
@@ -133,6 +129,15 @@ uint lc_heap_smallest(uint from, uint to, float bound) {
         }
     }
     return smallest;
+}
+
+uint lc_heap_smallest(uint from, uint to, float bound) {
+#ifdef LC_HEAP_SMALLEST
+    // The includer's own search (the CPU's SSE one, the GPU's unrolled
+    // one), the same answer.
+    return LC_HEAP_SMALLEST(from, to, bound);
+#else
+    return lc_heap_smallest_scan(from, to, bound);
 #endif
 }
 
