@@ -236,7 +236,9 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
     if (LoadEXRImageFromFile(&exr, &header, name.c_str(), &err) != TINYEXR_SUCCESS)
         throw InputError(name, "", exr_message(err, "cannot decode the OpenEXR pixels"));
     ExrImageGuard image_guard{&exr};
-    if (exr.width <= 0 || exr.height <= 0) throw InputError(name, "", "image is empty");
+    // The size checked against max_pixels above is the one decoded.
+    if (exr.width != width || exr.height != height)
+        throw InputError(name, "", "decoded size differs from the header's data window");
 
     Image image(std::uint32_t(exr.width), std::uint32_t(exr.height));
     if (exr.images) {
