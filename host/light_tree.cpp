@@ -618,13 +618,13 @@ NodeCone node_cone(const ClusterCone& c) {
 // takes base_slot; the two children of each interior node take the next
 // two free slots when a depth-first walk, left before right, reaches it;
 // lights are numbered in the walk's leaf order, so each node's lights are
-// a contiguous range.
+// a contiguous range. The build's clusters are released once written.
 //
 // The walk's numbering follows from subtree sizes: a subtree of L leaves
 // takes 2(L - 1) slots below its root and L lights, so its right child's
 // subtree starts 2 L_left slots and L_left lights after its left child's.
 // The top of the tree is cut into subtrees that way, and threads walk them.
-void flatten(const Build& build, std::size_t leaf_count, std::span<const gpu::Light> input, std::uint32_t root,
+void flatten(Build& build, std::size_t leaf_count, std::span<const gpu::Light> input, std::uint32_t root,
              std::uint32_t type, std::uint32_t base_slot, std::uint32_t base_light, LightTree& tree) {
     const UninitializedVector<Cluster>& all = build.all;
     const std::uint32_t type_bits = type << gpu::kNodeTypeShift;
@@ -711,6 +711,11 @@ void flatten(const Build& build, std::size_t leaf_count, std::span<const gpu::Li
     for (unsigned t = 1; t < threads; ++t) pool.emplace_back(walk);
     walk();
     for (auto& th : pool) th.join();
+    // The clusters are written: their memory (144 bytes a light without
+    // cones) goes back before the leaf-order lights' pages (48 bytes a light)
+    // are first touched, so that the build's peak holds one or the other.
+    release(build.all);
+    release(build.cones);
     parallel_for(leaf_count, [&](std::size_t begin, std::size_t end) {
         for (std::size_t l = begin; l < end; ++l) {
             if (l + 16 < end) __builtin_prefetch(&input[leaf_input[l + 16]]);
@@ -881,7 +886,7 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
                 if (has_cones) build.cones[k] = cone_record(EmissionCone::of_light(light));
             }
         });
-        keyed = {};
+        release(keyed);
         std::vector<std::uint32_t> leaves(leaf_count);
         std::iota(leaves.begin(), leaves.end(), 0u);
         std::uint32_t root = builder == TreeBuilder::kExact ? cluster_exact(build, std::move(leaves))

@@ -12,6 +12,7 @@
 #include "environment_lights.h"
 #include "vpls.h"
 #include "scene/float_limits.h"
+#include "scene/huge_pages.h"
 #include "lightcuts/error.h"
 #include "lightcuts/render.h"
 
@@ -123,7 +124,7 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
         prepared.has_oriented |= type == gpu::kLightSpot || type == gpu::kLightOriented || type == gpu::kLightVpl;
     }
     prepared.tree = build_light_tree(lights, seed);
-    joined = {};
+    release(joined);
     for (const auto& m : scene.materials) {
         prepared.has_specular |= (m.flags & gpu::kMaterialHasSpecular) != 0u;
         prepared.has_textures |= (m.flags & gpu::kMaterialTextured) != 0u;

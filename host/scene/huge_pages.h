@@ -1,7 +1,7 @@
 // Large arrays backed by transparent huge pages: the loader's light files
 // and the light tree at 10^6 to 10^7 lights touch gigabytes of fresh memory,
 // and faulting it in 4 KiB at a time is a large part of their time
-// (docs/results/scale.md).
+// (docs/results/scale.md). And the release of such arrays once used.
 #pragma once
 
 #include <cstddef>
@@ -28,6 +28,13 @@ void reserve_huge(Container& v, std::size_t n) {
     const std::uintptr_t end = (first + v.capacity() * sizeof(T)) & ~(kHuge - 1);
     if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
 #endif
+}
+
+// Gives v's memory back now. (`v = {}` only empties it: the assignment
+// from an initializer list keeps the capacity.)
+template <typename Container>
+void release(Container& v) {
+    Container().swap(v);
 }
 
 }  // namespace lc
