@@ -227,7 +227,9 @@ int run(int argc, char** argv) {
                              : 0;
                 hits[t] = h;
             });
-            report("software 8-wide BVH (AVX2), single rays", r.size(), s, total(), reference);
+            report(lc::cpu::cpu_has_avx512vl() ? "software 8-wide BVH (AVX-512VL), single rays"
+                                               : "software 8-wide BVH (AVX2), single rays",
+                   r.size(), s, total(), reference);
         }
 #endif
 

@@ -182,15 +182,15 @@ inline bool cpu_has_avx2() {
 
 // trace_any_wide's answer from the 8-wide tree (lc::WideBvhNode8,
 // collapse_bvh8): one 256-bit slab test checks a node's eight boxes, with
-// lc_hit_box's operations lane by lane (AVX2 without FMA, so nothing is
-// contracted), and leaves are tested with wide_hit_leaf. Fewer levels than
-// the 4-wide tree, so fewer nodes per ray: 1.1 to 1.3 times the rays per
-// second on lightcuts' shadow rays of the shipped room (bench/embree_rays).
-// Only where cpu_has_avx2().
+// lc_hit_box's operations lane by lane (nothing is contracted: the build
+// passes -ffp-contract=off), and leaves are tested with wide_hit_leaf. Fewer
+// levels than the 4-wide tree, so fewer nodes per ray: 1.1 to 1.3 times the
+// rays per second on lightcuts' shadow rays of the shipped room
+// (bench/embree_rays). The body of trace_any_wide8_avx2 and _avx512 below.
 template <class Kernel>
-__attribute__((target("avx2"))) bool trace_any_wide8(Kernel& kernel, const WideBvhNode8* nodes,
-                                                      const WideLeaf* leaves, glm::vec3 org, glm::vec3 dir,
-                                                      float t_max) {
+__attribute__((target("avx2"), always_inline)) inline bool wide8_walk(Kernel& kernel, const WideBvhNode8* nodes,
+                                                                      const WideLeaf* leaves, glm::vec3 org,
+                                                                      glm::vec3 dir, float t_max) {
     // Each visit pops one entry and pushes at most eight.
     std::uint32_t stack[7u * gpu::kBvhStackSize + 8u];
     std::uint32_t sp = 0;
@@ -239,8 +239,44 @@ __attribute__((target("avx2"))) bool trace_any_wide8(Kernel& kernel, const WideB
     }
     return false;
 }
+
+// The walk for AVX2 CPUs.
+template <class Kernel>
+__attribute__((target("avx2"))) bool trace_any_wide8_avx2(Kernel& kernel, const WideBvhNode8* nodes,
+                                                           const WideLeaf* leaves, glm::vec3 org, glm::vec3 dir,
+                                                           float t_max) {
+    return wide8_walk(kernel, nodes, leaves, org, dir, t_max);
+}
+
+// Whether this CPU runs AVX-512 with 256-bit vectors (AVX-512VL). Asked once.
+inline bool cpu_has_avx512vl() {
+    static const bool has = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl");
+    return has;
+}
+
+// The same walk where AVX-512VL gives 32 vector registers instead of 16:
+// the ray's constants stay in registers through the leaf tests, which with
+// 16 the compiler keeps on the stack and reloads every trip. The same
+// 256-bit operations, so the same answers, bit for bit (test_bvh checks
+// both walks against brute force). Only where cpu_has_avx512vl().
+template <class Kernel>
+__attribute__((target("avx2,avx512f,avx512vl"))) bool trace_any_wide8_avx512(Kernel& kernel,
+                                                                              const WideBvhNode8* nodes,
+                                                                              const WideLeaf* leaves, glm::vec3 org,
+                                                                              glm::vec3 dir, float t_max) {
+    return wide8_walk(kernel, nodes, leaves, org, dir, t_max);
+}
+
+// The 8-wide walk for this CPU: only where cpu_has_avx2().
+template <class Kernel>
+bool trace_any_wide8(Kernel& kernel, const WideBvhNode8* nodes, const WideLeaf* leaves, glm::vec3 org, glm::vec3 dir,
+                     float t_max) {
+    return cpu_has_avx512vl() ? trace_any_wide8_avx512(kernel, nodes, leaves, org, dir, t_max)
+                              : trace_any_wide8_avx2(kernel, nodes, leaves, org, dir, t_max);
+}
 #else
 inline bool cpu_has_avx2() { return false; }
+inline bool cpu_has_avx512vl() { return false; }
 #endif
 
 #if defined(__SSE2__)

@@ -128,9 +128,14 @@ std::string check_ray(const Scene& s, vec3 org, vec3 dir, float t_max) {
     if (k4.lc_trace_any(org, dir, t_max) != any)
         return "the kernels' 4-wide any-hit disagrees with brute force for " + describe(org, dir, t_max);
 #if defined(LC_WIDE8_TRACE)
+    // Both builds of the 8-wide walk that this CPU runs.
     if (lc::cpu::cpu_has_avx2() &&
-        lc::cpu::trace_any_wide8(k, s.bvh.wide8_nodes.data(), s.bvh.wide_leaves.data(), org, dir, t_max) != any)
-        return "8-wide any-hit disagrees with brute force for " + describe(org, dir, t_max);
+        lc::cpu::trace_any_wide8_avx2(k, s.bvh.wide8_nodes.data(), s.bvh.wide_leaves.data(), org, dir, t_max) != any)
+        return "8-wide any-hit (AVX2) disagrees with brute force for " + describe(org, dir, t_max);
+    if (lc::cpu::cpu_has_avx512vl() &&
+        lc::cpu::trace_any_wide8_avx512(k, s.bvh.wide8_nodes.data(), s.bvh.wide_leaves.data(), org, dir, t_max) !=
+            any)
+        return "8-wide any-hit (AVX-512) disagrees with brute force for " + describe(org, dir, t_max);
 #endif
     return {};
 }
@@ -549,8 +554,12 @@ TEST(Bvh, EmptySceneMissesEverything) {
         EXPECT_FALSE(lc::cpu::trace_any_wide(k, bvh.wide_nodes.data(), bvh.wide_leaves.data(), org, dir, kRayInfinity));
 #if defined(LC_WIDE8_TRACE)
         if (lc::cpu::cpu_has_avx2()) {
-            EXPECT_FALSE(
-                lc::cpu::trace_any_wide8(k, bvh.wide8_nodes.data(), bvh.wide_leaves.data(), org, dir, kRayInfinity));
+            EXPECT_FALSE(lc::cpu::trace_any_wide8_avx2(k, bvh.wide8_nodes.data(), bvh.wide_leaves.data(), org, dir,
+                                                       kRayInfinity));
+        }
+        if (lc::cpu::cpu_has_avx512vl()) {
+            EXPECT_FALSE(lc::cpu::trace_any_wide8_avx512(k, bvh.wide8_nodes.data(), bvh.wide_leaves.data(), org, dir,
+                                                         kRayInfinity));
         }
 #endif
     }
