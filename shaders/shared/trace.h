@@ -29,7 +29,9 @@ struct ShearedRay {
     float sx, sy, sz;
 };
 
-ShearedRay lc_shear_ray(vec3 dir) {
+// Inlined into the CPU's walks (host/wide_trace.h sets every ray up with
+// it): called out of line it made brute force 7 to 11% slower.
+LC_ALWAYS_INLINE ShearedRay lc_shear_ray(vec3 dir) {
     vec3 ad = abs(dir);
     ShearedRay r;
     r.kz = ad.x > ad.y ? (ad.x > ad.z ? 0 : 2) : (ad.y > ad.z ? 1 : 2);

@@ -12,8 +12,11 @@
 namespace lc::gpu {
 using uint = std::uint32_t;
 #define LC_CONST constexpr
+// A function the C++ compiler must inline (GLSL compilers inline every one).
+#define LC_ALWAYS_INLINE [[gnu::always_inline]]
 #else
 #define LC_CONST const
+#define LC_ALWAYS_INLINE
 #endif
 
 // ---------------------------------------------------------------------------
