@@ -215,22 +215,27 @@ int run(int argc, char** argv) {
         report("software 4-wide BVH, single rays", r.size(), s, total(), reference);
 
 #if defined(LC_WIDE8_TRACE)
-        if (lc::cpu::cpu_has_avx2()) {
+        // The 8-wide walk in each build this CPU runs (the renderer takes
+        // the AVX-512 one where there is one).
+        auto wide8 = [&](const char* what, auto trace) {
             std::fill(hits.begin(), hits.end(), 0);
             s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
                 lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
                 std::size_t h = 0;
                 for (std::size_t i = b; i < e; ++i)
-                    h += lc::cpu::trace_any_wide8(tk, p.bvh.wide8_nodes.data(), p.bvh.wide_leaves.data(), r[i].org,
-                                                  r[i].dir, r[i].t_max)
+                    h += trace(tk, p.bvh.wide8_nodes.data(), p.bvh.wide_leaves.data(), r[i].org, r[i].dir,
+                               r[i].t_max)
                              ? 1
                              : 0;
                 hits[t] = h;
             });
-            report(lc::cpu::cpu_has_avx512vl() ? "software 8-wide BVH (AVX-512VL), single rays"
-                                               : "software 8-wide BVH (AVX2), single rays",
-                   r.size(), s, total(), reference);
-        }
+            report(what, r.size(), s, total(), reference);
+        };
+        if (lc::cpu::cpu_has_avx2())
+            wide8("software 8-wide BVH (AVX2), single rays", [](auto&&... a) { return lc::cpu::trace_any_wide8_avx2(a...); });
+        if (lc::cpu::cpu_has_avx512vl())
+            wide8("software 8-wide BVH (AVX-512VL), single rays",
+                  [](auto&&... a) { return lc::cpu::trace_any_wide8_avx512(a...); });
 #endif
 
         // The Vulkan kernels' walk (lc_trace_any through Bvh4Node),
