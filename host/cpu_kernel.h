@@ -367,6 +367,28 @@ struct BasicShadeKernel {
         return wide_nodes != nullptr ? trace_any_wide(*this, wide_nodes, wide_leaves, org, dir, t_max)
                                      : lc_trace_any(org, dir, t_max);
     }
+
+    // lc_visible for up to four rays from their own points (bit r of
+    // packet.valid): bit r of the result is set where ray r is visible.
+    // Each answer is lc_visible's; where the 8-wide tree is bound the rays
+    // go down it together (trace_any_wide8x4), else one at a time.
+    unsigned lc_visible4(const RayPacket4& packet) {
+        const unsigned valid = packet.valid & 0xFu;
+        if (!kEnableShadows) return valid;
+#if defined(LC_WIDE8_TRACE)
+        if (!kRecordRays && wide8_nodes != nullptr)
+            return valid & ~(cpu_has_avx512vl() ? trace_any_wide8x4_avx512(*this, wide8_nodes, wide_leaves, packet)
+                                                : trace_any_wide8x4_avx2(*this, wide8_nodes, wide_leaves, packet));
+#endif
+        unsigned visible = 0u;
+        for (unsigned r = 0; r < 4u; ++r) {
+            if ((valid >> r & 1u) == 0u) continue;
+            SurfacePoint at;
+            at.p = packet.org[r];
+            if (lc_visible(at, packet.dir[r], packet.t_max[r])) visible |= 1u << r;
+        }
+        return visible;
+    }
 };
 
 using ShadeKernel = BasicShadeKernel<false>;

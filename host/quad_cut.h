@@ -332,9 +332,11 @@ private:
         errors(kept_node, kept.error);
         errors(fresh_node, fresh.error);
         const bool fresh_leaf = (fresh_node.flags & kNodeLeaf) != 0u;
-        // The new representative's shadow ray from each point. (Traced as
-        // one packet of four rays with a shared box test they ran slower:
-        // the points' spread widens the packet's bounds.)
+        // The new representative's shadow ray from each point, the four
+        // traced together (lc_visible4: each ray tested on its own at every
+        // node it enters, the nodes read and the branches taken once; a
+        // packet bounding the four rays with one box test ran slower, as the
+        // points' spread widens its bounds).
         const Light& rep = k_.lights[fresh_node.rep_light];
         vec3 units[kQuadLanes], wi[kQuadLanes];
         float t_max[kQuadLanes];
@@ -343,6 +345,7 @@ private:
 #else
         const bool lanes_done = false;
 #endif
+        RayPacket4 rays;
         for (uint p = 0; p < kQuadLanes; ++p) {
             fresh.unit[p] = vec3(0.0f);
             if (!lane(p) || !(fresh_leaf || fresh.error[p] > 0.0f)) continue;
@@ -351,8 +354,14 @@ private:
             if (!lanes_done) units[p] = k_.lc_light_unit(sp_[p], rep, f_.min_distance2, wi[p], t_max[p]);
             if (!(units[p].x + units[p].y + units[p].z > 0.0f)) continue;
             stats_[p].shadow_rays += 1u;
-            if (k_.lc_visible(sp_[p], wi[p], t_max[p])) fresh.unit[p] = units[p];
+            rays.org[p] = sp_[p].p;
+            rays.dir[p] = wi[p];
+            rays.t_max[p] = t_max[p];
+            rays.valid |= 1u << p;
         }
+        const unsigned visible = rays.valid != 0u ? k_.lc_visible4(rays) : 0u;
+        for (uint p = 0; p < kQuadLanes; ++p)
+            if ((visible >> p & 1u) != 0u) fresh.unit[p] = units[p];
         const bool has_kept = enter(kept_node, kept);
         const bool has_fresh = enter(fresh_node, fresh);
         if (!has_kept) free_[free_count_++] = kept_slot;

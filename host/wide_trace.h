@@ -171,6 +171,17 @@ bool trace_any_wide(Kernel& kernel, const WideBvhNode* nodes, const WideLeaf* le
 }
 
 
+// Up to four rays: ray r from org[r] along dir[r], for t in (0, t_max[r]),
+// where bit r of `valid` is set. (One struct by reference: with the three
+// arrays as separate pointer parameters, GCC 12.2 at -O3 dropped a caller's
+// stores to them as dead; -fno-ipa-modref or -fno-tree-dse kept them.)
+struct RayPacket4 {
+    glm::vec3 org[4];
+    glm::vec3 dir[4];
+    float t_max[4];
+    unsigned valid = 0u;
+};
+
 #if defined(__SSE2__) && (defined(__x86_64__) || defined(__i386__))
 #define LC_WIDE8_TRACE 1
 // Whether this CPU runs AVX2 (and its operating system saves the wide
@@ -187,6 +198,41 @@ inline bool cpu_has_avx2() {
 // levels than the 4-wide tree, so fewer nodes per ray: 1.1 to 1.3 times the
 // rays per second on lightcuts' shadow rays of the shipped room
 // (bench/embree_rays). The body of trace_any_wide8_avx2 and _avx512 below.
+// One ray's constants for the 8-wide slab test, broadcast to the lanes.
+struct Wide8Ray {
+    __m256 ox, oy, oz, ix, iy, iz, far_limit;
+};
+
+template <class Kernel>
+__attribute__((target("avx2"), always_inline)) inline Wide8Ray wide8_ray(Kernel& kernel, glm::vec3 org, glm::vec3 dir,
+                                                                         float t_max) {
+    const glm::vec3 inv = kernel.lc_safe_inverse(dir);
+    return Wide8Ray{_mm256_set1_ps(org.x), _mm256_set1_ps(org.y), _mm256_set1_ps(org.z), _mm256_set1_ps(inv.x),
+                    _mm256_set1_ps(inv.y),  _mm256_set1_ps(inv.z),  _mm256_set1_ps(t_max)};
+}
+
+// lc_hit_box on a node's eight boxes: bit s set where the ray enters child s.
+__attribute__((target("avx2"), always_inline)) inline unsigned wide8_hit_boxes(const WideBvhNode8& node,
+                                                                               const Wide8Ray& r) {
+    const __m256 zero = _mm256_setzero_ps();
+    const __m256 widen = _mm256_set1_ps(1.0000004f);  // lc_hit_box's robust far distance
+    const __m256 t0x = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.lo_x), r.ox), r.ix);
+    const __m256 t1x = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.hi_x), r.ox), r.ix);
+    const __m256 t0y = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.lo_y), r.oy), r.iy);
+    const __m256 t1y = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.hi_y), r.oy), r.iy);
+    const __m256 t0z = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.lo_z), r.oz), r.iz);
+    const __m256 t1z = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.hi_z), r.oz), r.iz);
+    const __m256 t_near = _mm256_max_ps(_mm256_max_ps(_mm256_min_ps(t0x, t1x), _mm256_min_ps(t0y, t1y)),
+                                        _mm256_max_ps(_mm256_min_ps(t0z, t1z), zero));
+    const __m256 t_far = _mm256_mul_ps(_mm256_min_ps(_mm256_min_ps(_mm256_max_ps(t0x, t1x), _mm256_max_ps(t0y, t1y)),
+                                                     _mm256_min_ps(_mm256_max_ps(t0z, t1z), r.far_limit)),
+                                       widen);
+    const __m256i present = _mm256_cmpgt_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(node.count)),
+                                               _mm256_set1_epi32(-1));
+    return unsigned(
+        _mm256_movemask_ps(_mm256_and_ps(_mm256_cmp_ps(t_near, t_far, _CMP_LE_OQ), _mm256_castsi256_ps(present))));
+}
+
 template <class Kernel>
 __attribute__((target("avx2"), always_inline)) inline bool wide8_walk(Kernel& kernel, const WideBvhNode8* nodes,
                                                                       const WideLeaf* leaves, glm::vec3 org,
@@ -199,29 +245,10 @@ __attribute__((target("avx2"), always_inline)) inline bool wide8_walk(Kernel& ke
     // ray reaches: many shadow rays reach none.
     WideRay ray;
     bool sheared = false;
-    const glm::vec3 inv = kernel.lc_safe_inverse(dir);
-    const __m256 ox = _mm256_set1_ps(org.x), oy = _mm256_set1_ps(org.y), oz = _mm256_set1_ps(org.z);
-    const __m256 ix = _mm256_set1_ps(inv.x), iy = _mm256_set1_ps(inv.y), iz = _mm256_set1_ps(inv.z);
-    const __m256 far_limit = _mm256_set1_ps(t_max), zero = _mm256_setzero_ps();
-    const __m256 widen = _mm256_set1_ps(1.0000004f);  // lc_hit_box's robust far distance
+    const Wide8Ray r = wide8_ray(kernel, org, dir, t_max);
     while (sp > 0u) {
         const WideBvhNode8& node = nodes[stack[--sp]];
-        const __m256 t0x = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.lo_x), ox), ix);
-        const __m256 t1x = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.hi_x), ox), ix);
-        const __m256 t0y = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.lo_y), oy), iy);
-        const __m256 t1y = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.hi_y), oy), iy);
-        const __m256 t0z = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.lo_z), oz), iz);
-        const __m256 t1z = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.hi_z), oz), iz);
-        const __m256 t_near = _mm256_max_ps(_mm256_max_ps(_mm256_min_ps(t0x, t1x), _mm256_min_ps(t0y, t1y)),
-                                            _mm256_max_ps(_mm256_min_ps(t0z, t1z), zero));
-        const __m256 t_far =
-            _mm256_mul_ps(_mm256_min_ps(_mm256_min_ps(_mm256_max_ps(t0x, t1x), _mm256_max_ps(t0y, t1y)),
-                                        _mm256_min_ps(_mm256_max_ps(t0z, t1z), far_limit)),
-                          widen);
-        const __m256i present = _mm256_cmpgt_epi32(
-            _mm256_load_si256(reinterpret_cast<const __m256i*>(node.count)), _mm256_set1_epi32(-1));
-        unsigned mask = unsigned(
-            _mm256_movemask_ps(_mm256_and_ps(_mm256_cmp_ps(t_near, t_far, _CMP_LE_OQ), _mm256_castsi256_ps(present))));
+        unsigned mask = wide8_hit_boxes(node, r);
         while (mask != 0u) {
             const unsigned s = unsigned(__builtin_ctz(mask));
             mask &= mask - 1u;
@@ -238,6 +265,70 @@ __attribute__((target("avx2"), always_inline)) inline bool wide8_walk(Kernel& ke
         }
     }
     return false;
+}
+
+// Up to four rays (bit r of packet.valid) through the 8-wide tree together:
+// bit r of the result is set where ray r is blocked. Each stack entry
+// carries the rays that entered its node, and each of them is tested
+// against the node's boxes on its own (wide8_hit_boxes): a ray visits
+// exactly the nodes and leaves its own walk would, so every answer is
+// trace_any_wide8's; what the rays share is the pops, the reads of the
+// nodes and the branches. For rays that take nearly the same path: the four
+// points of a quad to one light.
+template <class Kernel>
+__attribute__((target("avx2"), always_inline)) inline unsigned wide8_walk4(Kernel& kernel,
+                                                                          const WideBvhNode8* nodes,
+                                                                          const WideLeaf* leaves,
+                                                                          const RayPacket4& packet) {
+    const unsigned valid = packet.valid & 0xFu;
+    Wide8Ray rays[4];
+    WideRay sheared[4];
+    unsigned has_shear = 0u;
+    for (unsigned todo = valid; todo != 0u; todo &= todo - 1u) {
+        const unsigned r = unsigned(__builtin_ctz(todo));
+        rays[r] = wide8_ray(kernel, packet.org[r], packet.dir[r], packet.t_max[r]);
+    }
+    std::uint32_t stack[7u * gpu::kBvhStackSize + 8u];
+    std::uint8_t stack_rays[7u * gpu::kBvhStackSize + 8u];
+    std::uint32_t sp = 0;
+    stack[sp] = 0u;
+    stack_rays[sp++] = std::uint8_t(valid);
+    unsigned blocked = 0u;
+    while (sp > 0u) {
+        --sp;
+        const unsigned active = stack_rays[sp] & ~blocked;
+        if (active == 0u) continue;
+        const WideBvhNode8& node = nodes[stack[sp]];
+        unsigned masks[4] = {0u, 0u, 0u, 0u};
+        unsigned any = 0u;
+        for (unsigned todo = active; todo != 0u; todo &= todo - 1u) {
+            const unsigned r = unsigned(__builtin_ctz(todo));
+            masks[r] = wide8_hit_boxes(node, rays[r]);
+            any |= masks[r];
+        }
+        while (any != 0u) {
+            const unsigned s = unsigned(__builtin_ctz(any));
+            any &= any - 1u;
+            const unsigned entered = ((masks[0] >> s) & 1u) | ((masks[1] >> s) & 1u) << 1 |
+                                     ((masks[2] >> s) & 1u) << 2 | ((masks[3] >> s) & 1u) << 3;
+            const std::int32_t count = node.count[s];
+            if (count == 0) {
+                stack[sp] = node.child[s];
+                stack_rays[sp++] = std::uint8_t(entered);
+                continue;
+            }
+            for (unsigned todo = entered & ~blocked; todo != 0u; todo &= todo - 1u) {
+                const unsigned r = unsigned(__builtin_ctz(todo));
+                if ((has_shear >> r & 1u) == 0u) {
+                    wide_ray_shear(kernel, packet.org[r], packet.dir[r], packet.t_max[r], sheared[r]);
+                    has_shear |= 1u << r;
+                }
+                if (wide_hit_leaf(leaves[node.child[s]], count, sheared[r])) blocked |= 1u << r;
+            }
+            if (blocked == valid) return blocked;
+        }
+    }
+    return blocked;
 }
 
 // The walk for AVX2 CPUs.
@@ -267,6 +358,21 @@ __attribute__((target("avx2,avx512f,avx512vl"))) bool trace_any_wide8_avx512(Ker
     return wide8_walk(kernel, nodes, leaves, org, dir, t_max);
 }
 
+// wide8_walk4 for AVX2 and for AVX-512VL CPUs.
+template <class Kernel>
+__attribute__((target("avx2"))) unsigned trace_any_wide8x4_avx2(Kernel& kernel, const WideBvhNode8* nodes,
+                                                                 const WideLeaf* leaves, const RayPacket4& packet) {
+    return wide8_walk4(kernel, nodes, leaves, packet);
+}
+
+template <class Kernel>
+__attribute__((target("avx2,avx512f,avx512vl"))) unsigned trace_any_wide8x4_avx512(Kernel& kernel,
+                                                                                    const WideBvhNode8* nodes,
+                                                                                    const WideLeaf* leaves,
+                                                                                    const RayPacket4& packet) {
+    return wide8_walk4(kernel, nodes, leaves, packet);
+}
+
 // The 8-wide walk for this CPU: only where cpu_has_avx2().
 template <class Kernel>
 bool trace_any_wide8(Kernel& kernel, const WideBvhNode8* nodes, const WideLeaf* leaves, glm::vec3 org, glm::vec3 dir,
@@ -293,16 +399,6 @@ struct PacketBounds {
 };
 #endif
 
-// Up to four rays: ray r from org[r] along dir[r], for t in (0, t_max[r]),
-// where bit r of `valid` is set. (One struct by reference: with the three
-// arrays as separate pointer parameters, GCC 12.2 at -O3 dropped a caller's
-// stores to them as dead; -fno-ipa-modref or -fno-tree-dse kept them.)
-struct RayPacket4 {
-    glm::vec3 org[4];
-    glm::vec3 dir[4];
-    float t_max[4];
-    unsigned valid = 0u;
-};
 
 #if defined(__SSE2__)
 // The packet's PacketBounds, if it is coherent: its rays leave one point in

@@ -532,6 +532,63 @@ TEST(Bvh, PacketsOfFourGiveEachRaysAnswer) {
     EXPECT_LT(blocked, rays - rays / 10);
 }
 
+// trace_any_wide8x4: four rays from four points (a quad's points to one
+// light, or anywhere), some of them not in the packet, each answered as its
+// own walk would, in both builds this CPU runs.
+TEST(Bvh, EightWidePacketsFromFourPointsGiveEachRaysAnswer) {
+#if defined(LC_WIDE8_TRACE)
+    if (!lc::cpu::cpu_has_avx2()) GTEST_SKIP() << "this CPU has no AVX2: the 8-wide walk is not used";
+    std::mt19937 rng(20261202u);
+    GridCube cube = traversal_cube();
+    const Scene scene(traversal_triangles(rng, cube));
+    lc::cpu::TraceKernel k = scene.kernel();
+    std::uniform_real_distribution<float> u01(0.0f, 1.0f), box(-15.0f, 15.0f), inner(-0.35f, 0.35f);
+    int failures = 0, blocked = 0, rays = 0, mixed = 0;
+    std::string first_failure;
+    for (int packet_index = 0; packet_index < 4000; ++packet_index) {
+        const bool in_cube = packet_index % 4 == 3;
+        const vec3 centre = in_cube
+                                ? cube.center + cube.rotation * (vec3(inner(rng), inner(rng), inner(rng)) * cube.size)
+                                : vec3(box(rng) + 10.0f, box(rng), box(rng));
+        const float spread = std::pow(10.0f, -3.0f * u01(rng));
+        const vec3 target = in_cube ? cube.random_edge_point(rng).first : centre + 30.0f * random_unit(rng);
+        lc::cpu::RayPacket4 packet;
+        for (int j = 0; j < 4; ++j) {
+            packet.org[j] = centre + (in_cube ? 0.01f : spread) * random_unit(rng);
+            const bool to_target = packet_index % 3 != 0;
+            packet.dir[j] = to_target ? target - packet.org[j] : random_unit(rng);
+            packet.t_max[j] = to_target ? (u01(rng) < 0.5f ? 0.999f : kRayInfinity)
+                                        : (u01(rng) < 0.5f ? kRayInfinity : 30.0f * u01(rng));
+        }
+        packet.valid = packet_index % 8 == 5 ? 1u + unsigned(u01(rng) * 14.99f) : 15u;
+        const unsigned valid = packet.valid;
+        unsigned expected = 0u;
+        for (int j = 0; j < 4; ++j)
+            if ((valid >> j & 1u) != 0u && brute_any(scene, packet.org[j], packet.dir[j], packet.t_max[j]))
+                expected |= 1u << j;
+        rays += __builtin_popcount(valid);
+        blocked += __builtin_popcount(expected);
+        mixed += expected != 0u && expected != valid;
+        auto check = [&](const char* build, unsigned got) {
+            if (got != expected && failures++ == 0)
+                first_failure = std::string(build) + ", packet " + std::to_string(packet_index) + ": blocked " +
+                                std::to_string(got) + ", brute force " + std::to_string(expected);
+        };
+        check("AVX2", lc::cpu::trace_any_wide8x4_avx2(k, scene.bvh.wide8_nodes.data(), scene.bvh.wide_leaves.data(),
+                                                       packet));
+        if (lc::cpu::cpu_has_avx512vl())
+            check("AVX-512", lc::cpu::trace_any_wide8x4_avx512(k, scene.bvh.wide8_nodes.data(),
+                                                                scene.bvh.wide_leaves.data(), packet));
+    }
+    EXPECT_EQ(failures, 0) << "first: " << first_failure;
+    EXPECT_GT(blocked, rays / 10);
+    EXPECT_LT(blocked, rays - rays / 10);
+    EXPECT_GT(mixed, 100) << "packets whose rays disagree, which a shared answer would get wrong";
+#else
+    GTEST_SKIP() << "no 8-wide walk on this architecture";
+#endif
+}
+
 TEST(Bvh, EmptySceneMissesEverything) {
     std::vector<Triangle> tris;
     std::vector<TriangleNormals> normals;
