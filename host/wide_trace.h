@@ -284,9 +284,13 @@ __attribute__((target("avx2"), always_inline)) inline unsigned wide8_walk4(Kerne
     Wide8Ray rays[4];
     WideRay sheared[4];
     unsigned has_shear = 0u;
-    for (unsigned todo = valid; todo != 0u; todo &= todo - 1u) {
-        const unsigned r = unsigned(__builtin_ctz(todo));
-        rays[r] = wide8_ray(kernel, packet.org[r], packet.dir[r], packet.t_max[r]);
+    // Every slot gets a ray, so that the four box tests below run without
+    // branches: a slot not in the packet repeats the first ray, and its
+    // answers are masked off.
+    const unsigned first = valid != 0u ? unsigned(__builtin_ctz(valid)) : 0u;
+    for (unsigned r = 0; r < 4u; ++r) {
+        const unsigned from = (valid >> r & 1u) != 0u ? r : first;
+        rays[r] = wide8_ray(kernel, packet.org[from], packet.dir[from], packet.t_max[from]);
     }
     std::uint32_t stack[7u * gpu::kBvhStackSize + 8u];
     std::uint8_t stack_rays[7u * gpu::kBvhStackSize + 8u];
@@ -299,13 +303,9 @@ __attribute__((target("avx2"), always_inline)) inline unsigned wide8_walk4(Kerne
         const unsigned active = stack_rays[sp] & ~blocked;
         if (active == 0u) continue;
         const WideBvhNode8& node = nodes[stack[sp]];
-        unsigned masks[4] = {0u, 0u, 0u, 0u};
-        unsigned any = 0u;
-        for (unsigned todo = active; todo != 0u; todo &= todo - 1u) {
-            const unsigned r = unsigned(__builtin_ctz(todo));
-            masks[r] = wide8_hit_boxes(node, rays[r]);
-            any |= masks[r];
-        }
+        unsigned masks[4];
+        for (unsigned r = 0; r < 4u; ++r) masks[r] = wide8_hit_boxes(node, rays[r]) & (0u - (active >> r & 1u));
+        unsigned any = masks[0] | masks[1] | masks[2] | masks[3];
         while (any != 0u) {
             const unsigned s = unsigned(__builtin_ctz(any));
             any &= any - 1u;
