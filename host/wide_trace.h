@@ -191,13 +191,6 @@ inline bool cpu_has_avx2() {
     return has;
 }
 
-// trace_any_wide's answer from the 8-wide tree (lc::WideBvhNode8,
-// collapse_bvh8): one 256-bit slab test checks a node's eight boxes, with
-// lc_hit_box's operations lane by lane (nothing is contracted: the build
-// passes -ffp-contract=off), and leaves are tested with wide_hit_leaf. Fewer
-// levels than the 4-wide tree, so fewer nodes per ray: 1.1 to 1.3 times the
-// rays per second on lightcuts' shadow rays of the shipped room
-// (bench/embree_rays). The body of trace_any_wide8_avx2 and _avx512 below.
 // One ray's constants for the 8-wide slab test, broadcast to the lanes.
 struct Wide8Ray {
     __m256 ox, oy, oz, ix, iy, iz, far_limit;
@@ -233,6 +226,13 @@ __attribute__((target("avx2"), always_inline)) inline unsigned wide8_hit_boxes(c
         _mm256_movemask_ps(_mm256_and_ps(_mm256_cmp_ps(t_near, t_far, _CMP_LE_OQ), _mm256_castsi256_ps(present))));
 }
 
+// trace_any_wide's answer from the 8-wide tree (lc::WideBvhNode8,
+// collapse_bvh8): one 256-bit slab test checks a node's eight boxes, with
+// lc_hit_box's operations lane by lane (nothing is contracted: the build
+// passes -ffp-contract=off), and leaves are tested with wide_hit_leaf. Fewer
+// levels than the 4-wide tree, so fewer nodes per ray: 1.1 to 1.3 times the
+// rays per second on lightcuts' shadow rays of the shipped room
+// (bench/embree_rays). The body of trace_any_wide8_avx2 and _avx512 below.
 template <class Kernel>
 __attribute__((target("avx2"), always_inline)) inline bool wide8_walk(Kernel& kernel, const WideBvhNode8* nodes,
                                                                       const WideLeaf* leaves, glm::vec3 org,
