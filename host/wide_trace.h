@@ -306,11 +306,14 @@ __attribute__((target("avx2"), always_inline)) inline unsigned wide8_walk4(Kerne
         unsigned masks[4];
         for (unsigned r = 0; r < 4u; ++r) masks[r] = wide8_hit_boxes(node, rays[r]) & (0u - (active >> r & 1u));
         unsigned any = masks[0] | masks[1] | masks[2] | masks[3];
+        // Ray r's box bits in byte r: a child's rays are one bit of each
+        // byte, gathered into bits 24-27 by one multiplication (the four
+        // partial products land on distinct bits, so nothing carries).
+        const std::uint32_t by_ray = masks[0] | masks[1] << 8 | masks[2] << 16 | masks[3] << 24;
         while (any != 0u) {
             const unsigned s = unsigned(__builtin_ctz(any));
             any &= any - 1u;
-            const unsigned entered = ((masks[0] >> s) & 1u) | ((masks[1] >> s) & 1u) << 1 |
-                                     ((masks[2] >> s) & 1u) << 2 | ((masks[3] >> s) & 1u) << 3;
+            const unsigned entered = (((by_ray >> s) & 0x01010101u) * 0x01020408u) >> 24 & 0xFu;
             const std::int32_t count = node.count[s];
             if (count == 0) {
                 stack[sp] = node.child[s];
