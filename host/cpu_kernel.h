@@ -323,9 +323,8 @@ struct BasicShadeKernel {
 
     // lc_shade_brute's result, bit for bit, with the shadow rays traced four
     // at a time: a point's rays to consecutive lights, which the tree's
-    // leaf order keeps close together, go through the 4-wide tree as one
-    // packet (trace_any_wide4). The contributions are summed in light order,
-    // as there.
+    // leaf order keeps close together, go down the tree as one packet
+    // (lc_visible4). The contributions are summed in light order, as there.
     vec3 lc_shade_brute_packets(const SurfacePoint& sp, uint light_count, float min_distance2, ShadeStats& stats) {
         if (kRecordRays || wide_nodes == nullptr) return lc_shade_brute(sp, light_count, min_distance2, stats);
         vec3 sum(0.0f);
@@ -334,9 +333,9 @@ struct BasicShadeKernel {
         uint pending = 0u;
         auto trace = [&] {
             packet.valid = (1u << pending) - 1u;
-            const unsigned blocked = kEnableShadows ? trace_any_wide4(*this, wide_nodes, wide_leaves, packet) : 0u;
+            const unsigned visible = lc_visible4(packet);
             for (uint j = 0; j < pending; ++j)
-                if ((blocked >> j & 1u) == 0u) sum += contribution[j];
+                if ((visible >> j & 1u) != 0u) sum += contribution[j];
             pending = 0u;
         };
         for (uint i = 0u; i < light_count; ++i) {
@@ -368,10 +367,12 @@ struct BasicShadeKernel {
                                      : lc_trace_any(org, dir, t_max);
     }
 
-    // lc_visible for up to four rays from their own points (bit r of
-    // packet.valid): bit r of the result is set where ray r is visible.
-    // Each answer is lc_visible's; where the 8-wide tree is bound the rays
-    // go down it together (trace_any_wide8x4), else one at a time.
+    // lc_visible for up to four rays (bit r of packet.valid): bit r of the
+    // result is set where ray r is visible. Each answer is lc_visible's;
+    // the rays go down the 8-wide tree together where it is bound
+    // (trace_any_wide8x4: a quad's points' rays to one light, brute force's
+    // rays from one point to four lights), else through the 4-wide one as a
+    // packet (trace_any_wide4), else one at a time (the ray recorder).
     unsigned lc_visible4(const RayPacket4& packet) {
         const unsigned valid = packet.valid & 0xFu;
         if (!kEnableShadows) return valid;
@@ -380,6 +381,7 @@ struct BasicShadeKernel {
             return valid & ~(cpu_has_avx512vl() ? trace_any_wide8x4_avx512(*this, wide8_nodes, wide_leaves, packet)
                                                 : trace_any_wide8x4_avx2(*this, wide8_nodes, wide_leaves, packet));
 #endif
+        if (!kRecordRays && wide_nodes != nullptr) return valid & ~trace_any_wide4(*this, wide_nodes, wide_leaves, packet);
         unsigned visible = 0u;
         for (unsigned r = 0; r < 4u; ++r) {
             if ((valid >> r & 1u) == 0u) continue;
