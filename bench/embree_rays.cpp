@@ -273,6 +273,36 @@ int run(int argc, char** argv) {
         });
         report("software 4-wide BVH, packets of 4", r.size(), s, total(), reference);
 
+#if defined(LC_WIDE8_TRACE)
+        // Four consecutive rays down the 8-wide tree together, each tested
+        // on its own (trace_any_wide8x4): the renderer's packets, brute
+        // force's four lights from one point and a quad's four points to
+        // one light (the latter are not in these ray lists).
+        if (lc::cpu::cpu_has_avx2()) {
+            std::fill(hits.begin(), hits.end(), 0);
+            s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+                lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
+                std::size_t h = 0;
+                for (std::size_t i = b; i < e; i += 4) {
+                    lc::cpu::RayPacket4 packet;
+                    for (std::size_t j = 0; j < 4 && i + j < e; ++j) {
+                        packet.org[j] = r[i + j].org, packet.dir[j] = r[i + j].dir, packet.t_max[j] = r[i + j].t_max;
+                        packet.valid |= 1u << j;
+                    }
+                    const unsigned got =
+                        lc::cpu::cpu_has_avx512vl()
+                            ? lc::cpu::trace_any_wide8x4_avx512(tk, p.bvh.wide8_nodes.data(),
+                                                                 p.bvh.wide_leaves.data(), packet)
+                            : lc::cpu::trace_any_wide8x4_avx2(tk, p.bvh.wide8_nodes.data(), p.bvh.wide_leaves.data(),
+                                                               packet);
+                    h += unsigned(__builtin_popcount(got));
+                }
+                hits[t] = h;
+            });
+            report("software 8-wide BVH, packets of 4", r.size(), s, total(), reference);
+        }
+#endif
+
         std::fill(hits.begin(), hits.end(), 0);
         s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
             RTCIntersectContext ctx;
