@@ -255,30 +255,9 @@ int run(int argc, char** argv) {
         for (std::uint64_t n : trips) trip_total += n;
         std::printf("    %.2f trips round the kernels' loop per ray\n", double(trip_total) / double(r.size()));
 
-        std::fill(hits.begin(), hits.end(), 0);
-        s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
-            lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
-            std::size_t h = 0;
-            for (std::size_t i = b; i < e; i += 4) {
-                lc::cpu::RayPacket4 packet;
-                for (std::size_t j = 0; j < 4 && i + j < e; ++j) {
-                    packet.org[j] = r[i + j].org, packet.dir[j] = r[i + j].dir, packet.t_max[j] = r[i + j].t_max;
-                    packet.valid |= 1u << j;
-                }
-                const unsigned got =
-                    lc::cpu::trace_any_wide4(tk, p.bvh.wide_nodes.data(), p.bvh.wide_leaves.data(), packet);
-                h += unsigned(__builtin_popcount(got));
-            }
-            hits[t] = h;
-        });
-        report("software 4-wide BVH, packets of 4", r.size(), s, total(), reference);
-
-#if defined(LC_WIDE8_TRACE)
-        // Four consecutive rays down the 8-wide tree together, each tested
-        // on its own (trace_any_wide8x4): the renderer's packets, brute
-        // force's four lights from one point and a quad's four points to
-        // one light (the latter are not in these ray lists).
-        if (lc::cpu::cpu_has_avx2()) {
+        // Consecutive rays four at a time, `trace(kernel, packet)` giving the
+        // blocked ones.
+        auto packets = [&](const char* what, auto trace) {
             std::fill(hits.begin(), hits.end(), 0);
             s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
                 lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
@@ -289,18 +268,28 @@ int run(int argc, char** argv) {
                         packet.org[j] = r[i + j].org, packet.dir[j] = r[i + j].dir, packet.t_max[j] = r[i + j].t_max;
                         packet.valid |= 1u << j;
                     }
-                    const unsigned got =
-                        lc::cpu::cpu_has_avx512vl()
-                            ? lc::cpu::trace_any_wide8x4_avx512(tk, p.bvh.wide8_nodes.data(),
-                                                                 p.bvh.wide_leaves.data(), packet)
-                            : lc::cpu::trace_any_wide8x4_avx2(tk, p.bvh.wide8_nodes.data(), p.bvh.wide_leaves.data(),
-                                                               packet);
-                    h += unsigned(__builtin_popcount(got));
+                    h += unsigned(__builtin_popcount(trace(tk, packet)));
                 }
                 hits[t] = h;
             });
-            report("software 8-wide BVH, packets of 4", r.size(), s, total(), reference);
-        }
+            report(what, r.size(), s, total(), reference);
+        };
+        packets("software 4-wide BVH, packets of 4", [&](lc::cpu::TraceKernel& tk, const lc::cpu::RayPacket4& packet) {
+            return lc::cpu::trace_any_wide4(tk, p.bvh.wide_nodes.data(), p.bvh.wide_leaves.data(), packet);
+        });
+#if defined(LC_WIDE8_TRACE)
+        // Four consecutive rays down the 8-wide tree together, each tested
+        // on its own (trace_any_wide8x4): the renderer's packets, brute
+        // force's four lights from one point and a quad's four points to
+        // one light (the latter are not in these ray lists).
+        if (lc::cpu::cpu_has_avx2())
+            packets("software 8-wide BVH, packets of 4", [&](lc::cpu::TraceKernel& tk, const lc::cpu::RayPacket4& packet) {
+                return lc::cpu::cpu_has_avx512vl()
+                           ? lc::cpu::trace_any_wide8x4_avx512(tk, p.bvh.wide8_nodes.data(), p.bvh.wide_leaves.data(),
+                                                                packet)
+                           : lc::cpu::trace_any_wide8x4_avx2(tk, p.bvh.wide8_nodes.data(), p.bvh.wide_leaves.data(),
+                                                              packet);
+            });
 #endif
 
         std::fill(hits.begin(), hits.end(), 0);
