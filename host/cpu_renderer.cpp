@@ -167,10 +167,8 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     // the union of four points' refinements froze far more: on the stress
     // tests' million lights the error against brute force was 0.0259,
     // against a cut per pixel's 0.0169; pooled, 0.0140.
-    const std::uint32_t heap_slots = prepared.tree.cut_heap_slots(
-        frame.max_cut, quads ? std::uint32_t(std::min<std::uint64_t>(std::uint64_t(cpu::kQuadLanes) * options.cut_heap,
-                                                                     std::numeric_limits<std::uint32_t>::max()))
-                             : options.cut_heap);
+    const std::uint32_t heap_slots =
+        prepared.tree.cut_heap_slots(frame.max_cut, quads ? quad_cut_heap(options.cut_heap) : options.cut_heap);
     for (Worker& w : workers) {
         w.heap = cpu::CutHeap(lightcuts && !quads ? heap_slots : 0);
         w.quad_heap = cpu::QuadHeap(quads ? heap_slots : 0);

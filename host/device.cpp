@@ -26,14 +26,10 @@ RenderResult render(const PreparedScene& prepared, const RenderOptions& options,
     if (choice.device == "cpu") return render_cpu(prepared, options);
     if (choice.device == "vulkan") return render_vulkan(prepared, options, choice.vulkan);
 
-    // auto: the path tracer and quad-shared cuts run on the CPU only.
-    // Otherwise a named device is always tried, and only real GPU hardware
-    // beats the CPU path (lavapipe on the same cores is several times slower).
+    // auto: the path tracer runs on the CPU only. Otherwise a named device
+    // is always tried, and only real GPU hardware beats the CPU path
+    // (lavapipe on the same cores is several times slower).
     if (options.method == "path") return render_cpu(prepared, options);
-    if (options.method == "lightcuts" && options.cut_sharing == "quad") {
-        say(choice, "cut_sharing \"quad\" runs on the CPU only; rendering on the CPU");
-        return render_cpu(prepared, options);
-    }
     if (choice.vulkan.gpu.empty()) {
         const VulkanDevices found = choice.devices.valid() ? choice.devices.get() : find_vulkan_devices();
         if (!found.hardware) {
@@ -46,6 +42,12 @@ RenderResult render(const PreparedScene& prepared, const RenderOptions& options,
     try {
         return render_vulkan(prepared, options, choice.vulkan);
     } catch (const NoVulkanDevice& e) {
+        say(choice, std::string(e.what()) + "; rendering on the CPU");
+        return render_cpu(prepared, options);
+    } catch (const std::invalid_argument& e) {
+        // The options are valid (render_vulkan checks them first, as the
+        // CPU would), so what the device refused is cut_sharing "quad".
+        if (!(method_selects_cuts(options.method) && options.cut_sharing == "quad")) throw;
         say(choice, std::string(e.what()) + "; rendering on the CPU");
         return render_cpu(prepared, options);
     }

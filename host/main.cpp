@@ -103,7 +103,7 @@ int run_render(RenderArgs a) {
     // installed): that is done while the scene loads. Unless the command
     // line already rules Vulkan out (the scene's render block may still do
     // so; the answer then goes unread).
-    if (a.device.device == "auto" && a.device.vulkan.gpu.empty() && a.method != "path" && a.cut_sharing != "quad")
+    if (a.device.device == "auto" && a.device.vulkan.gpu.empty() && a.method != "path")
         a.device.devices = std::async(std::launch::async, lc::find_vulkan_devices).share();
     const auto start = std::chrono::steady_clock::now();
     lc::Scene scene = lc::load_scene(a.scene, a.scene_options);

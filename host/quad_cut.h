@@ -96,7 +96,8 @@ public:
         cut_indirect_ = f_.roots[kLightVpl] != kInvalidIndex ? 1u : 0u;
         frozen_ = 0u;
         hit_max_cut_ = 0u;
-        root_bounds_ = 0.0;
+        root_bounds_ = 0.0f;
+        float root_quarters[kQuadLanes] = {};  // each point's finite root bounds, a quarter of each, summed
         for (uint type = 0u; type < kLightTypeCount; ++type) {
             if (f_.roots[type] == kInvalidIndex) continue;
             const LightNode& root = k_.light_nodes[f_.roots[type]];
@@ -112,7 +113,8 @@ public:
                 }
             }
             for (uint p = 0; p < kQuadLanes; ++p)
-                if (e.error[p] > 0.0f && std::isfinite(e.error[p])) root_bounds_ += double(e.error[p]);
+                if (e.error[p] > 0.0f && !std::isinf(e.error[p])) root_quarters[p] += e.error[p] * 0.25f;
+            root_bounds_ = quad_sum(root_quarters);
             if (enter(root, e)) {
                 update_weights();
                 push(key_of(e), slot);
@@ -183,21 +185,25 @@ private:
     // instead of to Walter's bound > 0. The floor scales with the lights,
     // so scaling every light by a power of two leaves the keys, and so the
     // cuts, unchanged.
-    // (The sum is taken in double and the floor kept within the normal
-    // floats: a sum past the float range, or one whose 2^-20 underflows,
-    // still gives weights that order and test the bounds. A point whose
-    // estimate is not finite adds nothing to the sum.)
+    // The sum is the Vulkan kernel's (shaders/quadcuts.comp), bit for bit:
+    // in float, each term a quarter of its estimate (four of them cannot
+    // pass the float range), added (0 + 1) + (2 + 3) as its quad swaps add
+    // them, and the floor kept within the normal floats. A point whose
+    // estimate is not finite adds nothing to the sum.
     void update_weights() {
-        float estimate[kQuadLanes];
-        double total = 0.0;
+        float estimate[kQuadLanes], quarter[kQuadLanes];
+        bool any = false;
         for (uint p = 0; p < kQuadLanes; ++p) {
             estimate[p] = lc_luminance(fixed_[p] + heap_sum_[p]);
-            if (estimate[p] > 0.0f && std::isfinite(estimate[p])) total += double(estimate[p]);
+            const bool counts = estimate[p] > 0.0f && !std::isinf(estimate[p]);
+            quarter[p] = counts ? estimate[p] * 0.25f : 0.0f;
+            any = any || counts;
         }
-        if (!(total > 0.0)) total = root_bounds_;
-        const float floor = float(std::clamp(total * 0x1p-20, double(FLT_MIN), double(FLT_MAX)));
+        const float total = any ? quad_sum(quarter) : root_bounds_;
+        const float floor = std::clamp(total * 0x1p-18f, FLT_MIN, FLT_MAX);
         for (uint p = 0; p < kQuadLanes; ++p) weight_[p] = 1.0f / std::max(estimate[p], floor);
     }
+    static float quad_sum(const float* v) { return (v[0] + v[1]) + (v[2] + v[3]); }
     // A cluster's key in the heap: its largest ratio of bound to estimate
     // over the points, at most FLT_MAX. A NaN bound is passed over, as
     // Walter's test never refines it.
@@ -407,7 +413,7 @@ private:
     vec3 heap_sum_[kQuadLanes];  // ... and the running sum of the heap's
     float weight_[kQuadLanes];   // update_weights
     float frozen_error_[kQuadLanes];
-    double root_bounds_ = 0.0;  // the roots' finite bounds summed over the points (update_weights)
+    float root_bounds_ = 0.0f;  // a quarter of the roots' finite bounds, summed over the points (update_weights)
     uint cut_size_ = 0u, cut_indirect_ = 0u, frozen_ = 0u, hit_max_cut_ = 0u;
 };
 

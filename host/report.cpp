@@ -86,7 +86,8 @@ std::string lightcuts_text(const RenderReport& r, const LightcutsReport& l) {
     if (r.device != "cpu") {
         const std::string where =
             l.heap_private ? format("cut heap in private memory: %s per invocation",
-                                    human_bytes(std::uint64_t(l.heap_slots) * sizeof(gpu::CutEntry)).c_str())
+                                    human_bytes(std::uint64_t(l.heap_slots) * (l.quad_cuts ? sizeof(gpu::QuadCutEntry)
+                                                                                : sizeof(gpu::CutEntry))).c_str())
                            : format("cut heap in shared memory: %s per workgroup of %u",
                                     human_bytes(l.heap_bytes).c_str(), l.workgroup_size);
         text += format("  %s; %llu samples (%.2f%%) paused it in global memory between dispatches\n", where.c_str(),

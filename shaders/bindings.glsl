@@ -114,6 +114,15 @@ uint lc_tile_row(uint i, uint width, uint height) {
     return 2u * pair + (2u * pair + 1u < height ? (i & 1u) : 0u);
 }
 
+// The inverse: the index of the tile pixel at (x, y) of the tile.
+#ifdef __cplusplus
+inline
+#endif
+uint lc_tile_index(uint x, uint y, uint width, uint height) {
+    uint pair = y / 2u;
+    return 2u * pair + 1u < height ? pair * 2u * width + 2u * x + (y & 1u) : pair * 2u * width + x;
+}
+
 #ifdef __cplusplus
 inline std::uint64_t count64(uint lo, uint hi) { return std::uint64_t(hi) << 32 | lo; }
 #else
@@ -131,6 +140,10 @@ void lc_count_add(inout uint lo, inout uint hi, uint v) {
 LC_CONST uint kCutDone = 1u;       // result added to the pixel; later dispatches skip it
 LC_CONST uint kCutFroze = 2u;      // the cut froze clusters out of a full heap
 LC_CONST uint kCutSelected = 4u;   // stochastic: the cut is final; its clusters are being shaded
+LC_CONST uint kCutFreshKeys = 8u;  // quadcuts.comp: the heap's keys are from the current estimates
+// quadcuts.comp keeps a quad's cut in the same record, one per lane: `shaded`
+// holds the bits of the quad's summed root bounds, `draw` those of the
+// lane's weight (host/quad_cut.h, update_weights).
 struct CutState {
     uint heap_size;
     uint cut_size;

@@ -19,22 +19,31 @@
 
 #extension GL_EXT_control_flow_attributes : require
 
+// The entry and the field that orders the heap: CutEntry by its error, or
+// what the includer defines first (quadcuts.comp: QuadCutEntry by its key).
+#ifndef LC_HEAP_ENTRY
+#define LC_HEAP_ENTRY CutEntry
+#endif
+#ifndef LC_HEAP_ORDER
+#define LC_HEAP_ORDER error
+#endif
+
 layout(constant_id = kSpecHeapSlots) const uint kHeapSlots = 1u;
 layout(constant_id = kSpecHeapPrivate) const bool kHeapPrivate = false;
 
-layout(std430, binding = kBindingHeapSave) buffer HeapSave { CutEntry heap_save[]; };
+layout(std430, binding = kBindingHeapSave) buffer HeapSave { LC_HEAP_ENTRY heap_save[]; };
 
 // Slot-major, so neighbouring invocations touch neighbouring entries. The
 // array that is not used has one entry.
-shared CutEntry s_heap[kHeapPrivate ? 1u : kHeapSlots * gl_WorkGroupSize.x];
-CutEntry p_heap[kHeapPrivate ? kHeapSlots : 1u];
+shared LC_HEAP_ENTRY s_heap[kHeapPrivate ? 1u : kHeapSlots * gl_WorkGroupSize.x];
+LC_HEAP_ENTRY p_heap[kHeapPrivate ? kHeapSlots : 1u];
 
 uint lc_shared_slot(uint slot) { return slot * gl_WorkGroupSize.x + gl_LocalInvocationIndex; }
 uint lc_saved_slot(uint slot) { return slot * push.heap_save_stride + gl_GlobalInvocationID.x; }
 
-CutEntry lc_heap_load(uint slot) { return kHeapPrivate ? p_heap[slot] : s_heap[lc_shared_slot(slot)]; }
+LC_HEAP_ENTRY lc_heap_load(uint slot) { return kHeapPrivate ? p_heap[slot] : s_heap[lc_shared_slot(slot)]; }
 
-void lc_heap_store(uint slot, CutEntry e) {
+void lc_heap_store(uint slot, LC_HEAP_ENTRY e) {
     if (kHeapPrivate) {
         p_heap[slot] = e;
     } else {
@@ -65,7 +74,7 @@ uint lc_heap_smallest_full(uint from, uint to, float bound) {
     uint smallest = kInvalidIndex;
     float smallest_error = bound;
     [[unroll]] for (uint i = kHeapSlots / 2u; i < kHeapSlots; ++i) {
-        float error = lc_heap_load(i).error;
+        float error = lc_heap_load(i).LC_HEAP_ORDER;
         bool smaller = error < smallest_error; // false for a NaN error, as in the loop
         smallest = smaller ? i : smallest;
         smallest_error = smaller ? error : smallest_error;
@@ -73,7 +82,7 @@ uint lc_heap_smallest_full(uint from, uint to, float bound) {
     return smallest;
 }
 
-#define HeapEntry CutEntry
+#define HeapEntry LC_HEAP_ENTRY
 #define LC_HEAP_SMALLEST(from, to, bound) lc_heap_smallest_full(from, to, bound)
 #define LC_HEAP_LOAD(i) lc_heap_load(i)
 #define LC_HEAP_STORE(i, e) lc_heap_store(i, e)

@@ -148,7 +148,16 @@ for bad in "--max-bounces=1025" "--vpl-bounces=-1"; do
 for bad in "--vpl-clamp=-0.5" "--time-limit=nan" "--time-limit=-1"; do
   expect_error "must be a finite number, 0 or more" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
 expect_error "method path (the path tracer) runs on the CPU only" render "$mini" -o "$tmp/edge2.exr" --method path --device vulkan
-expect_error 'cut_sharing "quad" runs on the CPU only' render "$mini" -o "$tmp/edge2.exr" --method lightcuts --cut-sharing quad --device vulkan
+# Cuts shared by quads on Vulkan (quadcuts.comp), and the message where
+# the quad's heap cannot fit the device's shared memory.
+if "$exe" render "$mini" -o "$tmp/vq.exr" --no-png --width 5 --height 3 --method lightcuts --cut-sharing quad \
+     --device vulkan --stats "$tmp/vq.json" >"$tmp/vq.txt" 2>&1; then
+  grep '"cut_sharing": "quad"' "$tmp/vq.json" >/dev/null || fail "--cut-sharing quad --device vulkan: the stats do not say quad"
+  LC_VK_HEAP_MEMORY=shared expect_error 'cut_sharing "quad" on ' render "$root/scenes/room/room.json" \
+    -o "$tmp/edge2.exr" --width 2 --height 2 --method lightcuts --cut-sharing quad --device vulkan
+elif ! grep "no Vulkan device" "$tmp/vq.txt" >/dev/null || [ -n "${LC_REQUIRE_VULKAN:-}" ]; then
+  fail "--cut-sharing quad --device vulkan: $(cat "$tmp/vq.txt")"
+fi
 expect_error '--cut-sharing: must be "auto", "pixel" or "quad", got "tiles"' render "$mini" -o "$tmp/edge2.exr" --cut-sharing tiles
 expect_error '--method: must be "brute", "lightcuts", "sampled", "stochastic" or "path", got "fast"' render "$mini" -o "$tmp/edge2.exr" --method fast
 expect_error '--light-pick: must be "tree", "uniform" or "power", got "random"' render "$mini" -o "$tmp/edge2.exr" --light-pick random

@@ -25,6 +25,13 @@ gpu::FrameParams frame_params(const Context& ctx, const PreparedScene& prepared,
 // presplit_on_llvmpipe).
 Tuning device_tuning(const Context& ctx, Tuning tuning);
 
+// Whether Lightcuts shares each cut between the pixels of a 2x2 quad
+// (quadcuts.comp): cut_sharing "quad", where the device has subgroup quad
+// operations and the quad's heap fits, else std::invalid_argument saying
+// why. "auto" is "pixel" on Vulkan.
+bool share_cuts(const Context& ctx, const LightTree& tree, const RenderOptions& options,
+                const gpu::FrameParams& frame, const Tuning& tuning);
+
 // The smallest tile worth a pass on this device: one pixel on a GPU; on a
 // CPU device enough workgroups to keep each of its threads busy.
 std::uint32_t min_tile_pixels(const Context& ctx);

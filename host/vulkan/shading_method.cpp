@@ -7,6 +7,7 @@
 
 #include "spirv/brute.h"
 #include "spirv/lightcuts.h"
+#include "spirv/quadcuts.h"
 #include "spirv/sampled.h"
 
 namespace lc::vk {
@@ -60,25 +61,27 @@ constexpr std::uint32_t kFirstRefineBudget = 128;
 class Lightcuts final : public ShadingMethod {
 public:
     Lightcuts(const gpu::FrameParams& frame, const LightTree& tree, const Tuning& tuning,
-              std::uint32_t cut_heap, std::uint32_t shared_memory_bytes, bool stochastic)
-        : stochastic_(stochastic) {
+              std::uint32_t cut_heap, std::uint32_t shared_memory_bytes, bool stochastic, bool quads)
+        : stochastic_(stochastic), quads_(quads) {
         // Walter 2005 §4 keeps a max-heap of the refinable clusters of the
         // cut, here bounded by K = render.cut_heap (shared/lightcuts.h,
-        // lc_heap_push); the tree bounds it too, whatever max_cut says. All
-        // K slots of every invocation live in shared memory, which limits
-        // K, or (Tuning::heap_memory, CPU devices) in each invocation's own
-        // private array, which does not.
-        heap_slots_ = tree.cut_heap_slots(frame.max_cut, cut_heap);
-        const std::uint64_t bytes =
-            std::uint64_t(heap_slots_) * gpu::kWorkgroupSize * sizeof(gpu::CutEntry);
+        // lc_heap_push); the tree bounds it too, whatever max_cut says. A
+        // quad's shared cut pools its four points' K, as on the CPU
+        // (host/cpu_renderer.cpp), and each of its lanes holds all of it
+        // (quadcuts.comp). All slots of every invocation live in shared
+        // memory, which limits K, or (Tuning::heap_memory, CPU devices) in
+        // each invocation's own private array, which does not.
+        heap_slots_ = tree.cut_heap_slots(frame.max_cut, quads ? quad_cut_heap(cut_heap) : cut_heap);
+        const std::uint64_t bytes = std::uint64_t(heap_slots_) * gpu::kWorkgroupSize * entry_bytes();
         if (tuning.heap_memory != Tuning::HeapMemory::kPrivate && bytes > shared_memory_bytes)
             throw std::runtime_error(
-                "cut_heap " + std::to_string(cut_heap) + " needs " + std::to_string(bytes) +
-                " bytes of shared memory per workgroup (" + std::to_string(gpu::kWorkgroupSize) +
-                " invocations x " + std::to_string(heap_slots_) + " slots x " +
-                std::to_string(sizeof(gpu::CutEntry)) + " bytes); the Vulkan device offers " +
+                "cut_heap " + std::to_string(cut_heap) + std::string(quads ? " shared by quads" : "") + " needs " +
+                std::to_string(bytes) + " bytes of shared memory per workgroup (" +
+                std::to_string(gpu::kWorkgroupSize) + " invocations x " + std::to_string(heap_slots_) +
+                " slots x " + std::to_string(entry_bytes()) + " bytes); the Vulkan device offers " +
                 std::to_string(shared_memory_bytes) + ", so at most cut_heap " +
-                std::to_string(shared_memory_bytes / (gpu::kWorkgroupSize * sizeof(gpu::CutEntry))));
+                std::to_string(shared_memory_bytes / (gpu::kWorkgroupSize * entry_bytes()) / (quads ? 4u : 1u)) +
+                (quads ? " (or cut_sharing \"pixel\")" : ""));
         // A refinement adds one cluster to the cut and takes one interior
         // node off the heap for good, so a cut never sees more refinements
         // than either allows.
@@ -91,14 +94,19 @@ public:
             budget_ = tuning.refinements_per_dispatch;
     }
 
+    std::size_t entry_bytes() const { return quads_ ? sizeof(gpu::QuadCutEntry) : sizeof(gpu::CutEntry); }
+
     KernelCode kernel() const override {
+        if (quads_) return {lc_spirv_quadcuts, sizeof lc_spirv_quadcuts, "quadcuts.comp (cuts shared by quads)"};
         return {lc_spirv_lightcuts, sizeof lc_spirv_lightcuts,
                 stochastic_ ? "lightcuts.comp (stochastic lightcuts)" : "lightcuts.comp (cut selection + shading)"};
     }
     bool stochastic() const override { return stochastic_; }
+    bool quad_cuts() const override { return quads_; }
     std::uint32_t heap_slots() const override { return heap_slots_; }
+    std::uint32_t heap_entry_bytes() const override { return std::uint32_t(entry_bytes()); }
     TileBuffer heap_save() const override {
-        return {"heap save", std::uint64_t(heap_slots_) * sizeof(gpu::CutEntry),
+        return {"heap save", std::uint64_t(heap_slots_) * entry_bytes(),
                 std::to_string(heap_slots_) + " heap slots per pixel"};
     }
     TileBuffer cut_state() const override { return {"cut state", sizeof(gpu::CutState), ""}; }
@@ -124,6 +132,7 @@ public:
 
 private:
     bool stochastic_;
+    bool quads_;
     std::uint32_t heap_slots_ = 0;
     std::uint64_t max_steps_ = 0;
     std::uint32_t budget_ = gpu::kUnlimitedRefinements;  // refinements per dispatch
@@ -134,10 +143,10 @@ private:
 std::unique_ptr<ShadingMethod> make_shading_method(const RenderOptions& options,
                                                    const gpu::FrameParams& frame,
                                                    const LightTree& tree, const Tuning& tuning,
-                                                   std::uint32_t shared_memory_bytes) {
+                                                   std::uint32_t shared_memory_bytes, bool quads) {
     if (method_selects_cuts(options.method))
         return std::make_unique<Lightcuts>(frame, tree, tuning, options.cut_heap, shared_memory_bytes,
-                                           options.method == "stochastic");
+                                           options.method == "stochastic", quads);
     if (options.method == "sampled")
         return std::make_unique<RangedMethod>(
             KernelCode{lc_spirv_sampled, sizeof lc_spirv_sampled, "sampled.comp (light samples)"},

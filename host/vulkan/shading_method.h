@@ -48,6 +48,16 @@ public:
     virtual bool reports_cuts() const { return false; }
     // The kernel's kSpecStochastic (lightcuts.comp only).
     virtual bool stochastic() const { return false; }
+    // Bytes of one heap slot (CutEntry, or QuadCutEntry for quads).
+    virtual std::uint32_t heap_entry_bytes() const { return sizeof(gpu::CutEntry); }
+    // True when the kernel shares each cut between the four pixels of a
+    // 2x2 quad (quadcuts.comp): tiles then start at even pixels, and the
+    // shading dispatch has one invocation per quad lane.
+    virtual bool quad_cuts() const { return false; }
+    // Shading invocations for a tile of width x height pixels.
+    std::uint32_t invocations(std::uint32_t width, std::uint32_t height) const {
+        return quad_cuts() ? 4u * ((width + 1u) / 2u) * ((height + 1u) / 2u) : width * height;
+    }
 
     // Dispatches one sample's shading takes with the current split.
     virtual std::uint32_t dispatch_count() const = 0;
@@ -61,10 +71,11 @@ public:
 
 // "brute", "lightcuts", "sampled" or "stochastic" (options.method, already
 // validated).
-// `shared_memory_bytes` is the device's maxComputeSharedMemorySize.
+// `shared_memory_bytes` is the device's maxComputeSharedMemorySize; `quads`
+// selects quadcuts.comp for "lightcuts".
 std::unique_ptr<ShadingMethod> make_shading_method(const RenderOptions& options,
                                                    const gpu::FrameParams& frame,
                                                    const LightTree& tree, const Tuning& tuning,
-                                                   std::uint32_t shared_memory_bytes);
+                                                   std::uint32_t shared_memory_bytes, bool quads);
 
 }  // namespace lc::vk

@@ -103,7 +103,10 @@ void TilePass::record(VkCommandBuffer cmd, const gpu::PushConstants& tile, bool 
     // Shading reads the G-buffer the camera-ray kernel just wrote and adds
     // to the pixel flags it may have set.
     barrier(cmd, kCompute, VK_ACCESS_SHADER_WRITE_BIT, kCompute, kShaderReadWrite);
-    record_shading(cmd, push, groups);
+    const std::uint32_t shading_groups =
+        (method_.invocations(tile.tile_width, tile.tile_height) + gpu::kWorkgroupSize - 1) / gpu::kWorkgroupSize;
+    push.group_stride = spread_groups_ ? workgroup_stride(shading_groups) : 1u;
+    record_shading(cmd, push, shading_groups);
     if (last) record_readback(cmd, pixels);
 }
 

@@ -26,17 +26,27 @@ TileScheduler::TileScheduler(std::string device_name, Submitter& submitter, Tile
 // the first dispatch short on any device, and a pass that the driver's loop
 // limit spoils cheap. A tile never drops below min_tile_pixels (a CPU
 // device's threads each need workgroups) unless the buffers say so.
+//
+// Cuts shared by quads (ShadingMethod::quad_cuts) need every tile to start
+// at an even pixel, so tiles are then an even number of pixels wide and
+// high but at the image's last column and row; a tile's quad invocations,
+// its size rounded up to even, must fit the tile buffers' invocations.
 void TileScheduler::render(RenderResult& result) {
     const std::uint32_t width = frame_.width, height = frame_.height;
     const std::uint32_t max_pixels = resources_.tiles().max_pixels;
+    const bool quads = method_.quad_cuts();
+    const auto even = [quads](std::uint32_t v) { return quads ? std::max(2u, v & ~1u) : v; };
+    const auto rounded_up = [quads](std::uint32_t v) { return quads ? (v + 1u) & ~1u : v; };
     samples_total_ = std::uint64_t(width) * height * frame_.spp;
     double budget = std::min<double>(std::max(4 * gpu::kWorkgroupSize, min_tile_pixels_), max_pixels);
     for (std::uint32_t y0 = 0; y0 < height;) {
         const std::uint32_t band = std::min<std::uint32_t>(
-            height - y0, std::max<std::uint32_t>(1, std::uint32_t(std::sqrt(budget))));
+            height - y0, even(std::max<std::uint32_t>(1, std::uint32_t(std::sqrt(budget)))));
         for (std::uint32_t x0 = 0; x0 < width;) {
-            std::uint32_t w = std::max<std::uint32_t>(1, std::uint32_t(budget / band));
-            w = std::min({w, width - x0, std::max<std::uint32_t>(1, max_pixels / band)});
+            std::uint32_t w = even(std::max<std::uint32_t>(1, std::uint32_t(budget / band)));
+            std::uint32_t fit = std::max<std::uint32_t>(1, max_pixels / band);
+            if (quads) fit = even(std::min(fit, resources_.tiles().invocations / rounded_up(band)));
+            w = std::min({w, width - x0, fit});
             const double ms = render_tile({x0, y0, w, band}, result);
             budget = next_budget(budget, double(w) * band, ms);
             x0 += w;

@@ -42,6 +42,20 @@ bool driver_limits_loops(const Context& ctx) {
     return driver.driverID == VK_DRIVER_ID_MESA_LLVMPIPE;
 }
 
+// Whether the device can run quadcuts.comp: subgroup quad operations in
+// compute shaders, in subgroups of at least four invocations that divide
+// the workgroup (so that each quad's four lanes are a subgroup quad).
+bool device_has_quad_subgroups(const Context& ctx) {
+    if (ctx.properties().apiVersion < VK_API_VERSION_1_1) return false;
+    auto subgroup = vk_struct<VkPhysicalDeviceSubgroupProperties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES);
+    auto properties = vk_struct<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
+    properties.pNext = &subgroup;
+    vkGetPhysicalDeviceProperties2(ctx.physical(), &properties);
+    return (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) != 0 &&
+           (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_QUAD_BIT) != 0 && subgroup.subgroupSize >= 4 &&
+           gpu::kWorkgroupSize % subgroup.subgroupSize == 0;
+}
+
 RenderResult render(const Context& ctx, const PreparedScene& prepared,
                     const RenderOptions& options, const Tuning& requested) {
     const gpu::FrameParams frame = frame_params(ctx, prepared, options);
@@ -66,14 +80,41 @@ RenderResult render(const Context& ctx, const PreparedScene& prepared,
     stats.camera_rays = std::uint64_t(frame.width) * frame.height * frame.spp;
     stats.heap_slots = setup.method->heap_slots();
     stats.heap_private = tuning.heap_memory == Tuning::HeapMemory::kPrivate;
-    stats.heap_shared_bytes =
-        stats.heap_private ? 0 : std::uint64_t(stats.heap_slots) * gpu::kWorkgroupSize * sizeof(gpu::CutEntry);
+    stats.heap_shared_bytes = stats.heap_private ? 0
+                                                 : std::uint64_t(stats.heap_slots) * gpu::kWorkgroupSize *
+                                                       setup.method->heap_entry_bytes();
+    stats.quad_cuts = setup.method->quad_cuts();
     stats.workgroup_size = gpu::kWorkgroupSize;
     stats.buffer_bytes = setup.resources.buffer_bytes();
     return result;
 }
 
 }  // namespace
+
+bool share_cuts(const Context& ctx, const LightTree& tree, const RenderOptions& options,
+                const gpu::FrameParams& frame, const Tuning& tuning) {
+    // "auto" cuts each pixel alone on Vulkan: on lavapipe the quads' kernel
+    // took 1.2 to 2 times as long as the per-pixel one (docs/results/
+    // lavapipe.md, §17), as its lanes share the cut's decisions but not its
+    // work. GPUs are not measured.
+    if (options.method != "lightcuts" || options.cut_sharing != "quad") return false;
+    std::string why;
+    if (!device_has_quad_subgroups(ctx)) {
+        why = "the device has no subgroup quad operations in compute shaders";
+    } else if (tuning.heap_memory != Tuning::HeapMemory::kPrivate) {
+        const std::uint64_t slots = tree.cut_heap_slots(frame.max_cut, quad_cut_heap(options.cut_heap));
+        const std::uint64_t bytes = slots * gpu::kWorkgroupSize * sizeof(gpu::QuadCutEntry);
+        const std::uint32_t offered = ctx.properties().limits.maxComputeSharedMemorySize;
+        if (bytes > offered)
+            why = "a quad's heap of " + std::to_string(slots) + " slots needs " + std::to_string(bytes) +
+                  " bytes of shared memory per workgroup, the device offers " + std::to_string(offered);
+    }
+    if (why.empty()) return true;
+    if (options.cut_sharing == "quad")
+        throw std::invalid_argument("cut_sharing \"quad\" on " + ctx.device_name() + ": " + why +
+                                    "; use cut_sharing \"pixel\" or \"auto\", or --device cpu");
+    return false;
+}
 
 Tuning device_tuning(const Context& ctx, Tuning tuning) {
     const bool cpu = ctx.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
@@ -125,7 +166,8 @@ RenderSetup::RenderSetup(const Context& context, const PreparedScene& prepared,
       submitter(context),
       timestamps(context),
       method(make_shading_method(options, frame, prepared.tree, tuning,
-                                 context.properties().limits.maxComputeSharedMemorySize)),
+                                 context.properties().limits.maxComputeSharedMemorySize,
+                                 share_cuts(context, prepared.tree, options, frame, tuning))),
       resources(context, submitter, kernel_arrays(prepared, frame), *method,
                 std::uint64_t(frame.width) * frame.height, tuning.max_tile_pixels, tuning.split_bytes,
                 tuning.texel_reads == Tuning::TexelReads::kOn, tuning.chunk_buffers, tuning.host_import),
@@ -191,10 +233,6 @@ RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& o
                            const VulkanOptions& vulkan, const Tuning& tuning) {
     if (options.method == "path")
         throw std::invalid_argument("method path (the path tracer) runs on the CPU only: use --device cpu");
-    if (options.method == "lightcuts" && options.cut_sharing == "quad")
-        throw std::invalid_argument(
-            "cut_sharing \"quad\" runs on the CPU only (the Vulkan kernels cut each pixel alone): use "
-            "--device cpu, or cut_sharing \"pixel\" or \"auto\"");
     const Clock::time_point start = Clock::now();
     MessageLog log;
     RenderResult result;

@@ -72,7 +72,7 @@ struct RenderOptions {
     std::uint32_t cut_heap = kDefaultCutHeap;  // lightcuts: cut-heap capacity K per shaded point
                                                // (where quads share cuts, a quad's heap pools its
                                                // four points' K slots)
-    std::string cut_sharing = "auto";  // lightcuts: "pixel", "quad" (CPU only) or "auto"
+    std::string cut_sharing = "auto";  // lightcuts: "pixel", "quad" or "auto" ("quad" on the CPU, "pixel" on Vulkan)
                                        // (cut_sharing_problem, lightcuts/settings.h)
     std::uint32_t seed = 1;
     std::uint32_t light_samples = 1;  // sampled: lights per camera sample; stochastic: draws per cluster

@@ -63,12 +63,19 @@ std::string light_pick_problem(std::string_view pick);
 
 // What is wrong with a cut sharing, or "" for "auto", "pixel" and "quad".
 // Lightcuts cuts each shaded point alone ("pixel"), or the four points of a
-// 2x2 block of pixels together ("quad", CPU only: host/quad_cut.h). "auto"
-// is "quad" on the CPU and "pixel" on Vulkan.
+// 2x2 block of pixels together ("quad": host/quad_cut.h on the CPU,
+// shaders/quadcuts.comp on Vulkan devices with subgroup quad operations).
+// "auto" is "quad" on the CPU and "pixel" on Vulkan.
 std::string cut_sharing_problem(std::string_view sharing);
 
 // Whether a render on the CPU with these settings shares cuts between the
 // pixels of a quad: method "lightcuts" and cut_sharing "quad" or "auto".
 bool cpu_shares_cuts(std::string_view method, std::string_view sharing);
+
+// The heap slots of a quad's shared cut for render.cut_heap K: its four
+// points' K, pooled (a quad's slot holds the four points' bounds).
+inline std::uint32_t quad_cut_heap(std::uint32_t cut_heap) {
+    return cut_heap > UINT32_MAX / 4u ? UINT32_MAX : 4u * cut_heap;
+}
 
 }  // namespace lc

@@ -9,6 +9,9 @@
 //   LC_HEAP_LOAD(i)         -> HeapEntry       (heap slot i of this point)
 //   LC_HEAP_STORE(i, e)     stores HeapEntry e in slot i
 //   LC_HEAP_CAPACITY        K, the heap's capacity (see lc_heap_push)
+//   LC_HEAP_ORDER (optional) the entry's field that orders the heap: `error`
+//                           unless defined (a quad's shared cut orders by
+//                           `key`, quadcuts.comp)
 //   LC_PREFETCH_LIGHT_NODES(i) (optional) starts loading nodes i and i + 1
 //   LC_HEAP_SMALLEST(from, to, bound) (optional) lc_heap_smallest's answer,
 //                           found the includer's way
@@ -44,6 +47,10 @@ vec3 lc_rep_unit_known(LC_IN(SurfacePoint) sp, uint light_index, float min_dista
     return lc_light_unit(sp, LC_LIGHT(light_index), min_distance2, wi, t_max);
 }
 
+#ifndef LC_HEAP_ORDER
+#define LC_HEAP_ORDER error
+#endif
+
 uint lc_entry_node(HeapEntry e) { return e.node & kCutEntryNodeMask; }
 bool lc_entry_visible(HeapEntry e) { return (e.node & kCutEntryVisible) != 0u; }
 
@@ -73,17 +80,16 @@ void lc_heap_sift_up(uint i, HeapEntry e) {
     while (i > 0u) {
         uint parent = (i - 1u) / 2u;
         HeapEntry p = LC_HEAP_LOAD(parent);
-        if (p.error >= e.error) break;
+        if (p.LC_HEAP_ORDER >= e.LC_HEAP_ORDER) break;
         LC_HEAP_STORE(i, p);
         i = parent;
     }
     LC_HEAP_STORE(i, e);
 }
 
-// Puts e in place of the largest entry (slot 0) of a heap of `size`
-// entries and lets it sink to its place: a pop and a push in one pass.
-void lc_heap_replace_top(uint size, HeapEntry e) {
-    uint i = 0u;
+// Puts e in slot i of a heap of `size` entries and lets it sink to its
+// place.
+void lc_heap_sift_down(uint i, uint size, HeapEntry e) {
     while (true) {
         uint child = 2u * i + 1u;
         if (child >= size) break;
@@ -95,20 +101,24 @@ void lc_heap_replace_top(uint size, HeapEntry e) {
         // store-to-load forward per level), and its error is the one already
         // read, not read again (on llvmpipe each read of the heap at an
         // index that differs between lanes is a loop over the lanes).
-        float child_error = LC_HEAP_LOAD(child).error;
+        float child_error = LC_HEAP_LOAD(child).LC_HEAP_ORDER;
         if (child + 1u < size) {
-            float right_error = LC_HEAP_LOAD(child + 1u).error;
+            float right_error = LC_HEAP_LOAD(child + 1u).LC_HEAP_ORDER;
             child += uint(right_error > child_error);
             child_error = right_error > child_error ? right_error : child_error;
         }
-        if (child_error <= e.error) break;
+        if (child_error <= e.LC_HEAP_ORDER) break;
         HeapEntry c = LC_HEAP_LOAD(child);
-        c.error = child_error;
+        c.LC_HEAP_ORDER = child_error;
         LC_HEAP_STORE(i, c);
         i = child;
     }
     LC_HEAP_STORE(i, e);
 }
+
+// Puts e in place of the largest entry (slot 0) and lets it sink to its
+// place: a pop and a push in one pass.
+void lc_heap_replace_top(uint size, HeapEntry e) { lc_heap_sift_down(0u, size, e); }
 
 // Removes the largest entry (slot 0).
 void lc_heap_pop(LC_INOUT(uint) size) {
@@ -122,7 +132,7 @@ uint lc_heap_smallest_scan(uint from, uint to, float bound) {
     uint smallest = kInvalidIndex;
     float smallest_error = bound;
     for (uint i = from; i < to; ++i) {
-        float error = LC_HEAP_LOAD(i).error;
+        float error = LC_HEAP_LOAD(i).LC_HEAP_ORDER;
         if (error < smallest_error) {
             smallest_error = error;
             smallest = i;

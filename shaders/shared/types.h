@@ -228,6 +228,18 @@ struct CutEntry {
 LC_CONST uint kCutEntryVisible = 0x80000000u;
 LC_CONST uint kCutEntryNodeMask = 0x7FFFFFFFu;
 
+// One entry of a quad's shared cut heap as each of the quad's four lanes
+// keeps it (quadcuts.comp, 12 bytes): the node and this lane's visibility
+// bit as in CutEntry, this lane's own error bound, and the heap's order
+// `key`, the largest ratio of the cluster's bound to a point's estimate over
+// the quad, the same in all four lanes (host/quad_cut.h computes the same
+// on the CPU).
+struct QuadCutEntry {
+    uint node;
+    float error;
+    float key;
+};
+
 // How --method sampled draws its lights (FrameParams.light_pick):
 // through the light tree by importance at the shaded point, with the same
 // probability for every light, or in proportion to each light's power.

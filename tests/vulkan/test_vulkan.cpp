@@ -96,29 +96,6 @@ TEST(DeviceChoiceAuto, DecidesFromTheDevicesFoundEarly) {
     }
 }
 
-// Cuts shared by quads of pixels are the CPU's alone: the Vulkan renderer
-// refuses them before it touches a device, and device "auto" renders them
-// on the CPU, saying so.
-TEST(VulkanQuadCuts, RefusedByVulkanAndRenderedOnTheCpuByAuto) {
-    PreparedScene p = prepare_scene(random_scene(5, 4, 0, 8, 8), 1);
-    RenderOptions o = options("lightcuts", 8, 8);
-    o.cut_sharing = "quad";
-    try {
-        render_vulkan(p, o, VulkanOptions{});
-        FAIL() << "expected an exception";
-    } catch (const std::invalid_argument& e) {
-        EXPECT_NE(std::string(e.what()).find("cut_sharing \"quad\" runs on the CPU only"), std::string::npos)
-            << e.what();
-    }
-    DeviceChoice choice;
-    std::string said;
-    choice.note = [&](const std::string& line) { said = line; };
-    const RenderResult r = render(p, o, choice);
-    EXPECT_EQ(r.stats.device, "cpu");
-    EXPECT_TRUE(r.stats.quad_cuts);
-    EXPECT_NE(said.find("cut_sharing \"quad\" runs on the CPU only"), std::string::npos) << said;
-}
-
 // --- Analytic truth (pbrt-v4 style): a point light of intensity pi * h^2 at
 // height h straight above the point the centre pixel sees, on a Lambert
 // plane of albedo 0.5, gives radiance kd/pi * I * cos / d^2 = 0.5 there.
@@ -171,6 +148,53 @@ TEST_F(Vulkan, LightcutsMatchesCpuOnRandomScenes) {
         expect_lightcuts_matches(p, o, g);
         EXPECT_EQ(g.stats.heap_slots, std::min(kDefaultCutHeap, p.tree.cut_heap_capacity(o.max_cut)));
     }
+}
+
+// Cuts shared by the pixels of 2x2 quads (quadcuts.comp) against the CPU's
+// (host/quad_cut.h), at odd image sizes (quads cut by the right and bottom
+// edges, lanes without a pixel). "auto" cuts each pixel alone on Vulkan.
+TEST_F(Vulkan, QuadCutsMatchCpu) {
+    for (std::uint32_t seed = 20; seed < 23; ++seed) {
+        SCOPED_TRACE("seed " + std::to_string(seed));
+        PreparedScene p = prepare_scene(random_scene(seed, 200, 3, 41, 31), seed);
+        RenderOptions o = options("lightcuts", 41, 31);
+        o.seed = seed;
+        o.max_cut = 100;
+        o.cut_sharing = "quad";
+        RenderResult g = gpu(p, o);
+        EXPECT_TRUE(g.stats.quad_cuts);
+        expect_lightcuts_matches(p, o, g);
+        EXPECT_EQ(g.stats.heap_slots, std::min(4 * kDefaultCutHeap, p.tree.cut_heap_capacity(o.max_cut)));
+        o.cut_sharing = "auto";
+        EXPECT_FALSE(gpu(p, o).stats.quad_cuts);
+    }
+}
+
+// A quad's cut paused between dispatches (a few refinements each, its heap
+// of 4 x 4 slots freezing clusters), over several samples and tiles smaller
+// than a workgroup: the same image as in one dispatch, bit for bit (the
+// pause keeps everything the next step reads), and the CPU's.
+TEST_F(Vulkan, QuadCutsSplitOverDispatchesMatchCpu) {
+    PreparedScene p = prepare_scene(random_scene(71, 300, 2, 25, 19), 9);
+    RenderOptions o = options("lightcuts", 25, 19, 2);
+    o.cut_sharing = "quad";
+    o.relative_error = 0.0f;
+    o.max_cut = 200;
+    o.cut_heap = 4;
+    vk::Tuning split;
+    split.refinements_per_dispatch = 16;
+    split.max_tile_pixels = 50;
+    vk::Tuning whole;
+    whole.max_tile_pixels = 50;
+    const RenderResult g = gpu(p, o, split);
+    EXPECT_GT(g.stats.heap_paused_samples, 0u);
+    EXPECT_GT(g.stats.heap_frozen_samples, 0u);
+    EXPECT_EQ(g.stats.heap_slots, 16u);
+    const RenderResult once = gpu(p, o, whole);
+    EXPECT_EQ(once.stats.heap_paused_samples, 0u);
+    EXPECT_EQ(vulkan_test::max_relative_difference(g.image, once.image, "quads paused", 0.0), 0.0);
+    EXPECT_EQ(g.stats.shadow_rays, once.stats.shadow_rays);
+    expect_lightcuts_matches(p, o, g);
 }
 
 // Odd image size, several samples and tiles far smaller than the image (and

@@ -1,0 +1,332 @@
+// Lightcuts with one cut per 2x2 quad of pixels (cut_sharing "quad"), the
+// cut the CPU's QuadCut (host/quad_cut.h) selects, step for step: a cluster
+// is refined while its error bound exceeds relative_error times the
+// estimate of any of the four points. Each point keeps its own estimate,
+// shadow rays and sums.
+//
+// The four points are the four lanes of a subgroup quad. Each lane keeps
+// the whole heap in its own slots: the nodes and the heap's order `key`
+// (the largest ratio of a cluster's bound to a point's estimate over the
+// quad, exchanged with subgroupQuadSwap*) are the same in all four, the
+// error bound and the representative's visibility the lane's own. So the
+// four make the same heap moves in step, and each traces its own shadow
+// rays. A lane whose pixel sees no surface, or lies past the tile, keeps
+// the heap with the others, with zero bounds. Quad sums are added (0 + 1) +
+// (2 + 3), as on the CPU, so every lane has the same bits.
+//
+// As lightcuts.comp, one dispatch runs every cut to the end, or (lavapipe)
+// a budget of refinements per dispatch, the cut paused in CutState and the
+// heap in the heap-save buffer, both indexed by invocation.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_quad : require
+
+#include "kernel.glsl"
+#define LC_HEAP_ENTRY QuadCutEntry
+#define LC_HEAP_ORDER key
+#include "heap.glsl"
+#define LC_LIGHT(i) lc_light(i)
+#include "shared/sampling.h"
+#include "shared/lightcuts.h"
+
+layout(std430, binding = kBindingCutState) buffer CutStates { CutState cut_states[]; };
+
+const float kFloatMin = 1.17549435082228750797e-38;  // FLT_MIN, 2^-126
+const float kFloatMax = 3.40282346638528859812e+38;  // FLT_MAX
+
+// The lane's point and its part of the quad's cut (host/quad_cut.h's
+// members of the same names, for this lane's point).
+bool q_active;      // this lane shades a surface
+SurfacePoint q_sp;  // ... this one
+uint q_size;        // entries in the heap
+vec3 q_fixed;       // final estimates: leaves and frozen clusters
+vec3 q_heap_sum;    // running sum of the heap's estimates
+float q_weight;     // 1 / estimate (update_weights)
+float q_root_bounds;  // the roots' finite bounds summed over the quad, times 1/4
+bool q_fresh_keys;  // the keys are from the current weights
+uint q_frozen;      // clusters frozen out of a full heap
+ShadeStats q_stats;
+
+float lc_quad_sum(float v) {
+    v += subgroupQuadSwapHorizontal(v);
+    return v + subgroupQuadSwapVertical(v);
+}
+
+float lc_quad_max(float v) {
+    v = max(v, subgroupQuadSwapHorizontal(v));
+    return max(v, subgroupQuadSwapVertical(v));
+}
+
+bool lc_quad_any(bool b) {
+    uint v = b ? 1u : 0u;
+    v |= subgroupQuadSwapHorizontal(v);
+    v |= subgroupQuadSwapVertical(v);
+    return v != 0u;
+}
+
+// QuadCut::update_weights: 1 / estimate, the estimate taken as at least
+// 2^-20 of the quad's summed estimates (of its summed root bounds while
+// those are all zero).
+void lc_quad_update_weights() {
+    float estimate = lc_luminance(q_fixed + q_heap_sum);
+    bool counts = estimate > 0.0f && !isinf(estimate);
+    float total = lc_quad_sum(counts ? estimate * 0.25f : 0.0f);
+    if (!lc_quad_any(counts)) total = q_root_bounds;
+    float floor_estimate = clamp(total * (1.0f / 262144.0f), kFloatMin, kFloatMax);
+    q_weight = 1.0f / (estimate < floor_estimate ? floor_estimate : estimate);
+}
+
+// QuadCut::key_of: the largest ratio of bound to estimate over the quad,
+// at most FLT_MAX; a NaN bound is passed over.
+float lc_quad_key(float error) {
+    float ratio = error > 0.0f ? error * q_weight : 0.0f;
+    if (!(ratio >= 0.0f)) ratio = 0.0f;
+    return min(lc_quad_max(ratio), kFloatMax);
+}
+
+// QuadCut::enter: a leaf goes to the fixed sum; an interior cluster whose
+// bound is above zero at some point of the quad enters the heap (true),
+// with zero contribution where its bound is not.
+bool lc_quad_enter(uint index, LightNode node, float error, vec3 unit, bool visible, out QuadCutEntry e) {
+    vec3 intensity = lc_node_intensity(node);
+    e.node = index;
+    e.error = error;
+    e.key = 0.0f;
+    if ((node.flags & kNodeLeaf) != 0u) {
+        q_fixed += unit * intensity;
+        return false;
+    }
+    bool mine = error > 0.0f;
+    if (!mine) {
+        unit = vec3(0.0f);
+        visible = false;
+    }
+    if (!lc_quad_any(mine)) return false;
+    q_heap_sum += unit * intensity;
+    e.node = index | (visible ? kCutEntryVisible : 0u);
+    return true;
+}
+
+// QuadCut::push: into a full heap, the entry with the smallest key (this
+// one included) is frozen.
+void lc_quad_push(QuadCutEntry e) {
+    if (q_size < kHeapSlots) {
+        q_size += 1u;
+        lc_heap_sift_up(q_size - 1u, e);
+        return;
+    }
+    q_frozen += 1u;
+    uint smallest = lc_heap_smallest(q_size / 2u, q_size, e.key);
+    QuadCutEntry leaving = smallest == kInvalidIndex ? e : LC_HEAP_LOAD(smallest);
+    q_stats.frozen_error += leaving.error;
+    vec3 estimate = lc_entry_estimate(q_sp, leaving, frame.min_distance2);
+    q_heap_sum -= estimate;
+    q_fixed += estimate;
+    if (smallest != kInvalidIndex) lc_heap_sift_up(smallest, e);
+}
+
+// Every key again from the current estimates, and the heap rebuilt.
+void lc_quad_rekey() {
+    lc_quad_update_weights();
+    for (uint i = 0u; i < q_size; ++i) {
+        QuadCutEntry e = LC_HEAP_LOAD(i);
+        e.key = lc_quad_key(e.error);
+        LC_HEAP_STORE(i, e);
+    }
+    for (uint i = q_size / 2u; i > 0u; --i) lc_heap_sift_down(i - 1u, q_size, LC_HEAP_LOAD(i - 1u));
+}
+
+float lc_quad_error(LightNode node) {
+    return q_active ? lc_cluster_error(q_sp, q_sp.mat, node, frame.min_distance2) : 0.0f;
+}
+
+void lc_quad_start() {
+    q_size = 0u;
+    q_fixed = vec3(0.0f);
+    q_heap_sum = vec3(0.0f);
+    q_root_bounds = 0.0f;
+    q_fresh_keys = false;
+    q_frozen = 0u;
+    q_stats.cut_size = 0u;
+    q_stats.cut_indirect = frame.roots[kLightVpl] != kInvalidIndex ? 1u : 0u;
+    float root_sum = 0.0f;
+    for (uint type = 0u; type < kLightTypeCount; ++type) {
+        uint index = frame.roots[type];
+        if (index == kInvalidIndex) continue;
+        LightNode root = LC_LIGHT_NODE(index);
+        float error = lc_quad_error(root);
+        vec3 unit = vec3(0.0f);
+        bool visible = false;
+        if (q_active && lc_cluster_needs_unit(root, error))
+            unit = lc_rep_unit(q_sp, root.rep_light, frame.min_distance2, visible, q_stats);
+        if (error > 0.0f && !isinf(error)) root_sum += error * 0.25f;
+        q_root_bounds = lc_quad_sum(root_sum);
+        QuadCutEntry e;
+        if (lc_quad_enter(index, root, error, unit, visible, e)) {
+            lc_quad_update_weights();
+            e.key = lc_quad_key(e.error);
+            lc_quad_push(e);
+        }
+        q_stats.cut_size += 1u;
+    }
+    lc_quad_update_weights();
+}
+
+// QuadCut::refine_top: the cluster at the top of the heap is replaced by
+// its children; the child with the parent's representative keeps its
+// visibility, the other's comes from one new shadow ray per lane.
+void lc_quad_refine_top() {
+    QuadCutEntry top = LC_HEAP_LOAD(0u);
+    LightNode node = LC_LIGHT_NODE(lc_entry_node(top));
+    q_heap_sum -= lc_entry_unit(q_sp, top, node, frame.min_distance2) * lc_node_intensity(node);
+    bool right_shares = (node.flags & kNodeRepFromRight) != 0u;
+    uint kept_index = right_shares ? node.left + 1u : node.left;
+    uint fresh_index = right_shares ? node.left : node.left + 1u;
+    LightNode kept_node = LC_LIGHT_NODE(kept_index);
+    LightNode fresh_node = LC_LIGHT_NODE(fresh_index);
+    float kept_error = lc_quad_error(kept_node);
+    float fresh_error = lc_quad_error(fresh_node);
+    bool fresh_leaf = (fresh_node.flags & kNodeLeaf) != 0u;
+    vec3 fresh_unit = vec3(0.0f);
+    bool fresh_visible = false;
+    if (q_active && (fresh_leaf || fresh_error > 0.0f))
+        fresh_unit = lc_rep_unit(q_sp, fresh_node.rep_light, frame.min_distance2, fresh_visible, q_stats);
+    vec3 kept_unit = lc_entry_unit(q_sp, top, node, frame.min_distance2);
+    QuadCutEntry a, b;
+    bool has_a = lc_quad_enter(kept_index, kept_node, kept_error, kept_unit, lc_entry_visible(top), a);
+    bool has_b = lc_quad_enter(fresh_index, fresh_node, fresh_error, fresh_unit, fresh_visible, b);
+    q_stats.cut_size += 1u;
+    if (lc_node_type(node) == kLightVpl) q_stats.cut_indirect += 1u;
+    lc_quad_update_weights();
+    a.key = has_a ? lc_quad_key(a.error) : 0.0f;
+    b.key = has_b ? lc_quad_key(b.error) : 0.0f;
+    // The larger child takes the parent's place and sinks; the smaller one
+    // is pushed.
+    if (has_b && (!has_a || b.key > a.key)) {
+        QuadCutEntry swap_entry = a;
+        a = b;
+        b = swap_entry;
+        bool swap_has = has_a;
+        has_a = has_b;
+        has_b = swap_has;
+    }
+    if (has_a) {
+        lc_heap_sift_down(0u, q_size, a);
+    } else {
+        q_size -= 1u;
+        if (q_size > 0u) lc_heap_sift_down(0u, q_size, LC_HEAP_LOAD(q_size));
+    }
+    if (has_b) lc_quad_push(b);
+}
+
+// QuadCut::refine_all, one refinement at a time: false once the cut is
+// final (every key at most relative_error, checked with fresh keys) or at
+// max_cut.
+bool lc_quad_refine() {
+    while (q_size > 0u) {
+        float top_key = lc_quad_key(LC_HEAP_LOAD(0u).error);
+        if (!(top_key > frame.relative_error)) {
+            if (q_fresh_keys) return false;
+            lc_quad_rekey();
+            q_fresh_keys = true;
+            continue;
+        }
+        if (q_stats.cut_size >= frame.max_cut) {
+            q_stats.hit_max_cut = 1u;
+            return false;
+        }
+        q_fresh_keys = false;
+        lc_quad_refine_top();
+        return true;
+    }
+    return false;
+}
+
+void main() {
+    // Invocation `invocation` is lane invocation % 4 of quad invocation / 4
+    // of the tile; the lane order of a subgroup quad (0 top left, 1 top
+    // right, 2 bottom left, 3 bottom right) is host/quad_cut.h's.
+    uint block = (gl_WorkGroupID.x * push.group_stride) % gl_NumWorkGroups.x;
+    uint invocation = block * gl_WorkGroupSize.x + gl_SubgroupID * gl_SubgroupSize + gl_SubgroupInvocationID;
+    uint quad = invocation / 4u, lane = invocation % 4u;
+    uint quads_x = (push.tile_width + 1u) / 2u;
+    if (quad >= quads_x * ((push.tile_height + 1u) / 2u)) return;  // the whole quad
+    uint x = 2u * (quad % quads_x) + (lane & 1u), y = 2u * (quad / quads_x) + (lane >> 1u);
+    uint i = kInvalidIndex;  // this lane's tile pixel
+    GBufferTexel g;
+    g.material = kInvalidIndex;
+    if (x < push.tile_width && y < push.tile_height) {
+        i = lc_tile_index(x, y, push.tile_width, push.tile_height);
+        g = gbuffer[i];
+    }
+    q_active = g.material != kInvalidIndex;
+    // A lane without a surface reads nothing of its point; it gets a valid
+    // one all the same (material 0), so that no read can go astray.
+    q_sp = q_active ? lc_texel_surface(g)
+                    : lc_make_surface(vec3(0.0f), vec3(0.0f, 0.0f, 1.0f), vec3(0.0f, 0.0f, 1.0f), 0u, vec2(0.0f));
+    if (!lc_quad_any(q_active)) return;  // no surface in the quad
+
+    q_stats.cut_size = 0u;
+    q_stats.shadow_rays = 0u;
+    q_stats.hit_max_cut = 0u;
+    q_stats.cut_indirect = 0u;
+    q_stats.frozen = 0u;
+    q_stats.frozen_error = 0.0f;
+    if ((push.cut_flags & kCutFirstDispatch) != 0u) {
+        lc_quad_start();
+    } else {
+        CutState s = cut_states[invocation];
+        if ((s.flags & kCutDone) != 0u) return;  // the whole quad
+        q_size = s.heap_size;
+        q_stats.cut_size = s.cut_size;
+        q_stats.cut_indirect = s.cut_indirect;
+        q_stats.shadow_rays = s.shadow_rays;
+        q_frozen = (s.flags & kCutFroze) != 0u ? 1u : 0u;
+        q_fresh_keys = (s.flags & kCutFreshKeys) != 0u;
+        q_fixed = vec3(s.fixed_r, s.fixed_g, s.fixed_b);
+        q_heap_sum = vec3(s.heap_r, s.heap_g, s.heap_b);
+        q_root_bounds = uintBitsToFloat(s.shaded);
+        q_weight = uintBitsToFloat(s.draw);
+        lc_heap_restore(q_size);
+    }
+
+    bool done = false;
+    for (uint r = 0u; r < push.refine_budget && !done; ++r) done = !lc_quad_refine();
+    bool cut_short = lc_loops_were_cut_short();
+
+    if (!done) {
+        if (i != kInvalidIndex && q_active) {
+            PixelStats ps = pixel_stats[i];
+            if ((push.cut_flags & kCutLastDispatch) != 0u) ps.flags |= kPixelCutUnfinished;
+            if (cut_short) ps.flags |= kPixelLoopLimit;
+            if ((push.cut_flags & kCutFirstDispatch) != 0u) ps.paused_samples += 1u;
+            pixel_stats[i] = ps;
+        }
+        lc_heap_save(q_size);
+        CutState s;
+        s.heap_size = q_size;
+        s.cut_size = q_stats.cut_size;
+        s.cut_indirect = q_stats.cut_indirect;
+        s.shadow_rays = q_stats.shadow_rays;
+        s.flags = (q_frozen > 0u ? kCutFroze : 0u) | (q_fresh_keys ? kCutFreshKeys : 0u);
+        s.fixed_r = q_fixed.x; s.fixed_g = q_fixed.y; s.fixed_b = q_fixed.z;
+        s.heap_r = q_heap_sum.x; s.heap_g = q_heap_sum.y; s.heap_b = q_heap_sum.z;
+        s.shaded = floatBitsToUint(q_root_bounds);
+        s.draw = floatBitsToUint(q_weight);
+        cut_states[invocation] = s;
+        return;
+    }
+
+    if ((push.cut_flags & kCutLastDispatch) == 0u) cut_states[invocation].flags = kCutDone;
+    if (!q_active) return;
+    lc_accumulate(i, lc_cut_result(q_sp, frame.min_distance2, q_size, q_fixed));
+    PixelStats ps = pixel_stats[i];
+    lc_count_add(ps.cut_size_lo, ps.cut_size_hi, q_stats.cut_size);
+    lc_count_add(ps.cut_indirect_lo, ps.cut_indirect_hi, q_stats.cut_indirect);
+    lc_count_add(ps.shadow_rays_lo, ps.shadow_rays_hi, q_stats.shadow_rays);
+    ps.max_cut_samples += q_stats.hit_max_cut;
+    ps.frozen_samples += q_frozen > 0u ? 1u : 0u;
+    if (cut_short || lc_loops_were_cut_short()) ps.flags |= kPixelLoopLimit;
+    pixel_stats[i] = ps;
+}
