@@ -61,16 +61,18 @@ void lc_heap_restore(uint heap_size) {
 }
 
 // lc_heap_smallest on a full heap, the only heap it is asked about
-// (lc_heap_push: from = K/2, to = K): for K up to 64 a loop the compiler
-// unrolls once K is specialized, so that each slot's index is the same
-// constant in every lane (llvmpipe reads a private array at an index that
-// may differ between lanes one lane at a time, at a constant index all the
-// lanes at once); above that shared/lightcuts.h's loop. Same slots, same
-// order, same answer.
+// (lc_heap_push: from = K/2, to = K): for K up to 256 (a quad's heap at
+// the default cut_heap 64) a loop the compiler unrolls once K is
+// specialized, so that each slot's index is the same constant in every lane
+// (llvmpipe reads a private array at an index that may differ between lanes
+// one lane at a time, at a constant index all the lanes at once; and it ends
+// an invocation's loops after 65535 iterations in all, which a quad's scans
+// of 128 slots a freeze had reached at the room's deepest cuts); above that
+// shared/lightcuts.h's loop. Same slots, same order, same answer.
 uint lc_heap_smallest_scan(uint from, uint to, float bound);  // shared/lightcuts.h
 
 uint lc_heap_smallest_full(uint from, uint to, float bound) {
-    if (kHeapSlots > 64u) return lc_heap_smallest_scan(from, to, bound);
+    if (kHeapSlots > 256u) return lc_heap_smallest_scan(from, to, bound);
     uint smallest = kInvalidIndex;
     float smallest_error = bound;
     [[unroll]] for (uint i = kHeapSlots / 2u; i < kHeapSlots; ++i) {
