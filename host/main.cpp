@@ -226,9 +226,9 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
                        "its clusters of smallest bound (default " + std::to_string(lc::kDefaultCutHeap) + ")")
         ->transform(setting(lc::kSettingCutHeap));
     render->add_option("--cut-sharing", r.cut_sharing,
-                       "lightcuts: pixel (a cut per pixel, as the Vulkan kernels), quad (the four pixels of a 2x2 "
-                       "block share one cut: CPU only, faster) or auto (quad on the CPU, pixel on Vulkan; the "
-                       "default)")
+                       "lightcuts: pixel (a cut per pixel), quad (the four pixels of a 2x2 block share one cut: "
+                       "faster on the CPU; on Vulkan it needs subgroup quad operations) or auto (quad on the CPU, "
+                       "pixel on Vulkan; the default)")
         ->check(ask(lc::cut_sharing_problem));
     render->add_option("--area-samples", r.area_samples,
                        "Point lights the emissive surfaces become, in all (default 65536)")
