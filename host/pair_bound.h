@@ -27,6 +27,7 @@
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#include <immintrin.h>
 #endif
 
 namespace lc::cpu {
@@ -146,115 +147,70 @@ bool pair_errors(Kernel& kernel, const SurfacePoint& sp, const gpu::Material& m,
 }
 
 #if defined(__SSE2__)
-// The four shaded points of a quad (host/quad_cut.h) lane by lane, for
-// quad_errors: positions, frames and the diffuse colours.
-struct QuadLanes {
-    __m128 px, py, pz;
-    __m128 nx, ny, nz, anx, any, anz;
-    __m128 tx, ty, tz, atx, aty, atz;
-    __m128 bx, by, bz, abx, aby, abz;
-    __m128 kd_r, kd_g, kd_b;
-    __m128 wox, woy, woz, alpha;  // the view direction and the GGX roughness
-    __m128 active;        // all ones in the lanes of active points
-    unsigned specular;    // lanes whose material has a GGX lobe
-    bool covered = false; // no active point has the Disney BRDF
-};
+// The quad evaluation with the four points in the four SSE lanes.
+namespace quad4 {
+using V = __m128;
+inline V v_set1(float x) { return _mm_set1_ps(x); }
+inline V v_zero() { return _mm_setzero_ps(); }
+inline V v_add(V a, V b) { return _mm_add_ps(a, b); }
+inline V v_sub(V a, V b) { return _mm_sub_ps(a, b); }
+inline V v_mul(V a, V b) { return _mm_mul_ps(a, b); }
+inline V v_div(V a, V b) { return _mm_div_ps(a, b); }
+inline V v_sqrt(V a) { return _mm_sqrt_ps(a); }
+inline V v_and(V a, V b) { return _mm_and_ps(a, b); }
+inline V v_andnot(V a, V b) { return _mm_andnot_ps(a, b); }
+inline V v_or(V a, V b) { return _mm_or_ps(a, b); }
+inline V v_cmpgt(V a, V b) { return _mm_cmpgt_ps(a, b); }
+inline V v_cmpge(V a, V b) { return _mm_cmpge_ps(a, b); }
+inline V v_cmpnle(V a, V b) { return _mm_cmpnle_ps(a, b); }
+inline V v_abs(V a) { return abs_lanes(a); }
+inline V v_min(V x, V y) { return glsl_min(x, y); }
+inline V v_max(V x, V y) { return glsl_max(x, y); }
+inline int v_movemask(V a) { return _mm_movemask_ps(a); }
+inline V v_set2(float a, float) { return _mm_set1_ps(a); }  // one cluster in all four lanes
+#include "quad_bounds_body.h"
+}  // namespace quad4
 
+using QuadLanes = quad4::QuadLanes;
+using quad4::dot4;
+
+// The four shaded points of a quad (host/quad_cut.h) lane by lane.
 template <class SurfacePoint>
 QuadLanes quad_lanes(const SurfacePoint* sp, unsigned active) {
     QuadLanes q;
-    alignas(16) float v[28][4];
-    alignas(16) std::uint32_t mask[4];
+    alignas(16) float v[31][4];
+    alignas(16) std::uint32_t mask[2][4];
     q.specular = 0u;
     q.covered = true;
     for (unsigned p = 0; p < 4u; ++p) {
         const bool on = (active >> p & 1u) != 0u;
-        mask[p] = on ? ~0u : 0u;
         const SurfacePoint& s = sp[p];
+        const bool specular = on && (s.mat.flags & gpu::kMaterialHasSpecular) != 0u;
+        mask[0][p] = on ? ~0u : 0u;
+        mask[1][p] = specular ? ~0u : 0u;
         const glm::vec3 zero(0.0f);
         const glm::vec3 pos = on ? s.p : zero, n = on ? s.n : zero, t = on ? s.t : zero, b = on ? s.b : zero;
-        const float f[28] = {pos.x, pos.y, pos.z, n.x, n.y, n.z, std::fabs(n.x), std::fabs(n.y), std::fabs(n.z),
+        const float f[31] = {pos.x, pos.y, pos.z, n.x, n.y, n.z, std::fabs(n.x), std::fabs(n.y), std::fabs(n.z),
                              t.x, t.y, t.z, std::fabs(t.x), std::fabs(t.y), std::fabs(t.z),
                              b.x, b.y, b.z, std::fabs(b.x), std::fabs(b.y), std::fabs(b.z),
                              on ? s.mat.kd_r : 0.0f, on ? s.mat.kd_g : 0.0f, on ? s.mat.kd_b : 0.0f,
+                             specular ? s.mat.ks_r : 0.0f, specular ? s.mat.ks_g : 0.0f, specular ? s.mat.ks_b : 0.0f,
                              on ? s.wo.x : 0.0f, on ? s.wo.y : 0.0f, on ? s.wo.z : 0.0f,
                              on ? s.mat.alpha : 1.0f};
-        for (unsigned i = 0; i < 28u; ++i) v[i][p] = f[i];
+        for (unsigned i = 0; i < 31u; ++i) v[i][p] = f[i];
         if (!on) continue;
         if ((s.mat.flags & gpu::kMaterialDisney) != 0u) q.covered = false;
-        if ((s.mat.flags & gpu::kMaterialHasSpecular) != 0u) q.specular |= 1u << p;
+        if (specular) q.specular |= 1u << p;
     }
-    __m128* out[28] = {&q.px, &q.py, &q.pz, &q.nx, &q.ny, &q.nz, &q.anx, &q.any, &q.anz,
+    __m128* out[30] = {&q.px, &q.py, &q.pz, &q.nx, &q.ny, &q.nz, &q.anx, &q.any, &q.anz,
                        &q.tx, &q.ty, &q.tz, &q.atx, &q.aty, &q.atz, &q.bx, &q.by, &q.bz,
-                       &q.abx, &q.aby, &q.abz, &q.kd_r, &q.kd_g, &q.kd_b, &q.wox, &q.woy, &q.woz, &q.alpha};
-    for (unsigned i = 0; i < 28u; ++i) *out[i] = _mm_load_ps(v[i]);
-    q.active = _mm_load_ps(reinterpret_cast<const float*>(mask));
+                       &q.abx, &q.aby, &q.abz, &q.kd_r, &q.kd_g, &q.kd_b, &q.ks_r, &q.ks_g, &q.ks_b,
+                       &q.wox, &q.woy, &q.woz};
+    for (unsigned i = 0; i < 30u; ++i) *out[i] = _mm_load_ps(v[i]);
+    quad4::set_ggx_terms(q, _mm_load_ps(v[30]));
+    q.active = _mm_load_ps(reinterpret_cast<const float*>(mask[0]));
+    q.specular_lanes = _mm_load_ps(reinterpret_cast<const float*>(mask[1]));
     return q;
-}
-
-// ((a_x * v_x + a_y * v_y) + a_z * v_z) lane by lane: glm's dot.
-inline __m128 dot4(__m128 ax, __m128 ay, __m128 az, __m128 vx, __m128 vy, __m128 vz) {
-    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, vx), _mm_mul_ps(ay, vy)), _mm_mul_ps(az, vz));
-}
-
-// lc_ggx_bound of one box at the quad's points, lane by lane, with the
-// same operations in the same order as lc_ggx_bound, lc_box_cone,
-// lc_cos_h_max, lc_ggx_d and lc_smith_g1: into ggx[p] for the lanes of
-// `lanes`, 0 elsewhere.
-template <class Kernel>
-void quad_ggx_bounds(const QuadLanes& q, const gpu::LightNode& node, unsigned lanes, float ggx[4]) {
-    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), half = _mm_set1_ps(0.5f);
-    // cos_o = dot(n, wo); the lanes with cos_o <= 0 give 0.
-    const __m128 cos_o = dot4(q.nx, q.ny, q.nz, q.wox, q.woy, q.woz);
-    // lc_box_cone: the box seen from each point.
-    const __m128 c_x = _mm_mul_ps(half, _mm_add_ps(_mm_sub_ps(_mm_set1_ps(node.min_x), q.px),
-                                                   _mm_sub_ps(_mm_set1_ps(node.max_x), q.px)));
-    const __m128 c_y = _mm_mul_ps(half, _mm_add_ps(_mm_sub_ps(_mm_set1_ps(node.min_y), q.py),
-                                                   _mm_sub_ps(_mm_set1_ps(node.max_y), q.py)));
-    const __m128 c_z = _mm_mul_ps(half, _mm_add_ps(_mm_sub_ps(_mm_set1_ps(node.min_z), q.pz),
-                                                   _mm_sub_ps(_mm_set1_ps(node.max_z), q.pz)));
-    const glm::vec3 extent(node.max_x - node.min_x, node.max_y - node.min_y, node.max_z - node.min_z);
-    const __m128 radius = _mm_set1_ps(0.5f * std::sqrt((extent.x * extent.x + extent.y * extent.y) +
-                                                       extent.z * extent.z));
-    const __m128 dist = _mm_sqrt_ps(dot4(c_x, c_y, c_z, c_x, c_y, c_z));
-    const __m128 outside = _mm_cmpgt_ps(dist, radius);  // else any direction: cos_h_max = 1
-    const __m128 a_x = _mm_div_ps(c_x, dist), a_y = _mm_div_ps(c_y, dist), a_z = _mm_div_ps(c_z, dist);
-    const __m128 sin_c = glsl_min(_mm_div_ps(radius, dist), one);
-    // lc_cos_h_max.
-    const __m128 two_cos_o = _mm_mul_ps(_mm_set1_ps(2.0f), cos_o);
-    const __m128 wr_x = _mm_sub_ps(_mm_mul_ps(two_cos_o, q.nx), q.wox);
-    const __m128 wr_y = _mm_sub_ps(_mm_mul_ps(two_cos_o, q.ny), q.woy);
-    const __m128 wr_z = _mm_sub_ps(_mm_mul_ps(two_cos_o, q.nz), q.woz);
-    const __m128 cos_r = dot4(wr_x, wr_y, wr_z, a_x, a_y, a_z);
-    const __m128 cos_c = _mm_sqrt_ps(glsl_max(_mm_sub_ps(one, _mm_mul_ps(sin_c, sin_c)), zero));
-    const __m128 in_cone = _mm_cmpge_ps(cos_r, cos_c);  // the mirror direction in the cone: 1
-    const __m128 x_x = _mm_sub_ps(_mm_mul_ps(wr_y, a_z), _mm_mul_ps(a_y, wr_z));
-    const __m128 x_y = _mm_sub_ps(_mm_mul_ps(wr_z, a_x), _mm_mul_ps(a_z, wr_x));
-    const __m128 x_z = _mm_sub_ps(_mm_mul_ps(wr_x, a_y), _mm_mul_ps(a_x, wr_y));
-    const __m128 sin_r = _mm_sqrt_ps(dot4(x_x, x_y, x_z, x_x, x_y, x_z));
-    const __m128 cos_delta = glsl_min(
-        _mm_add_ps(_mm_add_ps(_mm_mul_ps(cos_r, cos_c), _mm_mul_ps(sin_r, sin_c)), _mm_set1_ps(Kernel::kCosineAbsSlack)),
-        one);
-    const __m128 narrowed = glsl_min(
-        _mm_mul_ps(_mm_sqrt_ps(glsl_max(_mm_add_ps(half, _mm_mul_ps(half, cos_delta)), zero)),
-                   _mm_set1_ps(Kernel::kBoundSlack)),
-        one);
-    const __m128 wide = _mm_andnot_ps(outside, one);
-    const __m128 narrow = _mm_and_ps(outside, _mm_or_ps(_mm_and_ps(in_cone, one), _mm_andnot_ps(in_cone, narrowed)));
-    const __m128 cos_h = _mm_or_ps(wide, narrow);
-    // lc_ggx_d(cos_h, alpha) * lc_smith_g1(cos_o, alpha) / (4 cos_o) * kBoundSlack.
-    const __m128 a2 = _mm_mul_ps(q.alpha, q.alpha);
-    const __m128 c2 = _mm_mul_ps(cos_h, cos_h);
-    const __m128 denom = _mm_add_ps(_mm_sub_ps(one, c2), _mm_mul_ps(a2, c2));
-    const __m128 d = _mm_div_ps(a2, _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(Kernel::kPi), denom), denom));
-    const __m128 g1 = _mm_div_ps(
-        _mm_mul_ps(_mm_set1_ps(2.0f), cos_o),
-        _mm_add_ps(cos_o, _mm_sqrt_ps(_mm_add_ps(a2, _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(one, a2), cos_o), cos_o)))));
-    const __m128 bound = _mm_mul_ps(_mm_div_ps(_mm_mul_ps(d, g1), _mm_mul_ps(_mm_set1_ps(4.0f), cos_o)),
-                                    _mm_set1_ps(Kernel::kBoundSlack));
-    alignas(16) float out[4];
-    _mm_store_ps(out, _mm_and_ps(bound, _mm_cmpnle_ps(cos_o, zero)));  // lc_ggx_bound: 0 where cos_o <= 0
-    for (unsigned p = 0; p < 4u; ++p) ggx[p] = (lanes >> p & 1u) != 0u ? out[p] : 0.0f;
 }
 
 // lc_cluster_error of one `node` at the quad's four points, into errors[p]
@@ -264,77 +220,90 @@ void quad_ggx_bounds(const QuadLanes& q, const gpu::LightNode& node, unsigned la
 template <class Kernel, class SurfacePoint>
 bool quad_errors(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, const gpu::LightNode& node,
                  float min_distance2, float errors[4]) {
+    (void)sp;
     if (!q.covered || !pair_bound_covers(node)) return false;
-    const __m128 half = _mm_set1_ps(0.5f), zero = _mm_setzero_ps();
-    const __m128 min_x = _mm_set1_ps(node.min_x), min_y = _mm_set1_ps(node.min_y), min_z = _mm_set1_ps(node.min_z);
-    const __m128 max_x = _mm_set1_ps(node.max_x), max_y = _mm_set1_ps(node.max_y), max_z = _mm_set1_ps(node.max_z);
-    const __m128 lo_x = _mm_sub_ps(min_x, q.px), lo_y = _mm_sub_ps(min_y, q.py), lo_z = _mm_sub_ps(min_z, q.pz);
-    const __m128 hi_x = _mm_sub_ps(max_x, q.px), hi_y = _mm_sub_ps(max_y, q.py), hi_z = _mm_sub_ps(max_z, q.pz);
-    const __m128 c_x = _mm_mul_ps(half, _mm_add_ps(lo_x, hi_x)), c_y = _mm_mul_ps(half, _mm_add_ps(lo_y, hi_y)),
-                 c_z = _mm_mul_ps(half, _mm_add_ps(lo_z, hi_z));
-    const __m128 e_x = _mm_mul_ps(half, _mm_sub_ps(hi_x, lo_x)), e_y = _mm_mul_ps(half, _mm_sub_ps(hi_y, lo_y)),
-                 e_z = _mm_mul_ps(half, _mm_sub_ps(hi_z, lo_z));
-    const __m128 ne = dot4(q.anx, q.any, q.anz, e_x, e_y, e_z);
-    const __m128 z_max = _mm_add_ps(
-        _mm_add_ps(dot4(q.nx, q.ny, q.nz, c_x, c_y, c_z), ne),
-        _mm_mul_ps(_mm_set1_ps(Kernel::kCosineAbsSlack),
-                   _mm_add_ps(dot4(q.anx, q.any, q.anz, abs_lanes(c_x), abs_lanes(c_y), abs_lanes(c_z)), ne)));
-    const __m128 near_x = glsl_max(
-        _mm_sub_ps(abs_lanes(dot4(q.tx, q.ty, q.tz, c_x, c_y, c_z)), dot4(q.atx, q.aty, q.atz, e_x, e_y, e_z)), zero);
-    const __m128 near_y = glsl_max(
-        _mm_sub_ps(abs_lanes(dot4(q.bx, q.by, q.bz, c_x, c_y, c_z)), dot4(q.abx, q.aby, q.abz, e_x, e_y, e_z)), zero);
-    const __m128 qq = _mm_add_ps(_mm_add_ps(_mm_mul_ps(near_x, near_x), _mm_mul_ps(near_y, near_y)),
-                                 _mm_mul_ps(z_max, z_max));
-    const __m128 bound = _mm_mul_ps(z_max, _mm_div_ps(_mm_set1_ps(1.0f), _mm_sqrt_ps(qq)));
-    const __m128 cos_bound = glsl_min(_mm_mul_ps(bound, _mm_set1_ps(Kernel::kBoundSlack)), _mm_set1_ps(1.0f));
-    // lc_cosine_bound and lc_cluster_bound return 0 where z_max <= 0 or the
-    // cosine bound <= 0 (a NaN goes on, as there).
-    const __m128 lit = _mm_and_ps(_mm_cmpnle_ps(z_max, zero), q.active);
-    alignas(16) float cosines[4];
-    _mm_store_ps(cosines, _mm_and_ps(cos_bound, lit));
-    const __m128 positive = _mm_and_ps(_mm_cmpnle_ps(_mm_load_ps(cosines), zero), q.active);
-    if (_mm_movemask_ps(positive) == 0) {
-        for (unsigned p = 0; p < 4u; ++p) errors[p] = 0.0f;
-        return true;
-    }
-    const __m128 d_x = glsl_max(glsl_max(lo_x, _mm_sub_ps(q.px, max_x)), zero);
-    const __m128 d_y = glsl_max(glsl_max(lo_y, _mm_sub_ps(q.py, max_y)), zero);
-    const __m128 d_z = glsl_max(glsl_max(lo_z, _mm_sub_ps(q.pz, max_z)), zero);
-    const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(d_x, d_x), _mm_mul_ps(d_y, d_y)), _mm_mul_ps(d_z, d_z));
-    const std::uint32_t type = (node.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask;
-    const __m128 clamp = _mm_set1_ps(kernel.lc_falloff_clamp2(min_distance2, type));
-    const __m128 factor = _mm_div_ps(_mm_set1_ps(Kernel::kBoundSlack), glsl_max(d2, clamp));
-    const __m128 cos_over_pi = _mm_div_ps(_mm_load_ps(cosines), _mm_set1_ps(Kernel::kPi));
-    __m128 r = _mm_mul_ps(q.kd_r, cos_over_pi);
-    __m128 g = _mm_mul_ps(q.kd_g, cos_over_pi);
-    __m128 b = _mm_mul_ps(q.kd_b, cos_over_pi);
-    if (q.specular != 0u) {
-        alignas(16) float ks[3][4] = {}, ggx[4] = {};
-        unsigned lanes = 0u;
-        for (unsigned p = 0; p < 4u; ++p) {
-            if ((q.specular >> p & 1u) == 0u || cosines[p] <= 0.0f) continue;
-            lanes |= 1u << p;
-            ks[0][p] = sp[p].mat.ks_r;
-            ks[1][p] = sp[p].mat.ks_g;
-            ks[2][p] = sp[p].mat.ks_b;
-        }
-        quad_ggx_bounds<Kernel>(q, node, lanes, ggx);
-        const __m128 gv = _mm_load_ps(ggx);
-        r = _mm_add_ps(r, _mm_mul_ps(_mm_load_ps(ks[0]), gv));
-        g = _mm_add_ps(g, _mm_mul_ps(_mm_load_ps(ks[1]), gv));
-        b = _mm_add_ps(b, _mm_mul_ps(_mm_load_ps(ks[2]), gv));
-    }
-    r = _mm_mul_ps(_mm_mul_ps(r, factor), _mm_set1_ps(node.intensity_r));
-    g = _mm_mul_ps(_mm_mul_ps(g, factor), _mm_set1_ps(node.intensity_g));
-    b = _mm_mul_ps(_mm_mul_ps(b, factor), _mm_set1_ps(node.intensity_b));
-    const __m128 error = _mm_add_ps(
-        _mm_add_ps(_mm_mul_ps(_mm_set1_ps(0.2126f), r), _mm_mul_ps(_mm_set1_ps(0.7152f), g)),
-        _mm_mul_ps(_mm_set1_ps(0.0722f), b));
-    alignas(16) float out[4];
-    _mm_store_ps(out, _mm_and_ps(error, positive));
-    for (unsigned p = 0; p < 4u; ++p) errors[p] = out[p];
+    const quad4::QuadNodes n = quad4::quad_nodes(kernel, node, node, min_distance2);
+    __m128 e;
+    quad4::cluster_errors<Kernel>(q, n, e);
+    _mm_storeu_ps(errors, e);
     return true;
 }
+
+// The same for two clusters at once, in the eight lanes of AVX2: the first
+// in lanes 0-3, the second in lanes 4-7, the points in both halves. A
+// refinement's two children take one evaluation instead of two. Built for
+// AVX2 (and taken where the CPU has it, host/quad_cut.h); the build's
+// -ffp-contract=off keeps every multiply and add apart, so the values are
+// the SSE ones and the scalar ones, bit for bit.
+#pragma GCC push_options
+#pragma GCC target("avx2")
+namespace quad8 {
+using V = __m256;
+inline V v_set1(float x) { return _mm256_set1_ps(x); }
+inline V v_zero() { return _mm256_setzero_ps(); }
+inline V v_add(V a, V b) { return _mm256_add_ps(a, b); }
+inline V v_sub(V a, V b) { return _mm256_sub_ps(a, b); }
+inline V v_mul(V a, V b) { return _mm256_mul_ps(a, b); }
+inline V v_div(V a, V b) { return _mm256_div_ps(a, b); }
+inline V v_sqrt(V a) { return _mm256_sqrt_ps(a); }
+inline V v_and(V a, V b) { return _mm256_and_ps(a, b); }
+inline V v_andnot(V a, V b) { return _mm256_andnot_ps(a, b); }
+inline V v_or(V a, V b) { return _mm256_or_ps(a, b); }
+// The SSE compares' predicates: ordered (false for a NaN) for > and >=,
+// unordered (true for a NaN) for "not <=".
+inline V v_cmpgt(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GT_OS); }
+inline V v_cmpge(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GE_OS); }
+inline V v_cmpnle(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_NLE_US); }
+inline V v_abs(V a) { return _mm256_andnot_ps(_mm256_set1_ps(-0.0f), a); }
+inline V v_min(V x, V y) { return _mm256_min_ps(y, x); }
+inline V v_max(V x, V y) { return _mm256_max_ps(y, x); }
+inline int v_movemask(V a) { return _mm256_movemask_ps(a); }
+inline V v_set2(float a, float b) { return _mm256_setr_ps(a, a, a, a, b, b, b, b); }
+#include "quad_bounds_body.h"
+
+inline V twice(__m128 v) { return _mm256_insertf128_ps(_mm256_castps128_ps256(v), v, 1); }
+
+// The quad's lanes in both halves.
+inline void widen(const quad4::QuadLanes& q, QuadLanes& w) {
+    const __m128 quad4::QuadLanes::*fields[] = {
+        &quad4::QuadLanes::px,   &quad4::QuadLanes::py,   &quad4::QuadLanes::pz,    &quad4::QuadLanes::nx,
+        &quad4::QuadLanes::ny,   &quad4::QuadLanes::nz,   &quad4::QuadLanes::anx,   &quad4::QuadLanes::any,
+        &quad4::QuadLanes::anz,  &quad4::QuadLanes::tx,   &quad4::QuadLanes::ty,    &quad4::QuadLanes::tz,
+        &quad4::QuadLanes::atx,  &quad4::QuadLanes::aty,  &quad4::QuadLanes::atz,   &quad4::QuadLanes::bx,
+        &quad4::QuadLanes::by,   &quad4::QuadLanes::bz,   &quad4::QuadLanes::abx,   &quad4::QuadLanes::aby,
+        &quad4::QuadLanes::abz,  &quad4::QuadLanes::kd_r, &quad4::QuadLanes::kd_g,  &quad4::QuadLanes::kd_b,
+        &quad4::QuadLanes::ks_r, &quad4::QuadLanes::ks_g, &quad4::QuadLanes::ks_b,  &quad4::QuadLanes::wox,
+        &quad4::QuadLanes::woy,  &quad4::QuadLanes::woz,  &quad4::QuadLanes::cos_o, &quad4::QuadLanes::wr_x,
+        &quad4::QuadLanes::wr_y, &quad4::QuadLanes::wr_z, &quad4::QuadLanes::a2,    &quad4::QuadLanes::g1,
+        &quad4::QuadLanes::four_cos_o, &quad4::QuadLanes::active, &quad4::QuadLanes::specular_lanes};
+    V QuadLanes::*wide[] = {
+        &QuadLanes::px,   &QuadLanes::py,   &QuadLanes::pz,    &QuadLanes::nx,   &QuadLanes::ny,
+        &QuadLanes::nz,   &QuadLanes::anx,  &QuadLanes::any,   &QuadLanes::anz,  &QuadLanes::tx,
+        &QuadLanes::ty,   &QuadLanes::tz,   &QuadLanes::atx,   &QuadLanes::aty,  &QuadLanes::atz,
+        &QuadLanes::bx,   &QuadLanes::by,   &QuadLanes::bz,    &QuadLanes::abx,  &QuadLanes::aby,
+        &QuadLanes::abz,  &QuadLanes::kd_r, &QuadLanes::kd_g,  &QuadLanes::kd_b, &QuadLanes::ks_r,
+        &QuadLanes::ks_g, &QuadLanes::ks_b, &QuadLanes::wox,   &QuadLanes::woy,  &QuadLanes::woz,
+        &QuadLanes::cos_o, &QuadLanes::wr_x, &QuadLanes::wr_y, &QuadLanes::wr_z, &QuadLanes::a2,
+        &QuadLanes::g1,   &QuadLanes::four_cos_o, &QuadLanes::active, &QuadLanes::specular_lanes};
+    static_assert(sizeof fields / sizeof fields[0] == sizeof wide / sizeof wide[0]);
+    for (std::size_t i = 0; i < sizeof wide / sizeof wide[0]; ++i) w.*wide[i] = twice(q.*fields[i]);
+    w.specular = q.specular;
+    w.covered = q.covered;
+}
+
+// lc_cluster_error of `a` into errors_a[p] and of `b` into errors_b[p], at
+// the quad's points (zero in inactive lanes). For clusters that
+// quad_errors covers (the caller checks).
+template <class Kernel>
+void quad_pair_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode& a, const gpu::LightNode& b,
+                      float min_distance2, float errors_a[4], float errors_b[4]) {
+    V e;
+    cluster_errors<Kernel>(q, quad_nodes(kernel, a, b, min_distance2), e);
+    _mm_storeu_ps(errors_a, _mm256_castps256_ps128(e));
+    _mm_storeu_ps(errors_b, _mm256_extractf128_ps(e, 1));
+}
+}  // namespace quad8
+#pragma GCC pop_options
 
 // lc_light_unit of one point `light` at the quad's four points, lane by
 // lane, into unit[p] (zero in inactive lanes), and for each point where the

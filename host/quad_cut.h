@@ -81,6 +81,8 @@ public:
         active_ = active;
 #if defined(__SSE2__)
         lanes_ = quad_lanes(sp, active);
+        wide_ = lanes_.covered && cpu_has_avx2();
+        if (wide_) quad8::widen(lanes_, lanes8_);
 #endif
         stats_ = stats;
         size_ = 0u;
@@ -318,6 +320,19 @@ private:
             out[p] = lane(p) ? k_.lc_cluster_error(sp_[p], sp_[p].mat, node, f_.min_distance2) : 0.0f;
     }
 
+    // errors() of both children of a refinement: in one evaluation of
+    // eight lanes where the CPU has AVX2 and quad_errors covers both.
+    void child_errors(const LightNode& a, const LightNode& b, float* errors_a, float* errors_b) {
+#if defined(__SSE2__)
+        if (!Kernel::tightest_bound && wide_ && pair_bound_covers(a) && pair_bound_covers(b)) {
+            quad8::quad_pair_errors(k_, lanes8_, a, b, f_.min_distance2, errors_a, errors_b);
+            return;
+        }
+#endif
+        errors(a, errors_a);
+        errors(b, errors_b);
+    }
+
     // Replaces the cluster at the top of the heap by its children. The
     // child that keeps the parent's representative keeps its units (and
     // its slot); the other one's come from one new shadow ray per point.
@@ -335,8 +350,7 @@ private:
         QuadEntry& fresh = entries_[fresh_slot];
         kept.node = kept_index;
         fresh.node = fresh_index;
-        errors(kept_node, kept.error);
-        errors(fresh_node, fresh.error);
+        child_errors(kept_node, fresh_node, kept.error, fresh.error);
         const bool fresh_leaf = (fresh_node.flags & kNodeLeaf) != 0u;
         // The new representative's shadow ray from each point, the four
         // traced together (lc_visible4: each ray tested on its own at every
@@ -407,6 +421,8 @@ private:
     unsigned active_ = 0u;
 #if defined(__SSE2__)
     QuadLanes lanes_;
+    quad8::QuadLanes lanes8_;  // lanes_ in both halves (child_errors)
+    bool wide_ = false;        // lanes8_ is set and used
 #endif
     ShadeStats* stats_ = nullptr;
     vec3 fixed_[kQuadLanes];     // each point's final estimates: leaves and frozen clusters

@@ -43,7 +43,9 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
     Kernel k;
     k.materials = materials.data();  // lc_make_surface's; each point's own is set after it
     k.vpl_min_distance2 = 0.01f;
-    int trials = 0, covered = 0, checked = 0, nonzero = 0;
+    int trials = 0, covered = 0, checked = 0, nonzero = 0, pairs = 0;
+    gpu::LightNode previous{};
+    bool have_previous = false;
     for (int trial = 0; trial < 40000; ++trial) {
         const glm::vec3 centre = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 4.0f;
         // Some boxes past the float range's middle, whose arithmetic gives
@@ -90,10 +92,36 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
             ASSERT_TRUE(errors[p] == scalar || (std::isnan(errors[p]) && std::isnan(scalar)))
                 << "trial " << trial << " lane " << p << ": " << errors[p] << " against " << scalar;
         }
+#if defined(__SSE2__)
+        // Both children at once (AVX2, quad_pair_errors): this cluster and
+        // the last covered one in the eight lanes, each half its scalar
+        // values bit for bit.
+        if (cpu::cpu_has_avx2() && have_previous) {
+            cpu::quad8::QuadLanes wide;
+            cpu::quad8::widen(lanes, wide);
+            float first[4], second[4];
+            cpu::quad8::quad_pair_errors(k, wide, node, previous, min_distance2, first, second);
+            for (unsigned p = 0; p < 4u; ++p) {
+                const float scalar = (active >> p & 1u) != 0u
+                                         ? k.lc_cluster_error(sp[p], sp[p].mat, previous, min_distance2)
+                                         : 0.0f;
+                ASSERT_TRUE(first[p] == errors[p] || (std::isnan(first[p]) && std::isnan(errors[p])))
+                    << "trial " << trial << " lane " << p << " (pair, first)";
+                ASSERT_TRUE(second[p] == scalar || (std::isnan(second[p]) && std::isnan(scalar)))
+                    << "trial " << trial << " lane " << p << " (pair, second): " << second[p] << " against " << scalar;
+            }
+            ++pairs;
+        }
+        previous = node;
+        have_previous = true;
+#endif
     }
 #if defined(__SSE2__)
     EXPECT_GT(covered, trials / 2);
     EXPECT_GT(nonzero, checked / 3);
+    if (cpu::cpu_has_avx2()) {
+        EXPECT_GT(pairs, covered / 2);
+    }
 #endif
 }
 

@@ -1,0 +1,177 @@
+// The quad bound evaluation of host/pair_bound.h, written once over a
+// vector of float lanes: pair_bound.h includes this file twice, in
+// namespace quad4 (SSE: the four points of a quad in the lanes) and, built
+// for AVX2, in namespace quad8 (two clusters at the four points, the first
+// in lanes 0-3, the second in lanes 4-7). The including namespace provides
+// the vector type V and its operations v_set1, v_zero, v_add, v_sub, v_mul,
+// v_div, v_sqrt, v_and, v_andnot, v_or, v_cmpgt, v_cmpge, v_cmpnle,
+// v_abs, v_min and v_max (GLSL's min and max, see glsl_min), v_movemask,
+// and v_set2(a, b): the first cluster's value a and the second's b.
+// Every value is computed with the same operations in the same order as
+// the scalar lc_cluster_bound and lc_ggx_bound (shaders/shared), so the
+// results are theirs bit for bit (tests/test_quad_cut.cpp).
+// No include guard: included once per vector width.
+
+// The shaded points lane by lane: positions, frames, the diffuse and
+// specular colours (zero at points without a GGX lobe) and what the GGX
+// bound needs of each point alone.
+struct QuadLanes {
+    V px, py, pz;
+    V nx, ny, nz, anx, any, anz;
+    V tx, ty, tz, atx, aty, atz;
+    V bx, by, bz, abx, aby, abz;
+    V kd_r, kd_g, kd_b, ks_r, ks_g, ks_b;
+    V wox, woy, woz;
+    // lc_ggx_bound's terms that depend on the point alone: cos_o, the
+    // mirror direction wr, alpha^2, lc_smith_g1(cos_o, alpha) and 4 cos_o.
+    V cos_o, wr_x, wr_y, wr_z, a2, g1, four_cos_o;
+    V active;             // all ones in the lanes of active points
+    V specular_lanes;     // all ones in the lanes of active points with a GGX lobe
+    unsigned specular;    // lanes whose material has a GGX lobe
+    bool covered = false; // no active point has the Disney BRDF
+};
+
+// The clusters lane by lane: their boxes, radii, intensities and falloff
+// clamps.
+struct QuadNodes {
+    V min_x, min_y, min_z, max_x, max_y, max_z;
+    V radius;  // half the box's diagonal (lc_box_cone)
+    V intensity_r, intensity_g, intensity_b;
+    V clamp;   // lc_falloff_clamp2 of the cluster's type
+};
+
+// The clusters `a` and `b` as v_set2 lays them out.
+template <class Kernel>
+LC_ALWAYS_INLINE inline QuadNodes quad_nodes(Kernel& kernel, const gpu::LightNode& a, const gpu::LightNode& b,
+                                             float min_distance2) {
+    const auto radius = [](const gpu::LightNode& n) {
+        const glm::vec3 extent(n.max_x - n.min_x, n.max_y - n.min_y, n.max_z - n.min_z);
+        return 0.5f * std::sqrt((extent.x * extent.x + extent.y * extent.y) + extent.z * extent.z);
+    };
+    const auto clamp = [&](const gpu::LightNode& n) {
+        return kernel.lc_falloff_clamp2(min_distance2, (n.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask);
+    };
+    return {v_set2(a.min_x, b.min_x),
+            v_set2(a.min_y, b.min_y),
+            v_set2(a.min_z, b.min_z),
+            v_set2(a.max_x, b.max_x),
+            v_set2(a.max_y, b.max_y),
+            v_set2(a.max_z, b.max_z),
+            v_set2(radius(a), radius(b)),
+            v_set2(a.intensity_r, b.intensity_r),
+            v_set2(a.intensity_g, b.intensity_g),
+            v_set2(a.intensity_b, b.intensity_b),
+            v_set2(clamp(a), clamp(b))};
+}
+
+// ((a_x * v_x + a_y * v_y) + a_z * v_z) lane by lane: glm's dot.
+LC_ALWAYS_INLINE inline V dot4(V ax, V ay, V az, V vx, V vy, V vz) {
+    return v_add(v_add(v_mul(ax, vx), v_mul(ay, vy)), v_mul(az, vz));
+}
+
+// The point-only terms of QuadLanes from its positions, frames, view
+// directions and the roughness `alpha`.
+LC_ALWAYS_INLINE inline void set_ggx_terms(QuadLanes& q, V alpha) {
+    const V one = v_set1(1.0f), two = v_set1(2.0f);
+    q.cos_o = dot4(q.nx, q.ny, q.nz, q.wox, q.woy, q.woz);
+    const V two_cos_o = v_mul(two, q.cos_o);
+    q.wr_x = v_sub(v_mul(two_cos_o, q.nx), q.wox);
+    q.wr_y = v_sub(v_mul(two_cos_o, q.ny), q.woy);
+    q.wr_z = v_sub(v_mul(two_cos_o, q.nz), q.woz);
+    q.a2 = v_mul(alpha, alpha);
+    q.g1 = v_div(v_mul(two, q.cos_o),
+                 v_add(q.cos_o, v_sqrt(v_add(q.a2, v_mul(v_mul(v_sub(one, q.a2), q.cos_o), q.cos_o)))));
+    q.four_cos_o = v_mul(v_set1(4.0f), q.cos_o);
+}
+
+// lc_ggx_bound of each lane's box at its point: lc_box_cone, lc_cos_h_max,
+// lc_ggx_d and lc_smith_g1; 0 where cos_o <= 0, anything in lanes the
+// caller masks.
+template <class Kernel>
+LC_ALWAYS_INLINE inline V ggx_bounds(const QuadLanes& q, const QuadNodes& n) {
+    const V zero = v_zero(), one = v_set1(1.0f), half = v_set1(0.5f);
+    // lc_box_cone: the box seen from each point.
+    const V c_x = v_mul(half, v_add(v_sub(n.min_x, q.px), v_sub(n.max_x, q.px)));
+    const V c_y = v_mul(half, v_add(v_sub(n.min_y, q.py), v_sub(n.max_y, q.py)));
+    const V c_z = v_mul(half, v_add(v_sub(n.min_z, q.pz), v_sub(n.max_z, q.pz)));
+    const V dist = v_sqrt(dot4(c_x, c_y, c_z, c_x, c_y, c_z));
+    const V outside = v_cmpgt(dist, n.radius);  // else any direction: cos_h_max = 1
+    const V a_x = v_div(c_x, dist), a_y = v_div(c_y, dist), a_z = v_div(c_z, dist);
+    const V sin_c = v_min(v_div(n.radius, dist), one);
+    // lc_cos_h_max.
+    const V cos_r = dot4(q.wr_x, q.wr_y, q.wr_z, a_x, a_y, a_z);
+    const V cos_c = v_sqrt(v_max(v_sub(one, v_mul(sin_c, sin_c)), zero));
+    const V in_cone = v_cmpge(cos_r, cos_c);  // the mirror direction in the cone: 1
+    const V x_x = v_sub(v_mul(q.wr_y, a_z), v_mul(a_y, q.wr_z));
+    const V x_y = v_sub(v_mul(q.wr_z, a_x), v_mul(a_z, q.wr_x));
+    const V x_z = v_sub(v_mul(q.wr_x, a_y), v_mul(a_x, q.wr_y));
+    const V sin_r = v_sqrt(dot4(x_x, x_y, x_z, x_x, x_y, x_z));
+    const V cos_delta =
+        v_min(v_add(v_add(v_mul(cos_r, cos_c), v_mul(sin_r, sin_c)), v_set1(Kernel::kCosineAbsSlack)), one);
+    const V narrowed =
+        v_min(v_mul(v_sqrt(v_max(v_add(half, v_mul(half, cos_delta)), zero)), v_set1(Kernel::kBoundSlack)), one);
+    const V wide = v_andnot(outside, one);
+    const V narrow = v_and(outside, v_or(v_and(in_cone, one), v_andnot(in_cone, narrowed)));
+    const V cos_h = v_or(wide, narrow);
+    // lc_ggx_d(cos_h, alpha) * lc_smith_g1(cos_o, alpha) / (4 cos_o) * kBoundSlack.
+    const V c2 = v_mul(cos_h, cos_h);
+    const V denom = v_add(v_sub(one, c2), v_mul(q.a2, c2));
+    const V d = v_div(q.a2, v_mul(v_mul(v_set1(Kernel::kPi), denom), denom));
+    const V bound = v_mul(v_div(v_mul(d, q.g1), q.four_cos_o), v_set1(Kernel::kBoundSlack));
+    return v_and(bound, v_cmpnle(q.cos_o, zero));  // lc_ggx_bound: 0 where cos_o <= 0
+}
+
+// lc_cluster_error of each lane's cluster at its point, 0 in inactive
+// lanes; false (and zeros) when it is 0 in every lane.
+template <class Kernel>
+LC_ALWAYS_INLINE inline bool cluster_errors(const QuadLanes& q, const QuadNodes& n, V& errors) {
+    const V half = v_set1(0.5f), zero = v_zero();
+    const V lo_x = v_sub(n.min_x, q.px), lo_y = v_sub(n.min_y, q.py), lo_z = v_sub(n.min_z, q.pz);
+    const V hi_x = v_sub(n.max_x, q.px), hi_y = v_sub(n.max_y, q.py), hi_z = v_sub(n.max_z, q.pz);
+    const V c_x = v_mul(half, v_add(lo_x, hi_x)), c_y = v_mul(half, v_add(lo_y, hi_y)),
+            c_z = v_mul(half, v_add(lo_z, hi_z));
+    const V e_x = v_mul(half, v_sub(hi_x, lo_x)), e_y = v_mul(half, v_sub(hi_y, lo_y)),
+            e_z = v_mul(half, v_sub(hi_z, lo_z));
+    const V ne = dot4(q.anx, q.any, q.anz, e_x, e_y, e_z);
+    const V z_max = v_add(v_add(dot4(q.nx, q.ny, q.nz, c_x, c_y, c_z), ne),
+                          v_mul(v_set1(Kernel::kCosineAbsSlack),
+                                v_add(dot4(q.anx, q.any, q.anz, v_abs(c_x), v_abs(c_y), v_abs(c_z)), ne)));
+    const V near_x =
+        v_max(v_sub(v_abs(dot4(q.tx, q.ty, q.tz, c_x, c_y, c_z)), dot4(q.atx, q.aty, q.atz, e_x, e_y, e_z)), zero);
+    const V near_y =
+        v_max(v_sub(v_abs(dot4(q.bx, q.by, q.bz, c_x, c_y, c_z)), dot4(q.abx, q.aby, q.abz, e_x, e_y, e_z)), zero);
+    const V qq = v_add(v_add(v_mul(near_x, near_x), v_mul(near_y, near_y)), v_mul(z_max, z_max));
+    const V bound = v_mul(z_max, v_div(v_set1(1.0f), v_sqrt(qq)));
+    const V cos_bound = v_min(v_mul(bound, v_set1(Kernel::kBoundSlack)), v_set1(1.0f));
+    // lc_cosine_bound and lc_cluster_bound return 0 where z_max <= 0 or the
+    // cosine bound <= 0 (a NaN goes on, as there).
+    const V cosines = v_and(cos_bound, v_and(v_cmpnle(z_max, zero), q.active));
+    const V positive = v_and(v_cmpnle(cosines, zero), q.active);
+    if (v_movemask(positive) == 0) {
+        errors = zero;
+        return false;
+    }
+    const V d_x = v_max(v_max(lo_x, v_sub(q.px, n.max_x)), zero);
+    const V d_y = v_max(v_max(lo_y, v_sub(q.py, n.max_y)), zero);
+    const V d_z = v_max(v_max(lo_z, v_sub(q.pz, n.max_z)), zero);
+    const V d2 = v_add(v_add(v_mul(d_x, d_x), v_mul(d_y, d_y)), v_mul(d_z, d_z));
+    const V factor = v_div(v_set1(Kernel::kBoundSlack), v_max(d2, n.clamp));
+    const V cos_over_pi = v_div(cosines, v_set1(Kernel::kPi));
+    V r = v_mul(q.kd_r, cos_over_pi);
+    V g = v_mul(q.kd_g, cos_over_pi);
+    V b = v_mul(q.kd_b, cos_over_pi);
+    if (q.specular != 0u) {
+        // The lobe counts at points that have one, where the cosine bound
+        // is above 0 (or NaN), as in lc_cluster_bound.
+        const V ggx = v_and(ggx_bounds<Kernel>(q, n), v_and(positive, q.specular_lanes));
+        r = v_add(r, v_mul(q.ks_r, ggx));
+        g = v_add(g, v_mul(q.ks_g, ggx));
+        b = v_add(b, v_mul(q.ks_b, ggx));
+    }
+    r = v_mul(v_mul(r, factor), n.intensity_r);
+    g = v_mul(v_mul(g, factor), n.intensity_g);
+    b = v_mul(v_mul(b, factor), n.intensity_b);
+    const V error = v_add(v_add(v_mul(v_set1(0.2126f), r), v_mul(v_set1(0.7152f), g)), v_mul(v_set1(0.0722f), b));
+    errors = v_and(error, positive);
+    return true;
+}
