@@ -227,18 +227,30 @@ private:
         key_[i] = key;
         slot_[i] = slot;
     }
+    // The larger child's key is kept as read, not read again, and the
+    // heap's size and arrays are locals: through the stores into the
+    // arrays the compiler would otherwise read size_ again every level.
     void sift_down(uint i, float key, uint slot) {
+        float* const keys = key_;
+        uint* const slots = slot_;
+        const uint size = size_;
         while (true) {
             uint child = 2u * i + 1u;
-            if (child >= size_) break;
-            if (child + 1u < size_) child += uint(key_[child + 1u] > key_[child]);
-            if (key_[child] <= key) break;
-            key_[i] = key_[child];
-            slot_[i] = slot_[child];
+            if (child >= size) break;
+            float child_key = keys[child];
+            if (child + 1u < size) {
+                const float right = keys[child + 1u];
+                const bool right_larger = right > child_key;
+                child += uint(right_larger);
+                child_key = right_larger ? right : child_key;
+            }
+            if (child_key <= key) break;
+            keys[i] = child_key;
+            slots[i] = slots[child];
             i = child;
         }
-        key_[i] = key;
-        slot_[i] = slot;
+        keys[i] = key;
+        slots[i] = slot;
     }
     void remove_estimate(const QuadEntry& e, vec3* into) {
         const vec3 intensity = k_.lc_node_intensity(k_.light_nodes[e.node]);
