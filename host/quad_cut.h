@@ -30,13 +30,30 @@ namespace lc::cpu {
 
 inline constexpr uint kQuadLanes = 4u;
 
+// A colour at each of the four points, a row per channel (r, g, b), so
+// that the four points' sums are one vector operation a channel.
+struct QuadColor {
+    float c[3][kQuadLanes];
+    vec3 at(uint p) const { return vec3(c[0][p], c[1][p], c[2][p]); }
+    void set(uint p, vec3 v) { c[0][p] = v.x, c[1][p] = v.y, c[2][p] = v.z; }
+    void clear() {
+        for (auto& row : c)
+            for (float& x : row) x = 0.0f;
+    }
+    // this += unit * intensity, channel by channel.
+    void add_scaled(const QuadColor& unit, vec3 intensity) {
+        for (uint k = 0; k < 3u; ++k)
+            for (uint p = 0; p < kQuadLanes; ++p) c[k][p] += unit.c[k][p] * intensity[int(k)];
+    }
+};
+
 // One cluster of a quad's cut: its node, and at each of the four points its
 // error bound and its representative's unit contribution (zero where the
 // light is hidden or the bound is zero).
 struct QuadEntry {
     uint node;
     float error[kQuadLanes];
-    vec3 unit[kQuadLanes];
+    QuadColor unit;
 };
 
 // The quad's cut heap: `key` and `slot` are the heap (a max-heap on key,
@@ -88,9 +105,9 @@ public:
         size_ = 0u;
         free_count_ = capacity_ + 1u;
         for (uint i = 0; i <= capacity_; ++i) free_[i] = capacity_ - i;
+        fixed_.clear();
+        heap_sum_.clear();
         for (uint p = 0; p < kQuadLanes; ++p) {
-            fixed_[p] = vec3(0.0f);
-            heap_sum_[p] = vec3(0.0f);
             frozen_error_[p] = 0.0f;
             stats[p] = ShadeStats{};
         }
@@ -107,11 +124,11 @@ public:
             QuadEntry& e = entries_[slot];
             e.node = f_.roots[type];
             errors(root, e.error);
+            e.unit.clear();
             for (uint p = 0; p < kQuadLanes; ++p) {
-                e.unit[p] = vec3(0.0f);
                 if (lane(p) && k_.lc_cluster_needs_unit(root, e.error[p])) {
                     bool visible;
-                    e.unit[p] = k_.lc_rep_unit(sp_[p], root.rep_light, f_.min_distance2, visible, stats_[p]);
+                    e.unit.set(p, k_.lc_rep_unit(sp_[p], root.rep_light, f_.min_distance2, visible, stats_[p]));
                 }
             }
             for (uint p = 0; p < kQuadLanes; ++p)
@@ -128,15 +145,13 @@ public:
         refine_all();
         // Each point's sum over the heap's clusters in heap order, each
         // cluster's node read once for the four.
-        vec3 sum[kQuadLanes];
-        for (uint p = 0; p < kQuadLanes; ++p) sum[p] = fixed_[p];
+        QuadColor sum = fixed_;
         for (uint i = 0; i < size_; ++i) {
             const QuadEntry& e = entries_[slot_[i]];
-            const vec3 intensity = k_.lc_node_intensity(k_.light_nodes[e.node]);
-            for (uint p = 0; p < kQuadLanes; ++p) sum[p] += e.unit[p] * intensity;
+            sum.add_scaled(e.unit, k_.lc_node_intensity(k_.light_nodes[e.node]));
         }
         for (uint p = 0; p < kQuadLanes; ++p) {
-            radiance[p] = sum[p];
+            radiance[p] = sum.at(p);
             stats[p].cut_size = cut_size_;
             stats[p].cut_indirect = cut_indirect_;
             stats[p].hit_max_cut = hit_max_cut_;
@@ -160,19 +175,19 @@ private:
     bool enter(const LightNode& node, QuadEntry& e) {
         const vec3 intensity = k_.lc_node_intensity(node);
         if ((node.flags & kNodeLeaf) != 0u) {
-            for (uint p = 0; p < kQuadLanes; ++p) fixed_[p] += e.unit[p] * intensity;
+            fixed_.add_scaled(e.unit, intensity);
             return false;
         }
         bool any = false;
         for (uint p = 0; p < kQuadLanes; ++p) {
             if (!(e.error[p] > 0.0f)) {
-                e.unit[p] = vec3(0.0f);
+                e.unit.set(p, vec3(0.0f));
                 continue;
             }
             any = true;
         }
         if (!any) return false;
-        for (uint p = 0; p < kQuadLanes; ++p) heap_sum_[p] += e.unit[p] * intensity;
+        heap_sum_.add_scaled(e.unit, intensity);
         __builtin_prefetch(k_.light_nodes + node.left);
         __builtin_prefetch(k_.light_nodes + node.left + 1u);
         return true;
@@ -193,17 +208,21 @@ private:
     // them, and the floor kept within the normal floats. A point whose
     // estimate is not finite adds nothing to the sum.
     void update_weights() {
+        // Loops over the four points, one vector operation each.
         float estimate[kQuadLanes], quarter[kQuadLanes];
-        bool any = false;
+        for (uint p = 0; p < kQuadLanes; ++p)
+            estimate[p] = 0.2126f * (fixed_.c[0][p] + heap_sum_.c[0][p]) +
+                          0.7152f * (fixed_.c[1][p] + heap_sum_.c[1][p]) +
+                          0.0722f * (fixed_.c[2][p] + heap_sum_.c[2][p]);  // lc_luminance
+        unsigned counts = 0u;
         for (uint p = 0; p < kQuadLanes; ++p) {
-            estimate[p] = lc_luminance(fixed_[p] + heap_sum_[p]);
-            const bool counts = estimate[p] > 0.0f && !std::isinf(estimate[p]);
-            quarter[p] = counts ? estimate[p] * 0.25f : 0.0f;
-            any = any || counts;
+            const bool finite_positive = estimate[p] > 0.0f && estimate[p] < INFINITY;
+            quarter[p] = finite_positive ? estimate[p] * 0.25f : 0.0f;
+            counts |= unsigned(finite_positive);
         }
-        const float total = any ? quad_sum(quarter) : root_bounds_;
+        const float total = counts != 0u ? quad_sum(quarter) : root_bounds_;
         const float floor = std::clamp(total * 0x1p-18f, FLT_MIN, FLT_MAX);
-        for (uint p = 0; p < kQuadLanes; ++p) weight_[p] = 1.0f / std::max(estimate[p], floor);
+        for (uint p = 0; p < kQuadLanes; ++p) weight_[p] = 1.0f / (estimate[p] < floor ? floor : estimate[p]);
     }
     static float quad_sum(const float* v) { return (v[0] + v[1]) + (v[2] + v[3]); }
     // A cluster's key in the heap: its largest ratio of bound to estimate
@@ -252,13 +271,14 @@ private:
         keys[i] = key;
         slots[i] = slot;
     }
-    void remove_estimate(const QuadEntry& e, vec3* into) {
+    void remove_estimate(const QuadEntry& e, QuadColor* into) {
         const vec3 intensity = k_.lc_node_intensity(k_.light_nodes[e.node]);
-        for (uint p = 0; p < kQuadLanes; ++p) {
-            const vec3 estimate = e.unit[p] * intensity;
-            heap_sum_[p] -= estimate;
-            if (into != nullptr) into[p] += estimate;
-        }
+        for (uint k = 0; k < 3u; ++k)
+            for (uint p = 0; p < kQuadLanes; ++p) {
+                const float estimate = e.unit.c[k][p] * intensity[int(k)];
+                heap_sum_.c[k][p] -= estimate;
+                if (into != nullptr) into->c[k][p] += estimate;
+            }
     }
 
     // Pushes the entry in `slot` (its estimates already in heap_sum_) with
@@ -274,7 +294,7 @@ private:
         const uint smallest = heap_smallest(key_, size_ / 2u, size_, key);
         const uint leaving = smallest == kInvalidIndex ? slot : slot_[smallest];
         for (uint p = 0; p < kQuadLanes; ++p) frozen_error_[p] += entries_[leaving].error[p];
-        remove_estimate(entries_[leaving], fixed_);
+        remove_estimate(entries_[leaving], &fixed_);
         if (smallest == kInvalidIndex) {
             free_[free_count_++] = slot;
             return;
@@ -379,7 +399,7 @@ private:
 #endif
         RayPacket4 rays;
         for (uint p = 0; p < kQuadLanes; ++p) {
-            fresh.unit[p] = vec3(0.0f);
+            fresh.unit.set(p, vec3(0.0f));
             if (!lane(p) || !(fresh_leaf || fresh.error[p] > 0.0f)) continue;
             // lc_rep_unit, on the unit found for all four points at once
             // where quad_light_units covers the light.
@@ -393,7 +413,7 @@ private:
         }
         const unsigned visible = rays.valid != 0u ? k_.lc_visible4(rays) : 0u;
         for (uint p = 0; p < kQuadLanes; ++p)
-            if ((visible >> p & 1u) != 0u) fresh.unit[p] = units[p];
+            if ((visible >> p & 1u) != 0u) fresh.unit.set(p, units[p]);
         const bool has_kept = enter(kept_node, kept);
         const bool has_fresh = enter(fresh_node, fresh);
         if (!has_kept) free_[free_count_++] = kept_slot;
@@ -437,8 +457,8 @@ private:
     bool wide_ = false;        // lanes8_ is set and used
 #endif
     ShadeStats* stats_ = nullptr;
-    vec3 fixed_[kQuadLanes];     // each point's final estimates: leaves and frozen clusters
-    vec3 heap_sum_[kQuadLanes];  // ... and the running sum of the heap's
+    QuadColor fixed_;     // each point's final estimates: leaves and frozen clusters
+    QuadColor heap_sum_;  // ... and the running sum of the heap's
     float weight_[kQuadLanes];   // update_weights
     float frozen_error_[kQuadLanes];
     float root_bounds_ = 0.0f;  // a quarter of the roots' finite bounds, summed over the points (update_weights)
