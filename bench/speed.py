@@ -21,7 +21,8 @@
    for each K that fits its shared memory, with the CPU path cutting each
    pixel alone (the same image) in the same run, and the CPU at its
    defaults: the Vulkan/CPU time ratios, and the samples whose heap waited
-   in global memory between dispatches.
+   in global memory between dispatches; and the CPU's own cuts, shared by
+   quads, on both (cut_sharing "quad", shaders/quadcuts.comp).
 
 Writes DIR/speed.md and DIR/speed.json (default out/speed). Nothing here
 passes or fails. --quick: 32x32, two scenes (CI's bench label runs it);
@@ -207,6 +208,24 @@ def main():
                                                              "ratio": tv / default_cpu}
                     lines.append(f"| 64, CPU at its defaults | {default_cpu:.3f} | {tv:.3f} | {tv / default_cpu:.1f} "
                                  f"| {tk:.3f} | {tk / default_cpu:.1f} | | |")
+            # The CPU's own cuts (quads) on Vulkan too (quadcuts.comp), at
+            # the default K, against the CPU at its defaults: the same cuts.
+            try:
+                render(a.out, scene, "vk_warm_quad", 8, "lightcuts", device="vulkan", sharing="quad")
+                qimg, qs = render(a.out, scene, "vk_quad", size, "lightcuts", device="vulkan", sharing="quad")
+                dimg = os.path.join(a.out, "vk_cpu_default.exr")
+                c = compare(qimg, dimg)
+                tq = qs["seconds"]["render"]
+                tk = qs["seconds"]["primary"] + qs["seconds"]["shading"]
+                paused = qs["lightcuts"]["heap_paused_samples"] / (size * size)
+                results["vulkan_quads"] = {"cpu_default_seconds": default_cpu, "vulkan_seconds": tq,
+                                           "kernel_seconds": tk, "ratio": tq / default_cpu, "paused": paused,
+                                           "rmse": c["rmse"]}
+                lines.append(f"| 64, quads on both (cut_sharing quad) | {default_cpu:.3f} | {tq:.3f} | "
+                             f"{tq / default_cpu:.1f} | {tk:.3f} | {tk / default_cpu:.1f} | {100 * paused:.1f}% | "
+                             f"{c['rmse']:.2e} |")
+            except subprocess.CalledProcessError:
+                lines.append("| 64, quads on both | | the device has no quad subgroup operations | | | | | |")
             lines.append("")
 
     open(os.path.join(a.out, "speed.md"), "w").write("\n".join(lines) + "\n")

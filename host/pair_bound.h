@@ -13,9 +13,11 @@
 //
 // The quad functions below do the same for one cluster at the four shaded
 // points of a 2x2 quad (host/quad_cut.h), the points in the lanes: its
-// bound (quad_errors, with the GGX lobe's, quad_ggx_bounds) and its
-// representative's contribution (quad_light_units), bit for bit the scalar
-// functions' (tests/test_quad_cut.cpp).
+// bound with the GGX lobe's (quad_errors; the code in quad_bounds_body.h),
+// two clusters' bounds at once where the CPU has AVX2
+// (quad8::quad_pair_errors), and a representative's contribution
+// (quad_light_units), bit for bit the scalar functions'
+// (tests/test_quad_cut.cpp).
 #pragma once
 
 #include <cmath>
