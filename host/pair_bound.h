@@ -237,8 +237,12 @@ bool quad_errors(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, con
 // AVX2 (and taken where the CPU has it, host/quad_cut.h); the build's
 // -ffp-contract=off keeps every multiply and add apart, so the values are
 // the SSE ones and the scalar ones, bit for bit.
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2")
+#endif
 namespace quad8 {
 using V = __m256;
 inline V v_set1(float x) { return _mm256_set1_ps(x); }
@@ -305,7 +309,11 @@ void quad_pair_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode& 
     _mm_storeu_ps(errors_b, _mm256_extractf128_ps(e, 1));
 }
 }  // namespace quad8
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 
 // lc_light_unit of one point `light` at the quad's four points, lane by
 // lane, into unit[p] (zero in inactive lanes), and for each point where the
