@@ -149,11 +149,17 @@ for bad in "--vpl-clamp=-0.5" "--time-limit=nan" "--time-limit=-1"; do
   expect_error "must be a finite number, 0 or more" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
 expect_error "method path (the path tracer) runs on the CPU only" render "$mini" -o "$tmp/edge2.exr" --method path --device vulkan
 # Cuts shared by quads on Vulkan (quadcuts.comp), and the message where
-# the quad's heap cannot fit the device's shared memory.
-if "$exe" render "$mini" -o "$tmp/vq.exr" --no-png --width 5 --height 3 --method lightcuts --cut-sharing quad \
-     --device vulkan --stats "$tmp/vq.json" >"$tmp/vq.txt" 2>&1; then
+# the quad's heap cannot fit the device's shared memory. In a sanitizer
+# build, leaks are not checked on this render: the driver (lavapipe) keeps a
+# few allocations it never frees and is unloaded before LeakSanitizer looks,
+# so they show in an unknown module no suppression can name. The Vulkan
+# path's own leaks are checked by the gpu tests, which keep the driver
+# loaded (tests/vulkan/keep_drivers_loaded.cpp, lsan.supp).
+if ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" "$exe" render "$mini" -o "$tmp/vq.exr" --no-png \
+     --width 5 --height 3 --method lightcuts --cut-sharing quad --device vulkan --stats "$tmp/vq.json" \
+     >"$tmp/vq.txt" 2>&1; then
   grep '"cut_sharing": "quad"' "$tmp/vq.json" >/dev/null || fail "--cut-sharing quad --device vulkan: the stats do not say quad"
-  LC_VK_HEAP_MEMORY=shared expect_error 'cut_sharing "quad" on ' render "$root/scenes/room/room.json" \
+  ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" LC_VK_HEAP_MEMORY=shared expect_error 'cut_sharing "quad" on ' render "$root/scenes/room/room.json" \
     -o "$tmp/edge2.exr" --width 2 --height 2 --method lightcuts --cut-sharing quad --device vulkan
 elif ! grep "no Vulkan device" "$tmp/vq.txt" >/dev/null || [ -n "${LC_REQUIRE_VULKAN:-}" ]; then
   fail "--cut-sharing quad --device vulkan: $(cat "$tmp/vq.txt")"
