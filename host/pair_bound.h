@@ -224,7 +224,7 @@ bool quad_errors(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, con
                  float min_distance2, float errors[4]) {
     (void)sp;
     if (!q.covered || !pair_bound_covers(node)) return false;
-    const quad4::QuadNodes n = quad4::quad_nodes(kernel, node, node, min_distance2);
+    const quad4::QuadNodes n = quad4::quad_nodes(kernel, node, node, min_distance2, q.specular != 0u);
     __m128 e;
     quad4::cluster_errors<Kernel>(q, n, e);
     _mm_storeu_ps(errors, e);
@@ -304,7 +304,7 @@ template <class Kernel>
 void quad_pair_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode& a, const gpu::LightNode& b,
                       float min_distance2, float errors_a[4], float errors_b[4]) {
     V e;
-    cluster_errors<Kernel>(q, quad_nodes(kernel, a, b, min_distance2), e);
+    cluster_errors<Kernel>(q, quad_nodes(kernel, a, b, min_distance2, q.specular != 0u), e);
     _mm_storeu_ps(errors_a, _mm256_castps256_ps128(e));
     _mm_storeu_ps(errors_b, _mm256_extractf128_ps(e, 1));
 }

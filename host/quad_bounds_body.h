@@ -40,11 +40,13 @@ struct QuadNodes {
     V clamp;   // lc_falloff_clamp2 of the cluster's type
 };
 
-// The clusters `a` and `b` as v_set2 lays them out.
+// The clusters `a` and `b` as v_set2 lays them out; their radii only where
+// a point has a GGX lobe (`ggx`), the one bound that reads them.
 template <class Kernel>
 LC_ALWAYS_INLINE inline QuadNodes quad_nodes(Kernel& kernel, const gpu::LightNode& a, const gpu::LightNode& b,
-                                             float min_distance2) {
-    const auto radius = [](const gpu::LightNode& n) {
+                                             float min_distance2, bool ggx) {
+    const auto radius = [ggx](const gpu::LightNode& n) {
+        if (!ggx) return 0.0f;
         const glm::vec3 extent(n.max_x - n.min_x, n.max_y - n.min_y, n.max_z - n.min_z);
         return 0.5f * std::sqrt((extent.x * extent.x + extent.y * extent.y) + extent.z * extent.z);
     };

@@ -179,7 +179,8 @@ void lc_quad_start() {
 void lc_quad_refine_top() {
     QuadCutEntry top = LC_HEAP_LOAD(0u);
     LightNode node = LC_LIGHT_NODE(lc_entry_node(top));
-    q_heap_sum -= lc_entry_unit(q_sp, top, node, frame.min_distance2) * lc_node_intensity(node);
+    vec3 kept_unit = lc_entry_unit(q_sp, top, node, frame.min_distance2);  // the kept child's too
+    q_heap_sum -= kept_unit * lc_node_intensity(node);
     bool right_shares = (node.flags & kNodeRepFromRight) != 0u;
     uint kept_index = right_shares ? node.left + 1u : node.left;
     uint fresh_index = right_shares ? node.left : node.left + 1u;
@@ -192,7 +193,6 @@ void lc_quad_refine_top() {
     bool fresh_visible = false;
     if (q_active && (fresh_leaf || fresh_error > 0.0f))
         fresh_unit = lc_rep_unit(q_sp, fresh_node.rep_light, frame.min_distance2, fresh_visible, q_stats);
-    vec3 kept_unit = lc_entry_unit(q_sp, top, node, frame.min_distance2);
     QuadCutEntry a, b;
     bool has_a = lc_quad_enter(kept_index, kept_node, kept_error, kept_unit, lc_entry_visible(top), a);
     bool has_b = lc_quad_enter(fresh_index, fresh_node, fresh_error, fresh_unit, fresh_visible, b);
