@@ -1,14 +1,16 @@
 #!/usr/bin/env python3
 """Speed and the bounded heap, in one run (docs/results/speed.md).
 
-  bench/speed.py [--out DIR] [--size N] [--heaps 8,16,32,64] [--quick]
+  bench/speed.py [--out DIR] [--size N] [--heaps 8,16,32,64] [--brute-runs N] [--quick]
 
 1. Lightcuts against brute force on the shipped room with 10^4 and 10^5
    lights (scenes/room/room_1e4.json, room_1e5.json) at SIZE x SIZE on the
    CPU path, both at full resolution in this run: render times, shadow rays,
    the cost of a shadow ray (render time over shadow rays; the CPU path does
    not time its camera rays apart, which are one per pixel against hundreds
-   of shadow rays) and the speedup; at the defaults (the CPU's cuts shared
+   of shadow rays) and the speedup, from the medians of brute force's
+   renders (--brute-runs, 3 by default) and lightcuts', taken in turn so
+   that the machine's drift reaches both; at the defaults (the CPU's cuts shared
    by 2x2 quads of pixels) and with a cut per pixel (cut_sharing "pixel", as
    the Vulkan kernels cut).
 2. The K table: every shipped scene rendered with lightcuts on the CPU with a
@@ -80,6 +82,12 @@ def missing(scene):
     return None
 
 
+def median(values):
+    ordered = sorted(values)
+    middle = len(ordered) // 2
+    return ordered[middle] if len(ordered) % 2 else 0.5 * (ordered[middle - 1] + ordered[middle])
+
+
 def main():
     global EXE
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -89,9 +97,13 @@ def main():
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--no-vulkan", action="store_true")
     ap.add_argument("--vulkan-only", action="store_true", help="only part 3")
+    ap.add_argument("--brute-runs", type=int, default=None,
+                    help="brute-force renders of each room (default 3; 1 with --quick)")
     ap.add_argument("--exe", default=EXE, help="the lightcuts binary (default build/host/lightcuts)")
     a = ap.parse_args()
     EXE = a.exe
+    if a.brute_runs is None:
+        a.brute_runs = 1 if a.quick else 3
     size = 32 if a.quick else a.size
     scenes = SCENES[:1] + SCENES[3:4] if a.quick else SCENES
     heaps = [int(k) for k in a.heaps.split(",")]
@@ -103,8 +115,10 @@ def main():
     # 1 and 2: brute force once per scene, lightcuts per heap size.
     lines += ["## Lightcuts against brute force (defaults: error 0.02, max cut 1000, cut_heap 64, cuts shared "
               "by quads)", "",
-              "lightcuts s: the median of the renders at the defaults before brute force, at the end of the K "
-              "table and after it, each in brackets. pixel s: the render with a cut per pixel and K = 64 in the "
+              "brute s: the median of brute force's renders, the first before the K table (its image is the "
+              "reference) and the others after it, each in brackets. lightcuts s: the median of the renders at "
+              "the defaults before brute force, at the end of the K table and after it, taking turns with brute "
+              "force's, each in brackets. The speedup is the ratio of the medians. pixel s: the render with a cut per pixel and K = 64 in the "
               "K table (as the Vulkan kernels cut), and its speedup.", "",
               "| scene | brute s | brute rays/px | lightcuts s | rays/px | us per brute ray | us per lightcuts ray "
               "| ratio | speedup | pixel s | pixel rays/px | pixel speedup |",
@@ -153,19 +167,31 @@ def main():
                 lightcuts_times.append(s["seconds"]["render"])
         if not room:
             continue
-        lightcuts_times.append(render(a.out, scene, name + "_after", size, "lightcuts")[1]["seconds"]["render"])
-        tb, tl = bstats["seconds"]["render"], sorted(lightcuts_times)[len(lightcuts_times) // 2]
+        # Brute force's time drifts with the machine too (2.26 to 2.66 s
+        # for the room at 10^4 lights, 128x128, within one session): after
+        # the table, lightcuts and brute force again in turn, and the
+        # medians of each.
+        brute_times = [bstats["seconds"]["render"]]
+        for run in range(max(a.brute_runs, 1)):
+            lightcuts_times.append(
+                render(a.out, scene, f"{name}_after{run}", size, "lightcuts")[1]["seconds"]["render"])
+            if run + 1 < a.brute_runs:
+                print(f"{scene}: brute force again", file=sys.stderr)
+                brute_times.append(
+                    render(a.out, scene, f"{name}_brute{run + 1}", size, "brute")[1]["seconds"]["render"])
+        tb, tl = median(brute_times), median(lightcuts_times)
         rb, rl = bstats["shadow_rays"], first["shadow_rays"]
         cb, cl = 1e6 * tb / rb, 1e6 * tl / rl
         tp = pixel["seconds"]["render"] if pixel else float("nan")
         rp = pixel["shadow_rays"] if pixel else float("nan")
-        results["speed"].append({"scene": scene, "brute_seconds": tb, "brute_rays": rb,
+        results["speed"].append({"scene": scene, "brute_seconds": tb, "brute_runs": brute_times, "brute_rays": rb,
                                  "lightcuts_seconds": tl, "lightcuts_runs": lightcuts_times,
                                  "lightcuts_rays": rl, "us_per_brute_ray": cb, "us_per_lightcuts_ray": cl,
                                  "ratio": cl / cb, "speedup": tb / tl, "pixel_seconds": tp, "pixel_rays": rp,
                                  "pixel_speedup": tb / tp})
         runs = ", ".join(f"{t:.3f}" for t in lightcuts_times)
-        lines.append(f"| {name} | {tb:.2f} | {rb / pixels:.0f} | {tl:.3f} ({runs}) | {rl / pixels:.1f} | {cb:.4f} | "
+        brute_runs = ", ".join(f"{t:.2f}" for t in brute_times)
+        lines.append(f"| {name} | {tb:.2f} ({brute_runs}) | {rb / pixels:.0f} | {tl:.3f} ({runs}) | {rl / pixels:.1f} | {cb:.4f} | "
                      f"{cl:.4f} | {cl / cb:.2f} | {tb / tl:.1f}x | {tp:.3f} | {rp / pixels:.1f} | {tb / tp:.1f}x |")
     lines += [""] + table + [""]
 
