@@ -33,6 +33,7 @@ passes or fails. --quick: 32x32, two scenes (CI's bench label runs it);
 import argparse
 import json
 import os
+import statistics
 import subprocess
 import sys
 
@@ -82,12 +83,6 @@ def missing(scene):
     return None
 
 
-def median(values):
-    ordered = sorted(values)
-    middle = len(ordered) // 2
-    return ordered[middle] if len(ordered) % 2 else 0.5 * (ordered[middle - 1] + ordered[middle])
-
-
 def main():
     global EXE
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -112,7 +107,7 @@ def main():
     lines = [f"# Speed and the bounded heap ({size}x{size}, CPU path unless said)", "",
              "Command: `bench/speed.py " + " ".join(sys.argv[1:]) + "`", ""]
 
-    # 1 and 2: brute force once per scene, lightcuts per heap size.
+    # 1 and 2: brute force per scene (the rooms: --brute-runs times), lightcuts per heap size.
     lines += ["## Lightcuts against brute force (defaults: error 0.02, max cut 1000, cut_heap 64, cuts shared "
               "by quads)", "",
               "brute s: the median of brute force's renders, the first before the K table (its image is the "
@@ -179,7 +174,7 @@ def main():
                 print(f"{scene}: brute force again", file=sys.stderr)
                 brute_times.append(
                     render(a.out, scene, f"{name}_brute{run + 1}", size, "brute")[1]["seconds"]["render"])
-        tb, tl = median(brute_times), median(lightcuts_times)
+        tb, tl = statistics.median(brute_times), statistics.median(lightcuts_times)
         rb, rl = bstats["shadow_rays"], first["shadow_rays"]
         cb, cl = 1e6 * tb / rb, 1e6 * tl / rl
         tp = pixel["seconds"]["render"] if pixel else float("nan")
