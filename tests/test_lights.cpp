@@ -147,6 +147,72 @@ TEST(EmissionBound, EveryBoundIsConservative) {
     EXPECT_GT(zero_by_cone, 5000);  // the cone does cull: points behind or outside every spot
 }
 
+// lc_emission_bound forms no angles (it works with their cosines and
+// sines, kAngleSlack smaller): points just inside a light's cone, at angles
+// near 0 and near the rim, for narrow and wide spots and for cosine
+// emitters, from close by and far off, with the node's spread of axes zero
+// (an axis the node holds exactly), so that nothing but the bound's own
+// slack stands between the rounding and the answer. The bound of a
+// one-light node is at least the light's emission factor towards the point,
+// as the kernels compute it in float and in double. (It also passes with
+// kAngleSlack set to zero: on these cases the cosine formulas round no
+// further than the float positions already do.)
+TEST(EmissionBound, HoldsJustInsideTheRimOfTheCone) {
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    Kernel k;
+    int checked = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        const glm::vec3 pos = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 10.0f;
+        // An axis the nodes hold exactly, so that the node's spread of axes
+        // can be zero: the slack alone then covers the rounding.
+        const std::uint32_t packed = std::uint32_t(rng());
+        const glm::vec3 axis = gpu::lc_decode_axis(packed);
+        const int kind = trial % 4;  // spot, narrow spot, oriented, two-sided oriented
+        const float outer = kind == 0 ? 1.0f + 89.0f * u(rng) : 0.01f + 0.5f * u(rng);
+        const float inner = u(rng) < 0.3f ? outer : outer * u(rng);
+        const gpu::Light light = kind < 2 ? test::spot_light(pos, axis, glm::vec3(1.0f), inner, outer)
+                                          : test::oriented_light(pos, axis, glm::vec3(1.0f), kind == 3);
+        const LightTree tree = build_light_tree(std::vector<gpu::Light>{light}, std::uint32_t(trial));
+        gpu::LightNode root = tree.nodes[tree.roots[test::node_type(tree.nodes[0])]];
+        root.axis_oct = packed;
+        root.cos_theta_o = 1.0f;
+        const glm::dvec3 a = glm::normalize(glm::dvec3(light.axis_x, light.axis_y, light.axis_z));
+        const double rim = kind < 2 ? std::acos(double(light.cos_outer)) : 0.5 * 3.141592653589793;
+        // An angle from the axis: near zero, or just inside the rim.
+        const double gap = std::pow(10.0, -8.0 + 6.0 * u(rng));
+        const double angle = u(rng) < 0.3f ? gap : std::max(rim - gap, 0.0);
+        const glm::dvec3 side = glm::normalize(glm::cross(a, glm::dvec3(random_unit(rng))));
+        const glm::dvec3 dir = std::cos(angle) * a + std::sin(angle) * side;
+        const double distance = std::pow(10.0, -2.0 + 5.0 * u(rng));
+        const glm::vec3 x = glm::vec3(glm::dvec3(pos) + dir * distance);
+        // The emission towards x as the kernel computes it, and in double.
+        const glm::vec3 to_x = x - pos;
+        // Both cosines at most 1: in float the dot product of two unit
+        // vectors can round a few ulps above it (and a spot whose outer
+        // cosine rounds to 1 would then seem to emit on its axis).
+        const float cos_float = std::min(glm::dot(axis, to_x / glm::length(to_x)), 1.0f);
+        const double cos_double =
+            std::min(glm::dot(a, glm::normalize(glm::dvec3(x) - glm::dvec3(pos))), 1.0);
+        double exact_float, exact_double;
+        if (kind < 2) {
+            exact_float = k.lc_spot_falloff(light, cos_float);
+            const double s = std::clamp((cos_double - light.cos_outer) /
+                                            std::max(1e-3, double(light.cos_inner) - light.cos_outer),
+                                        0.0, 1.0);
+            exact_double = s * s;
+        } else {
+            exact_float = kind == 3 ? std::abs(cos_float) : std::max(cos_float, 0.0f);
+            exact_double = kind == 3 ? std::abs(cos_double) : std::max(cos_double, 0.0);
+        }
+        const float bound = k.lc_emission_bound(root, x);
+        ASSERT_GE(bound, exact_float) << "trial " << trial << " angle " << angle << " distance " << distance;
+        ASSERT_GE(double(bound), exact_double) << "trial " << trial << " angle " << angle << " distance " << distance;
+        checked += exact_double > 0.0;
+    }
+    EXPECT_GT(checked, 15000);  // most points receive light: the test is not vacuous
+}
+
 // The union of two cones holds both, and packing the axis keeps every
 // direction the cone held (theta_o is widened by the packing's error).
 TEST(EmissionBound, ConeUnionAndPackingHoldTheirInputs) {

@@ -493,23 +493,33 @@ float lc_ggx_bound(LC_IN(Material) m, vec3 box_min, vec3 box_max, vec3 x, vec3 n
 
 uint lc_node_type(LC_IN(LightNode) node) { return (node.flags >> kNodeTypeShift) & kNodeTypeMask; }
 
-// Angles in the emission bound come from acos, whose float result is off by
-// up to ~3.5e-4 rad near 0 and pi; the bound gives away this much more.
+// The bounds below work with the cosines and sines of angles, never the
+// angles: a sine from its cosine, sqrt(1 - cos^2), is off by up to ~3.5e-4
+// rad near 0 and pi, where the cosine's own rounding is amplified (as an
+// angle from acos would be), so they take each angle kAngleSlack wider.
 LC_KCONST float kAngleSlack = 1e-3f;
+LC_KCONST float kAngleSlackCos = 0.9999995f;     // cos(kAngleSlack)
+LC_KCONST float kAngleSlackSin = 9.9999983e-4f;  // sin(kAngleSlack)
 
-float lc_safe_acos(float c) { return acos(clamp(c, -1.0f, 1.0f)); }
+// sin of an angle in [0, pi] from its cosine.
+float lc_sin_of(float cos_a) { return sqrt(max(1.0f - cos_a * cos_a, 0.0f)); }
 
 // Upper bound of the emission factor towards x over every light of the
-// cluster (pbrt-v4's LightBounds::Importance, angles written out): a light
-// at p with axis a emits towards x at the angle (a, x - p), which is at
-// least theta' = theta_w - theta_o - theta_b by the triangle inequality on
-// the sphere, where theta_w is the angle between the cluster's axis and the
-// way from the box centre to x, theta_o the spread of the lights' axes and
-// theta_b the half-angle the box's bounding sphere subtends at x. Nothing is
-// emitted past theta_e; cosine emitters emit at most cos(theta') before, and
-// a spot at most s^2 with s = (cos theta' - cos theta_e) / w, w the
+// cluster (pbrt-v4's LightBounds::Importance): a light at p with axis a
+// emits towards x at the angle (a, x - p), which is at least theta' =
+// theta_w - theta_o - theta_b by the triangle inequality on the sphere,
+// where theta_w is the angle between the cluster's axis and the way from
+// the box centre to x, theta_o the spread of the lights' axes and theta_b
+// the half-angle the box's bounding sphere subtends at x. Nothing is
+// emitted past theta_e; cosine emitters emit at most cos(theta') before,
+// and a spot at most s^2 with s = (cos theta' - cos theta_e) / w, w the
 // cluster's narrowest falloff (each light's s is below that: its outer
 // cosine is at least cos theta_e, its width at least w).
+// The angles are never formed: theta' is taken kAngleSlack smaller, and
+// its cosine comes from the cosines and sines of the others by the
+// angle-sum formulas, as pbrt-v4 does (acos, asin and cos made this
+// function and its calls into libm most of the render on scenes of spots
+// and VPLs).
 float lc_emission_bound(LC_IN(LightNode) node, vec3 x) {
     if (node.cos_theta_o <= -1.0f) return 1.0f;  // emits everywhere
     vec3 lo = vec3(node.min_x, node.min_y, node.min_z) - x;
@@ -518,19 +528,31 @@ float lc_emission_bound(LC_IN(LightNode) node, vec3 x) {
     float radius = 0.5f * length(hi - lo);
     float d = length(to_centre);
     if (!(d > radius)) return 1.0f;  // x inside the bounding sphere: any direction
-    float cos_w = -dot(lc_decode_axis(node.axis_oct), to_centre) / d;
+    float cos_w = clamp(-dot(lc_decode_axis(node.axis_oct), to_centre) / d, -1.0f, 1.0f);
     if ((node.flags & kNodeTwoSided) != 0u) cos_w = abs(cos_w);
-    float theta = lc_safe_acos(cos_w) - lc_safe_acos(node.cos_theta_o) - asin(min(radius / d, 1.0f)) -
-                  kAngleSlack;
-    theta = max(theta, 0.0f);
-    float theta_e = lc_safe_acos(node.cos_theta_e);
-    if (theta >= theta_e) return 0.0f;
+    // cos theta', 1 where theta' <= 0: theta_w at most the sum s = theta_o +
+    // theta_b + kAngleSlack, or s at least pi (then cos_o <= -cos_b, or the
+    // slack takes the sum's sine below zero).
+    float sin_b = min(radius / d, 1.0f);
+    float cos_b = lc_sin_of(sin_b);
+    float cos_o = min(node.cos_theta_o, 1.0f);
+    float sin_o = lc_sin_of(cos_o);
+    float cos_t = 1.0f;
+    if (cos_o + cos_b > 0.0f) {
+        float cos_ob = cos_o * cos_b - sin_o * sin_b;
+        float sin_ob = sin_o * cos_b + cos_o * sin_b;
+        float cos_s = cos_ob * kAngleSlackCos - sin_ob * kAngleSlackSin;
+        float sin_s = sin_ob * kAngleSlackCos + cos_ob * kAngleSlackSin;
+        if (sin_s > 0.0f && cos_w < cos_s) cos_t = min(cos_w * cos_s + lc_sin_of(cos_w) * sin_s, 1.0f);
+    }
+    if (cos_t <= node.cos_theta_e) return 0.0f;  // theta' >= theta_e
     uint type = lc_node_type(node);
-    if (type == kLightOriented || type == kLightVpl) return min(cos(theta) * kBoundSlack, 1.0f);
+    if (type == kLightOriented || type == kLightVpl) return min(cos_t * kBoundSlack, 1.0f);
     if (type != kLightSpot) return 1.0f;
     // cos(theta_e + kAngleSlack), a little below the stored cosine, which
-    // went through acos and cos on the host.
-    float s = (cos(theta) - cos(theta_e + kAngleSlack)) / node.falloff_width;
+    // went through cos on the host.
+    float cos_e = clamp(node.cos_theta_e, -1.0f, 1.0f);
+    float s = (cos_t - (cos_e * kAngleSlackCos - lc_sin_of(cos_e) * kAngleSlackSin)) / node.falloff_width;
     s = min(s * kBoundSlack, 1.0f);
     return s * s;
 }
@@ -538,15 +560,26 @@ float lc_emission_bound(LC_IN(LightNode) node, vec3 x) {
 // The range (min, max) of cos_d = wi.h = cos(angle(wi, wo) / 2) over the
 // directions wi in the cone: by the triangle inequality on the sphere,
 // angle(wi, wo) lies within angle(wo, a) -+ theta_c, widened by kAngleSlack
-// for acos's rounding (docs/disney-bounds.md).
+// for the rounding (docs/disney-bounds.md). In cosines and sines, as
+// lc_emission_bound: cos(angle_o -+ (theta_c + slack)) by the angle-sum
+// formulas, then the half angle's cosine sqrt((1 + cos) / 2). sin of
+// angle_o from the cross product, accurate for small angles.
 vec2 lc_cos_d_range(vec4 cone, vec3 wo) {
     if (cone.w < 0.0f) return vec2(0.0f, 1.0f);
-    float angle_o = lc_safe_acos(dot(wo, vec3(cone)));
-    float theta_c = asin(cone.w);
-    float nearest = max(angle_o - theta_c - kAngleSlack, 0.0f);
-    float farthest = min(angle_o + theta_c + kAngleSlack, kPi);
-    return vec2(max(cos(0.5f * farthest) / kBoundSlack - kCosineAbsSlack, 0.0f),
-                min(cos(0.5f * nearest) * kBoundSlack, 1.0f));
+    vec3 a = vec3(cone);
+    float cos_o = clamp(dot(wo, a), -1.0f, 1.0f);
+    float sin_o = min(length(cross(wo, a)), 1.0f);
+    // theta_c + kAngleSlack: at most pi / 2 + 10^-3, so its sine is positive.
+    float sin_c = min(cone.w, 1.0f);
+    float cos_c = lc_sin_of(sin_c);
+    float cos_cs = cos_c * kAngleSlackCos - sin_c * kAngleSlackSin;
+    float sin_cs = sin_c * kAngleSlackCos + cos_c * kAngleSlackSin;
+    // nearest = max(angle_o - (theta_c + slack), 0): 0 where angle_o is no larger.
+    float cos_near = cos_o >= cos_cs ? 1.0f : min(cos_o * cos_cs + sin_o * sin_cs, 1.0f);
+    // farthest = min(angle_o + theta_c + slack, pi): pi where the sum is no smaller.
+    float cos_far = cos_o <= -cos_cs ? -1.0f : max(cos_o * cos_cs - sin_o * sin_cs, -1.0f);
+    return vec2(max(sqrt(0.5f + 0.5f * cos_far) / kBoundSlack - kCosineAbsSlack, 0.0f),
+                min(sqrt(0.5f + 0.5f * cos_near) * kBoundSlack, 1.0f));
 }
 
 // Bound of the Disney BRDF times cos(theta_i) over every wi towards the box
