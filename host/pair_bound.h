@@ -13,18 +13,22 @@
 //
 // The quad functions below do the same for one cluster at the four shaded
 // points of a 2x2 quad (host/quad_cut.h), the points in the lanes: its
-// bound with the GGX lobe's (quad_errors; the code in quad_bounds_body.h),
+// bound with the GGX lobe's and the emission cone's of spots, oriented
+// lights and VPLs (quad_errors; the code in quad_bounds_body.h; a change to
+// lc_emission_bound or lc_ggx_bound must be made there too),
 // two clusters' bounds at once where the CPU has AVX2
 // (quad8::quad_pair_errors), and a representative's contribution
 // (quad_light_units), bit for bit the scalar functions'
 // (tests/test_quad_cut.cpp).
 #pragma once
 
+#include <bit>
 #include <cmath>
 #include <cstdint>
 
 #include <glm/glm.hpp>
 
+#include "shared/octahedral.h"
 #include "shared/types.h"
 
 #if defined(__SSE2__)
@@ -55,6 +59,13 @@ inline __m128 glsl_max(__m128 x, __m128 y) { return _mm_max_ps(y, x); }
 inline bool pair_bound_covers(const gpu::LightNode& node) {
     const std::uint32_t type = (node.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask;
     return (node.flags & gpu::kNodeLeaf) == 0u && type != gpu::kLightDirectional && node.cos_theta_o <= -1.0f;
+}
+
+// Whether the quad evaluations cover this cluster: the pair evaluation's
+// clusters and those with emission cones (spots, oriented lights, VPLs).
+inline bool quad_bound_covers(const gpu::LightNode& node) {
+    const std::uint32_t type = (node.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask;
+    return (node.flags & gpu::kNodeLeaf) == 0u && type != gpu::kLightDirectional;
 }
 
 // lc_cluster_error of `left` and `right` into `errors`, or false where the
@@ -223,7 +234,7 @@ template <class Kernel, class SurfacePoint>
 bool quad_errors(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, const gpu::LightNode& node,
                  float min_distance2, float errors[4]) {
     (void)sp;
-    if (!q.covered || !pair_bound_covers(node)) return false;
+    if (!q.covered || !quad_bound_covers(node)) return false;
     const quad4::QuadNodes n = quad4::quad_nodes(kernel, node, node, min_distance2, q.specular != 0u);
     __m128 e;
     quad4::cluster_errors<Kernel>(q, n, e);

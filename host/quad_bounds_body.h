@@ -8,8 +8,10 @@
 // v_abs, v_min and v_max (GLSL's min and max, see glsl_min), v_movemask,
 // and v_set2(a, b): the first cluster's value a and the second's b.
 // Every value is computed with the same operations in the same order as
-// the scalar lc_cluster_bound and lc_ggx_bound (shaders/shared), so the
-// results are theirs bit for bit (tests/test_quad_cut.cpp).
+// the scalar lc_cluster_bound, lc_ggx_bound and lc_emission_bound
+// (shaders/shared), so the results are theirs bit for bit
+// (tests/test_quad_cut.cpp). The emission bound has no acos, asin or cos
+// for this: sqrt, like the rest, is rounded the same way in every lane.
 // No include guard: included once per vector width.
 
 // The shaded points lane by lane: positions, frames, the diffuse and
@@ -32,12 +34,20 @@ struct QuadLanes {
 };
 
 // The clusters lane by lane: their boxes, radii, intensities and falloff
-// clamps.
+// clamps, and their emission cones (lc_emission_bound) where some cluster
+// has one.
 struct QuadNodes {
     V min_x, min_y, min_z, max_x, max_y, max_z;
     V radius;  // half the box's diagonal (lc_box_cone)
     V intensity_r, intensity_g, intensity_b;
     V clamp;   // lc_falloff_clamp2 of the cluster's type
+    bool any_cone = false;  // the fields below are set
+    V cone;                 // all ones where the cluster's lights do not emit everywhere
+    V axis_x, axis_y, axis_z;
+    V cos_o, sin_o;         // min(cos_theta_o, 1) and its sine
+    V cos_e, edge;          // cos_theta_e and lc_spot_edge of it
+    V falloff_width;
+    V two_sided, cosine, spot;  // all ones where the node is two-sided, oriented or VPL, a spot
 };
 
 // The clusters `a` and `b` as v_set2 lays them out; their radii only where
@@ -53,18 +63,47 @@ LC_ALWAYS_INLINE inline QuadNodes quad_nodes(Kernel& kernel, const gpu::LightNod
     const auto clamp = [&](const gpu::LightNode& n) {
         return kernel.lc_falloff_clamp2(min_distance2, (n.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask);
     };
-    return {v_set2(a.min_x, b.min_x),
-            v_set2(a.min_y, b.min_y),
-            v_set2(a.min_z, b.min_z),
-            v_set2(a.max_x, b.max_x),
-            v_set2(a.max_y, b.max_y),
-            v_set2(a.max_z, b.max_z),
-            v_set2(radius(a), radius(b)),
-            v_set2(a.intensity_r, b.intensity_r),
-            v_set2(a.intensity_g, b.intensity_g),
-            v_set2(a.intensity_b, b.intensity_b),
-            v_set2(clamp(a), clamp(b))};
+    QuadNodes n;
+    n.min_x = v_set2(a.min_x, b.min_x);
+    n.min_y = v_set2(a.min_y, b.min_y);
+    n.min_z = v_set2(a.min_z, b.min_z);
+    n.max_x = v_set2(a.max_x, b.max_x);
+    n.max_y = v_set2(a.max_y, b.max_y);
+    n.max_z = v_set2(a.max_z, b.max_z);
+    n.radius = v_set2(radius(a), radius(b));
+    n.intensity_r = v_set2(a.intensity_r, b.intensity_r);
+    n.intensity_g = v_set2(a.intensity_g, b.intensity_g);
+    n.intensity_b = v_set2(a.intensity_b, b.intensity_b);
+    n.clamp = v_set2(clamp(a), clamp(b));
+    const auto has_cone = [](const gpu::LightNode& x) { return !(x.cos_theta_o <= -1.0f); };
+    n.any_cone = Kernel::kEnableOriented && (has_cone(a) || has_cone(b));
+    if (!n.any_cone) return n;
+    // Each node's own values, computed once here by the scalar functions
+    // lc_emission_bound calls, so that the lanes hold their very bits.
+    const auto all = [](bool on) { return on ? std::bit_cast<float>(~0u) : 0.0f; };
+    const auto type = [](const gpu::LightNode& x) { return (x.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask; };
+    const glm::vec3 axis_a = gpu::lc_decode_axis(a.axis_oct), axis_b = gpu::lc_decode_axis(b.axis_oct);
+    const float cos_o_a = std::min(a.cos_theta_o, 1.0f), cos_o_b = std::min(b.cos_theta_o, 1.0f);
+    n.cone = v_set2(all(has_cone(a)), all(has_cone(b)));
+    n.axis_x = v_set2(axis_a.x, axis_b.x);
+    n.axis_y = v_set2(axis_a.y, axis_b.y);
+    n.axis_z = v_set2(axis_a.z, axis_b.z);
+    n.cos_o = v_set2(cos_o_a, cos_o_b);
+    n.sin_o = v_set2(kernel.lc_sin_of(cos_o_a), kernel.lc_sin_of(cos_o_b));
+    n.cos_e = v_set2(a.cos_theta_e, b.cos_theta_e);
+    n.edge = v_set2(kernel.lc_spot_edge(a.cos_theta_e), kernel.lc_spot_edge(b.cos_theta_e));
+    n.falloff_width = v_set2(a.falloff_width, b.falloff_width);
+    n.two_sided = v_set2(all((a.flags & gpu::kNodeTwoSided) != 0u), all((b.flags & gpu::kNodeTwoSided) != 0u));
+    const auto cosine = [&](const gpu::LightNode& x) {
+        return type(x) == gpu::kLightOriented || type(x) == gpu::kLightVpl;
+    };
+    n.cosine = v_set2(all(cosine(a)), all(cosine(b)));
+    n.spot = v_set2(all(type(a) == gpu::kLightSpot), all(type(b) == gpu::kLightSpot));
+    return n;
 }
+
+// Where m is all ones, a; elsewhere b.
+LC_ALWAYS_INLINE inline V v_select(V m, V a, V b) { return v_or(v_and(m, a), v_andnot(m, b)); }
 
 // ((a_x * v_x + a_y * v_y) + a_z * v_z) lane by lane: glm's dot.
 LC_ALWAYS_INLINE inline V dot4(V ax, V ay, V az, V vx, V vy, V vz) {
@@ -123,6 +162,37 @@ LC_ALWAYS_INLINE inline V ggx_bounds(const QuadLanes& q, const QuadNodes& n) {
     return v_and(bound, v_cmpnle(q.cos_o, zero));  // lc_ggx_bound: 0 where cos_o <= 0
 }
 
+// lc_emission_bound of each lane's cluster at its point, from the box
+// relative to the point (lo, hi: box - p) and its centre c; 1 where the
+// cluster emits everywhere.
+template <class Kernel>
+LC_ALWAYS_INLINE inline V emission_bounds(const QuadNodes& n, V lo_x, V lo_y, V lo_z, V hi_x, V hi_y, V hi_z, V c_x,
+                                          V c_y, V c_z) {
+    const V zero = v_zero(), one = v_set1(1.0f), half = v_set1(0.5f);
+    const V h_x = v_sub(hi_x, lo_x), h_y = v_sub(hi_y, lo_y), h_z = v_sub(hi_z, lo_z);
+    const V radius = v_mul(half, v_sqrt(dot4(h_x, h_y, h_z, h_x, h_y, h_z)));
+    const V d = v_sqrt(dot4(c_x, c_y, c_z, c_x, c_y, c_z));
+    const V outside = v_cmpgt(d, radius);  // else any direction: 1
+    V cos_w = v_div(v_mul(dot4(n.axis_x, n.axis_y, n.axis_z, c_x, c_y, c_z), v_set1(-1.0f)), d);
+    cos_w = v_min(v_max(cos_w, v_set1(-1.0f)), one);  // clamp
+    cos_w = v_select(n.two_sided, v_abs(cos_w), cos_w);
+    const V sin_b = v_min(v_div(radius, d), one);
+    const V cos_b = v_sqrt(v_max(v_sub(one, v_mul(sin_b, sin_b)), zero));
+    const V cos_ob = v_sub(v_mul(n.cos_o, cos_b), v_mul(n.sin_o, sin_b));
+    const V sin_ob = v_add(v_mul(n.sin_o, cos_b), v_mul(n.cos_o, sin_b));
+    const V slack_cos = v_set1(Kernel::kAngleSlackCos), slack_sin = v_set1(Kernel::kAngleSlackSin);
+    const V cos_s = v_sub(v_mul(cos_ob, slack_cos), v_mul(sin_ob, slack_sin));
+    const V sin_s = v_add(v_mul(sin_ob, slack_cos), v_mul(cos_ob, slack_sin));
+    const V sin_w = v_sqrt(v_max(v_sub(one, v_mul(cos_w, cos_w)), zero));
+    const V apart = v_and(v_cmpgt(v_add(n.cos_o, cos_b), zero), v_and(v_cmpgt(sin_s, zero), v_cmpgt(cos_s, cos_w)));
+    const V cos_t = v_select(apart, v_min(v_add(v_mul(cos_w, cos_s), v_mul(sin_w, sin_s)), one), one);
+    const V cosine = v_min(v_mul(cos_t, v_set1(Kernel::kBoundSlack)), one);
+    const V s = v_min(v_mul(v_div(v_sub(cos_t, n.edge), n.falloff_width), v_set1(Kernel::kBoundSlack)), one);
+    V e = v_select(n.cosine, cosine, v_select(n.spot, v_mul(s, s), one));
+    e = v_andnot(v_cmpge(n.cos_e, cos_t), e);  // theta' >= theta_e: 0
+    return v_select(v_and(n.cone, outside), e, one);
+}
+
 // lc_cluster_error of each lane's cluster at its point, 0 in inactive
 // lanes; false (and zeros) when it is 0 in every lane.
 template <class Kernel>
@@ -157,7 +227,16 @@ LC_ALWAYS_INLINE inline bool cluster_errors(const QuadLanes& q, const QuadNodes&
     const V d_y = v_max(v_max(lo_y, v_sub(q.py, n.max_y)), zero);
     const V d_z = v_max(v_max(lo_z, v_sub(q.pz, n.max_z)), zero);
     const V d2 = v_add(v_add(v_mul(d_x, d_x), v_mul(d_y, d_y)), v_mul(d_z, d_z));
-    const V factor = v_div(v_set1(Kernel::kBoundSlack), v_max(d2, n.clamp));
+    V factor = v_div(v_set1(Kernel::kBoundSlack), v_max(d2, n.clamp));
+    V counted = positive;
+    if (n.any_cone) {
+        // lc_cluster_bound: the emission bound times kBoundSlack over the
+        // distance (1 times it where the lights emit everywhere, the same
+        // float), and 0 where the emission bound is <= 0.
+        const V emission = emission_bounds<Kernel>(n, lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, c_x, c_y, c_z);
+        factor = v_mul(emission, factor);
+        counted = v_and(counted, v_cmpnle(emission, zero));
+    }
     const V cos_over_pi = v_div(cosines, v_set1(Kernel::kPi));
     V r = v_mul(q.kd_r, cos_over_pi);
     V g = v_mul(q.kd_g, cos_over_pi);
@@ -174,6 +253,6 @@ LC_ALWAYS_INLINE inline bool cluster_errors(const QuadLanes& q, const QuadNodes&
     g = v_mul(v_mul(g, factor), n.intensity_g);
     b = v_mul(v_mul(b, factor), n.intensity_b);
     const V error = v_add(v_add(v_mul(v_set1(0.2126f), r), v_mul(v_set1(0.7152f), g)), v_mul(v_set1(0.0722f), b));
-    errors = v_and(error, positive);
+    errors = v_and(error, counted);
     return true;
 }

@@ -356,7 +356,7 @@ private:
     // eight lanes where the CPU has AVX2 and quad_errors covers both.
     void child_errors(const LightNode& a, const LightNode& b, float* errors_a, float* errors_b) {
 #if defined(__SSE2__)
-        if (!Kernel::tightest_bound && wide_ && pair_bound_covers(a) && pair_bound_covers(b)) {
+        if (!Kernel::tightest_bound && wide_ && quad_bound_covers(a) && quad_bound_covers(b)) {
             quad8::quad_pair_errors(k_, lanes8_, a, b, f_.min_distance2, errors_a, errors_b);
             return;
         }

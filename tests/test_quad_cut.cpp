@@ -43,7 +43,7 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
     Kernel k;
     k.materials = materials.data();  // lc_make_surface's; each point's own is set after it
     k.vpl_min_distance2 = 0.01f;
-    int trials = 0, covered = 0, checked = 0, nonzero = 0, pairs = 0;
+    int trials = 0, covered = 0, checked = 0, nonzero = 0, pairs = 0, cone_lit = 0, cone_dark = 0;
     gpu::LightNode previous{};
     bool have_previous = false;
     for (int trial = 0; trial < 40000; ++trial) {
@@ -53,12 +53,23 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
         const float size = trial % 50 == 0 ? 3e38f : u(rng) < 0.2f ? 0.0f : 0.7f;
         const glm::vec3 half = glm::vec3(u(rng), u(rng), u(rng)) * size;
         const float pick = u(rng);
-        const std::uint32_t type = pick < 0.7f   ? gpu::kLightPoint
-                                   : pick < 0.8f ? gpu::kLightVpl
-                                   : pick < 0.9f ? gpu::kLightOriented
-                                                 : gpu::kLightDirectional;
+        const std::uint32_t type = pick < 0.55f   ? gpu::kLightPoint
+                                   : pick < 0.65f ? gpu::kLightVpl
+                                   : pick < 0.75f ? gpu::kLightOriented
+                                   : pick < 0.9f  ? gpu::kLightSpot
+                                                  : gpu::kLightDirectional;
         gpu::LightNode node = test::node_with_box(centre - half, centre + half, type);
-        if (type == gpu::kLightOriented) node.cos_theta_o = 0.5f;
+        if (type == gpu::kLightVpl || type == gpu::kLightOriented || type == gpu::kLightSpot) {
+            // An emission cone (lc_emission_bound): any axis, a spread of
+            // axes from none to nearly everywhere (or everywhere), lights
+            // emitting up to theta_e, one-sided or two-sided.
+            node.axis_oct = std::uint32_t(rng());
+            const float spread = u(rng);
+            node.cos_theta_o = spread < 0.1f ? -1.0f : spread < 0.2f ? 1.0f : 1.0f - 1.9f * u(rng);
+            node.cos_theta_e = type == gpu::kLightSpot ? 1.0f - 2.0f * u(rng) * u(rng) : std::cos(1.5707964f);
+            node.falloff_width = std::max(1e-3f, u(rng));
+            if (u(rng) < 0.3f) node.flags |= gpu::kNodeTwoSided;
+        }
         if (u(rng) < 0.05f) node.flags |= gpu::kNodeLeaf;
         node.intensity_r = 10.0f * u(rng), node.intensity_g = 10.0f * u(rng), node.intensity_b = 10.0f * u(rng);
         Kernel::SurfacePoint sp[4];
@@ -88,6 +99,7 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
             const float scalar = k.lc_cluster_error(sp[p], sp[p].mat, node, min_distance2);
             ++checked;
             nonzero += scalar > 0.0f ? 1 : 0;
+            if (!(node.cos_theta_o <= -1.0f)) ++(scalar > 0.0f ? cone_lit : cone_dark);
             // Bit for bit: the same float (or both NaN), not merely close.
             ASSERT_TRUE(errors[p] == scalar || (std::isnan(errors[p]) && std::isnan(scalar)))
                 << "trial " << trial << " lane " << p << ": " << errors[p] << " against " << scalar;
@@ -119,6 +131,9 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
 #if defined(__SSE2__)
     EXPECT_GT(covered, trials / 2);
     EXPECT_GT(nonzero, checked / 3);
+    // Clusters with emission cones, lit and unlit by them.
+    EXPECT_GT(cone_lit, checked / 20);
+    EXPECT_GT(cone_dark, checked / 20);
     if (cpu::cpu_has_avx2()) {
         EXPECT_GT(pairs, covered / 2);
     }

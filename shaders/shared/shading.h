@@ -504,6 +504,13 @@ LC_KCONST float kAngleSlackSin = 9.9999983e-4f;  // sin(kAngleSlack)
 // sin of an angle in [0, pi] from its cosine.
 float lc_sin_of(float cos_a) { return sqrt(max(1.0f - cos_a * cos_a, 0.0f)); }
 
+// cos(theta_e + kAngleSlack) of a cluster whose lights emit up to theta_e,
+// a little below the stored cosine, which went through cos on the host.
+float lc_spot_edge(float cos_theta_e) {
+    float cos_e = clamp(cos_theta_e, -1.0f, 1.0f);
+    return cos_e * kAngleSlackCos - lc_sin_of(cos_e) * kAngleSlackSin;
+}
+
 // Upper bound of the emission factor towards x over every light of the
 // cluster (pbrt-v4's LightBounds::Importance): a light at p with axis a
 // emits towards x at the angle (a, x - p), which is at least theta' =
@@ -549,10 +556,7 @@ float lc_emission_bound(LC_IN(LightNode) node, vec3 x) {
     uint type = lc_node_type(node);
     if (type == kLightOriented || type == kLightVpl) return min(cos_t * kBoundSlack, 1.0f);
     if (type != kLightSpot) return 1.0f;
-    // cos(theta_e + kAngleSlack), a little below the stored cosine, which
-    // went through cos on the host.
-    float cos_e = clamp(node.cos_theta_e, -1.0f, 1.0f);
-    float s = (cos_t - (cos_e * kAngleSlackCos - lc_sin_of(cos_e) * kAngleSlackSin)) / node.falloff_width;
+    float s = (cos_t - lc_spot_edge(node.cos_theta_e)) / node.falloff_width;
     s = min(s * kBoundSlack, 1.0f);
     return s * s;
 }
