@@ -53,6 +53,40 @@ inline __m128 abs_lanes(__m128 v) { return _mm_andnot_ps(_mm_set1_ps(-0.0f), v);
 // hence the swapped operands.
 inline __m128 glsl_min(__m128 x, __m128 y) { return _mm_min_ps(y, x); }
 inline __m128 glsl_max(__m128 x, __m128 y) { return _mm_max_ps(y, x); }
+
+// lc_decode_axis of two packed axes at once, with its operations lane by
+// lane: the same vectors bit for bit (tests/test_quad_cut.cpp), without the
+// scalar code's branch on the octahedron's lower half, which half the
+// clusters of a tree take and the other half do not.
+inline void decode_axis_pair(std::uint32_t a, std::uint32_t b, glm::vec3& axis_a, glm::vec3& axis_b) {
+    const __m128i packed = _mm_setr_epi32(int(a), int(b), 0, 0);
+    const __m128 lo = _mm_cvtepi32_ps(_mm_srai_epi32(_mm_slli_epi32(packed, 16), 16));
+    const __m128 hi = _mm_cvtepi32_ps(_mm_srai_epi32(packed, 16));
+    const __m128 one = _mm_set1_ps(1.0f), minus_one = _mm_set1_ps(-1.0f), scale = _mm_set1_ps(32767.0f);
+    const __m128 ex = glsl_min(glsl_max(_mm_div_ps(lo, scale), minus_one), one);
+    const __m128 ey = glsl_min(glsl_max(_mm_div_ps(hi, scale), minus_one), one);
+    const __m128 ax = abs_lanes(ex), ay = abs_lanes(ey);
+    const __m128 z = _mm_sub_ps(_mm_sub_ps(one, ax), ay);
+    // Below the equator: x = (1 - |y|) sign(x), y = (1 - |x|) sign(y), with
+    // sign(0) = 1 as there.
+    const __m128 below = _mm_cmplt_ps(z, _mm_setzero_ps());
+    const __m128 sign_x = _mm_or_ps(_mm_and_ps(_mm_cmpge_ps(ex, _mm_setzero_ps()), one),
+                                    _mm_andnot_ps(_mm_cmpge_ps(ex, _mm_setzero_ps()), minus_one));
+    const __m128 sign_y = _mm_or_ps(_mm_and_ps(_mm_cmpge_ps(ey, _mm_setzero_ps()), one),
+                                    _mm_andnot_ps(_mm_cmpge_ps(ey, _mm_setzero_ps()), minus_one));
+    const __m128 fx = _mm_mul_ps(_mm_sub_ps(one, ay), sign_x), fy = _mm_mul_ps(_mm_sub_ps(one, ax), sign_y);
+    const __m128 x = _mm_or_ps(_mm_and_ps(below, fx), _mm_andnot_ps(below, ex));
+    const __m128 y = _mm_or_ps(_mm_and_ps(below, fy), _mm_andnot_ps(below, ey));
+    // glm::normalize: v * (1 / sqrt(dot(v, v))).
+    const __m128 r = _mm_div_ps(one, _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(x, x), _mm_mul_ps(y, y)),
+                                                            _mm_mul_ps(z, z))));
+    alignas(16) float v[3][4];
+    _mm_store_ps(v[0], _mm_mul_ps(x, r));
+    _mm_store_ps(v[1], _mm_mul_ps(y, r));
+    _mm_store_ps(v[2], _mm_mul_ps(z, r));
+    axis_a = glm::vec3(v[0][0], v[1][0], v[2][0]);
+    axis_b = glm::vec3(v[0][1], v[1][1], v[2][1]);
+}
 #endif
 
 // Whether the pair evaluation covers this child.

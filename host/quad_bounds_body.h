@@ -82,7 +82,8 @@ LC_ALWAYS_INLINE inline QuadNodes quad_nodes(Kernel& kernel, const gpu::LightNod
     // lc_emission_bound calls, so that the lanes hold their very bits.
     const auto all = [](bool on) { return on ? std::bit_cast<float>(~0u) : 0.0f; };
     const auto type = [](const gpu::LightNode& x) { return (x.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask; };
-    const glm::vec3 axis_a = gpu::lc_decode_axis(a.axis_oct), axis_b = gpu::lc_decode_axis(b.axis_oct);
+    glm::vec3 axis_a, axis_b;
+    decode_axis_pair(a.axis_oct, b.axis_oct, axis_a, axis_b);
     const float cos_o_a = std::min(a.cos_theta_o, 1.0f), cos_o_b = std::min(b.cos_theta_o, 1.0f);
     n.cone = v_set2(all(has_cone(a)), all(has_cone(b)));
     n.axis_x = v_set2(axis_a.x, axis_b.x);

@@ -3,6 +3,7 @@
 // at every point, and quads cut short by the image's edge or by camera rays
 // that miss.
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -137,6 +138,32 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
     if (cpu::cpu_has_avx2()) {
         EXPECT_GT(pairs, covered / 2);
     }
+#endif
+}
+
+// decode_axis_pair (quad_nodes' decoding of two clusters' axes) gives
+// lc_decode_axis's vectors bit for bit: over random packings and every
+// combination of the halves' extremes (0, +-1, -32768, +-32767), where the
+// octahedron folds and the clamp bites.
+TEST(QuadCut, AxisPairIsTheScalarDecodingBitForBit) {
+#if defined(__SSE2__)
+    std::mt19937 rng(77);
+    std::vector<std::uint32_t> packed;
+    const std::uint32_t halves[] = {0x0000u, 0x0001u, 0xFFFFu, 0x8000u, 0x8001u, 0x7FFFu, 0x4000u, 0xC000u};
+    for (std::uint32_t lo : halves)
+        for (std::uint32_t hi : halves) packed.push_back(lo | hi << 16);
+    for (int i = 0; i < 200000; ++i) packed.push_back(std::uint32_t(rng()));
+    const auto same = [](glm::vec3 a, glm::vec3 b) {
+        return std::memcmp(&a, &b, sizeof a) == 0;
+    };
+    for (std::size_t i = 0; i + 1 < packed.size(); ++i) {
+        glm::vec3 a, b;
+        cpu::decode_axis_pair(packed[i], packed[i + 1], a, b);
+        ASSERT_TRUE(same(a, gpu::lc_decode_axis(packed[i]))) << std::hex << packed[i];
+        ASSERT_TRUE(same(b, gpu::lc_decode_axis(packed[i + 1]))) << std::hex << packed[i + 1];
+    }
+#else
+    GTEST_SKIP() << "SSE2 only";
 #endif
 }
 
