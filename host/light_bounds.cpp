@@ -16,6 +16,9 @@ namespace {
 constexpr float kPi = 3.14159265358979f;
 
 float angle_between(glm::vec3 a, glm::vec3 b) {
+    // Equal axes first, as the lights of one emissive surface and VPLs on
+    // one wall have them: the answer is 0 either way, without the atan2.
+    if (a == b) return 0.0f;
     // atan2 of |a x b| and a . b is accurate at all angles, unlike acos.
     return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
 }
@@ -101,6 +104,17 @@ EmissionCone cone_union(const EmissionCone& a, const EmissionCone& b) {
     u.theta_o = std::max({theta_o, angle_between(u.axis, a.axis) + a.theta_o,
                           angle_between(u.axis, b.axis) + b.theta_o});
     return u;
+}
+
+float union_cos_beta(const EmissionCone& a, float cos_beta_a, const EmissionCone& b, float cos_beta_b) {
+    if (a.emits_everywhere() || b.emits_everywhere()) return EmissionCone::everywhere().cos_beta();
+    const float theta_d = angle_between(a.axis, b.axis);
+    if (std::min(theta_d + b.theta_o, kPi) <= a.theta_o) return cos_beta_a;
+    if (std::min(theta_d + a.theta_o, kPi) <= b.theta_o) return cos_beta_b;
+    const float theta_o = 0.5f * (a.theta_o + theta_d + b.theta_o);
+    const glm::vec3 w = glm::cross(a.axis, b.axis);
+    if (theta_o >= kPi || glm::dot(w, w) == 0.0f) return EmissionCone::everywhere().cos_beta();
+    return std::cos(theta_o);
 }
 
 EmissionCone quantized(const EmissionCone& cone, std::uint32_t& packed) {

@@ -50,6 +50,14 @@ glm::vec3 tree_point(const gpu::Light& light);
 // The smallest cone (in pbrt-v4's sense) holding both (DirectionCone::Union).
 EmissionCone cone_union(const EmissionCone& a, const EmissionCone& b);
 
+// cone_union(a, b).cos_beta() without the union's axis, for the tree
+// metric, which asks it of every candidate pair: the spread as cone_union
+// finds it, short of the few-ulp widening that holds both cones once the
+// axis is turned (the merged cluster's own cone is cone_union's).
+// cos_beta_a and cos_beta_b are a.cos_beta() and b.cos_beta(), which the
+// caller keeps for its clusters.
+float union_cos_beta(const EmissionCone& a, float cos_beta_a, const EmissionCone& b, float cos_beta_b);
+
 // The cone with its axis packed as the node stores it (octahedral, two
 // snorm16) and theta_o widened by the angle the packing moved the axis, so
 // it still holds every light. `packed` receives the stored bits.

@@ -91,11 +91,13 @@ struct CostKey {
     glm::vec3 lo, hi;
     double weight;
     EmissionCone cone;
+    float cos_beta;  // cone.cos_beta()
 };
 
 CostKey cost_key(const Build& b, std::uint32_t id) {
     const Cluster& c = b.all[id];
-    return CostKey{c.lo, c.hi, c.weight, b.cone(id).cone};
+    const EmissionCone& cone = b.cone(id).cone;
+    return CostKey{c.lo, c.hi, c.weight, cone, cone.cos_beta()};
 }
 
 // Walter 2005 §4.1: I_C * (alpha_C^2 + c^2 (1 - cos beta_C)^2) for the
@@ -104,7 +106,7 @@ double merge_cost(const Build& b, const CostKey& x, const CostKey& y) {
     glm::dvec3 d = glm::dvec3(glm::max(x.hi, y.hi)) - glm::dvec3(glm::min(x.lo, y.lo));
     double size = glm::dot(d, d);
     if (b.cone_weight > 0.0) {
-        const double spread = 1.0 - double(cone_union(x.cone, y.cone).cos_beta());
+        const double spread = 1.0 - double(union_cos_beta(x.cone, x.cos_beta, y.cone, y.cos_beta));
         size += b.cone_weight * spread * spread;
     }
     return (x.weight + y.weight) * size;
