@@ -360,19 +360,20 @@ void quad_pair_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode& 
 #pragma GCC pop_options
 #endif
 
-// lc_light_unit of one point `light` at the quad's four points, lane by
-// lane, into unit[p] (zero in inactive lanes), and for each point where the
-// unit is not zero the shadow ray's direction wi[p] and length t_max[p]:
-// the scalar function's values bit for bit (tests/test_quad_cut.cpp). False
-// where this does not cover the case: a light that is not a point light, or
-// a Disney material at an active point. Points with a GGX lobe get their
+// lc_light_unit of one point, spot, oriented light or VPL `light` at the
+// quad's four points, lane by lane, into unit[p] (zero in inactive lanes),
+// and for each point where the unit is not zero the shadow ray's direction
+// wi[p] and length t_max[p]: the scalar function's values bit for bit
+// (tests/test_quad_cut.cpp). False where this does not cover the case: a
+// directional light, or a Disney material at an active point. Points with a GGX lobe get their
 // BRDF from the scalar lc_brdf_cos, on the direction and cosine computed
 // here. A change to lc_light_unit or lc_brdf_cos (shaders/shared/shading.h)
 // must be made here too; the test fails until it is.
 template <class Kernel, class SurfacePoint>
 bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, const gpu::Light& light,
                       float min_distance2, glm::vec3 unit[4], glm::vec3 wi[4], float t_max[4]) {
-    if (!q.covered || (light.type & gpu::kLightTypeMask) != gpu::kLightPoint) return false;
+    const std::uint32_t type = light.type & gpu::kLightTypeMask;
+    if (!q.covered || type == gpu::kLightDirectional || type > gpu::kLightVpl) return false;
     const __m128 zero = _mm_setzero_ps();
     const __m128 tx = _mm_sub_ps(_mm_set1_ps(light.x), q.px), ty = _mm_sub_ps(_mm_set1_ps(light.y), q.py),
                  tz = _mm_sub_ps(_mm_set1_ps(light.z), q.pz);
@@ -380,8 +381,25 @@ bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp
     const __m128 d = _mm_sqrt_ps(d2);
     const __m128 wx = _mm_div_ps(tx, d), wy = _mm_div_ps(ty, d), wz = _mm_div_ps(tz, d);
     const __m128 length = _mm_mul_ps(d, _mm_set1_ps(1.0f - Kernel::kShadowEndRelative));
-    const __m128 factor = _mm_div_ps(
-        _mm_set1_ps(1.0f), glsl_max(d2, _mm_set1_ps(kernel.lc_falloff_clamp2(min_distance2, gpu::kLightPoint))));
+    __m128 factor =
+        _mm_div_ps(_mm_set1_ps(1.0f), glsl_max(d2, _mm_set1_ps(kernel.lc_falloff_clamp2(min_distance2, type))));
+    if (type != gpu::kLightPoint) {
+        // The emission towards each point: -(axis . wi), then the spot's
+        // falloff (lc_spot_falloff) or the cosine emitter's cosine.
+        const __m128 cos_axis = _mm_mul_ps(dot_lanes(glm::vec3(light.axis_x, light.axis_y, light.axis_z), wx, wy, wz),
+                                           _mm_set1_ps(-1.0f));
+        __m128 emission;
+        if (type == gpu::kLightSpot) {
+            const float width = std::max(1e-3f, light.cos_inner - light.cos_outer);
+            const __m128 s = glsl_min(
+                glsl_max(_mm_div_ps(_mm_sub_ps(cos_axis, _mm_set1_ps(light.cos_outer)), _mm_set1_ps(width)), zero),
+                _mm_set1_ps(1.0f));
+            emission = _mm_mul_ps(s, s);
+        } else {
+            emission = (light.type & gpu::kLightTwoSided) != 0u ? abs_lanes(cos_axis) : glsl_max(cos_axis, zero);
+        }
+        factor = _mm_mul_ps(factor, emission);
+    }
     const __m128 cos_i = dot4(q.nx, q.ny, q.nz, wx, wy, wz);
     // lc_light_unit's early returns: no direction (d = 0), the light behind
     // the surface, no emission towards it.

@@ -167,9 +167,10 @@ TEST(QuadCut, AxisPairIsTheScalarDecodingBitForBit) {
 #endif
 }
 
-// The same for a representative's contribution: over random point lights
-// (and some of other kinds, which quad_light_units leaves to the scalar
-// code), points near and far, in front of and behind the light, Lambert,
+// The same for a representative's contribution: over random point lights,
+// spots, cosine emitters and VPLs (and directional lights, which
+// quad_light_units leaves to the scalar code), points near and far, in
+// front of and behind the light, Lambert,
 // GGX and Disney materials and random active lanes, the four units are
 // lc_light_unit's bit for bit, with its ray direction and length where the
 // unit is not zero.
@@ -179,12 +180,31 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
     const std::vector<gpu::Material> materials = {test::lambert(glm::vec3(0.5f))};
     Kernel k;
     k.materials = materials.data();
-    int covered = 0, lanes = 0, lit = 0, trials = 0;
+    int covered = 0, lanes = 0, lit = 0, trials = 0, lit_cones = 0;
     for (int trial = 0; trial < 40000; ++trial) {
         const glm::vec3 at = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 4.0f;
-        const gpu::Light light = trial % 9 == 0
-                                     ? test::spot_light(at, test::random_unit(rng), glm::vec3(3.0f), 20.0f, 40.0f)
-                                     : test::point_light(at, glm::vec3(u(rng), u(rng), u(rng)) * 10.0f);
+        // Point lights, spots (narrow to wide, hard-edged too), one- and
+        // two-sided cosine emitters, VPLs, and directional lights, which
+        // quad_light_units leaves to the scalar code.
+        const glm::vec3 intensity = glm::vec3(u(rng), u(rng), u(rng)) * 10.0f;
+        gpu::Light light = test::point_light(at, intensity);
+        switch (trial % 6) {
+            case 1: {
+                const float outer = 1.0f + 89.0f * u(rng);
+                light = test::spot_light(at, test::random_unit(rng), intensity, u(rng) < 0.2f ? outer : outer * u(rng),
+                                         outer);
+                break;
+            }
+            case 2: light = test::oriented_light(at, test::random_unit(rng), intensity, u(rng) < 0.5f); break;
+            case 3:
+                light = test::oriented_light(at, test::random_unit(rng), intensity);
+                light.type = gpu::kLightVpl;
+                break;
+            case 4:
+                if (u(rng) < 0.3f) light.type = gpu::kLightDirectional;
+                break;
+            default: break;
+        }
         Kernel::SurfacePoint sp[4];
         const unsigned active = trial % 5 == 0 ? unsigned(rng() & 0xFu) : 0xFu;
         const bool disney = trial % 13 == 0;
@@ -218,6 +238,7 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
             ASSERT_EQ(unit[p], scalar) << "trial " << trial << " lane " << p;
             if (!(scalar.x + scalar.y + scalar.z > 0.0f)) continue;
             ++lit;
+            lit_cones += (light.type & gpu::kLightTypeMask) != gpu::kLightPoint;
             ASSERT_EQ(wi[p], scalar_wi) << "trial " << trial << " lane " << p;
             ASSERT_EQ(t_max[p], scalar_t_max) << "trial " << trial << " lane " << p;
         }
@@ -225,6 +246,7 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
 #if defined(__SSE2__)
     EXPECT_GT(covered, trials / 2);
     EXPECT_GT(lit, lanes / 5);
+    EXPECT_GT(lit_cones, lit / 5);  // spots, cosine emitters and VPLs that light their points
 #endif
 }
 
