@@ -222,13 +222,17 @@ using QuadLanes = quad4::QuadLanes;
 using quad4::dot4;
 
 // The four shaded points of a quad (host/quad_cut.h) lane by lane.
-template <class SurfacePoint>
-QuadLanes quad_lanes(const SurfacePoint* sp, unsigned active) {
+template <class Kernel, class SurfacePoint>
+QuadLanes quad_lanes(Kernel& kernel, const SurfacePoint* sp, unsigned active) {
     QuadLanes q;
     alignas(16) float v[31][4];
     alignas(16) std::uint32_t mask[2][4];
     q.specular = 0u;
     q.covered = true;
+    // The Disney terms (QuadLanes), each from the scalar function
+    // lc_disney_bound calls, so that the lanes hold its very floats.
+    alignas(16) float d[19][4] = {};
+    alignas(16) std::uint32_t dmask[3][4] = {};
     for (unsigned p = 0; p < 4u; ++p) {
         const bool on = (active >> p & 1u) != 0u;
         const SurfacePoint& s = sp[p];
@@ -246,9 +250,40 @@ QuadLanes quad_lanes(const SurfacePoint* sp, unsigned active) {
                              on ? s.mat.alpha : 1.0f};
         for (unsigned i = 0; i < 31u; ++i) v[i][p] = f[i];
         if (!on) continue;
-        if ((s.mat.flags & gpu::kMaterialDisney) != 0u) q.covered = false;
         if (specular) q.specular |= 1u << p;
+        if ((s.mat.flags & gpu::kMaterialDisney) == 0u || !Kernel::kEnableDisney) continue;
+        if (Kernel::seed_lobe_bound) q.covered = false;  // a benchmark's bound: the scalar code's
+        q.disney |= 1u << p;
+        const gpu::Material& m = s.mat;
+        const float cos_o = glm::dot(s.n, s.wo);
+        const bool sheen = Kernel::kEnableSheen && (m.flags & gpu::kMaterialHasSheen) != 0u;
+        const bool coat = Kernel::kEnableClearcoat && (m.flags & gpu::kMaterialHasClearcoat) != 0u;
+        const glm::vec3 spec0 = kernel.lc_disney_spec0(m);
+        const glm::vec3 sheen_color = sheen ? kernel.lc_disney_sheen_color(m) : glm::vec3(0.0f);
+        const float alpha_c = kernel.lc_clearcoat_alpha(m), a2 = alpha_c * alpha_c;
+        const float terms[19] = {1.0f - m.metallic,
+                                 2.0f * m.roughness,
+                                 kernel.lc_schlick_weight(cos_o),
+                                 spec0.x, spec0.y, spec0.z,
+                                 sheen_color.x, sheen_color.y, sheen_color.z,
+                                 0.25f * m.clearcoat,
+                                 a2,
+                                 a2 - 1.0f,
+                                 Kernel::kPi * std::log(a2),
+                                 kernel.lc_smith_g1(cos_o, Kernel::kClearcoatSmithAlpha),
+                                 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+        for (unsigned i = 0; i < 19u; ++i) d[i][p] = terms[i];
+        dmask[0][p] = ~0u;
+        dmask[1][p] = sheen ? ~0u : 0u;
+        dmask[2][p] = coat ? ~0u : 0u;
     }
+    __m128* disney_out[14] = {&q.one_minus_metallic, &q.two_roughness, &q.schlick_o, &q.spec0_r, &q.spec0_g,
+                              &q.spec0_b, &q.sheen_r, &q.sheen_g, &q.sheen_b, &q.coat_weight, &q.coat_a2,
+                              &q.coat_a2_minus_1, &q.coat_pi_log, &q.coat_g1};
+    for (unsigned i = 0; i < 14u; ++i) *disney_out[i] = _mm_load_ps(d[i]);
+    q.disney_lanes = _mm_load_ps(reinterpret_cast<const float*>(dmask[0]));
+    q.sheen_lanes = _mm_load_ps(reinterpret_cast<const float*>(dmask[1]));
+    q.coat_lanes = _mm_load_ps(reinterpret_cast<const float*>(dmask[2]));
     __m128* out[30] = {&q.px, &q.py, &q.pz, &q.nx, &q.ny, &q.nz, &q.anx, &q.any, &q.anz,
                        &q.tx, &q.ty, &q.tz, &q.atx, &q.aty, &q.atz, &q.bx, &q.by, &q.bz,
                        &q.abx, &q.aby, &q.abz, &q.kd_r, &q.kd_g, &q.kd_b, &q.ks_r, &q.ks_g, &q.ks_b,
@@ -269,7 +304,8 @@ bool quad_errors(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, con
                  float min_distance2, float errors[4]) {
     (void)sp;
     if (!q.covered || !quad_bound_covers(node)) return false;
-    const quad4::QuadNodes n = quad4::quad_nodes(kernel, node, node, min_distance2, q.specular != 0u);
+    const quad4::QuadNodes n =
+        quad4::quad_nodes(kernel, node, node, min_distance2, q.specular != 0u || q.disney != 0u);
     __m128 e;
     quad4::cluster_errors<Kernel>(q, n, e);
     _mm_storeu_ps(errors, e);
@@ -326,7 +362,13 @@ inline void widen(const quad4::QuadLanes& q, QuadLanes& w) {
         &quad4::QuadLanes::ks_r, &quad4::QuadLanes::ks_g, &quad4::QuadLanes::ks_b,  &quad4::QuadLanes::wox,
         &quad4::QuadLanes::woy,  &quad4::QuadLanes::woz,  &quad4::QuadLanes::cos_o, &quad4::QuadLanes::wr_x,
         &quad4::QuadLanes::wr_y, &quad4::QuadLanes::wr_z, &quad4::QuadLanes::a2,    &quad4::QuadLanes::g1,
-        &quad4::QuadLanes::four_cos_o, &quad4::QuadLanes::active, &quad4::QuadLanes::specular_lanes};
+        &quad4::QuadLanes::four_cos_o, &quad4::QuadLanes::active, &quad4::QuadLanes::specular_lanes,
+        &quad4::QuadLanes::disney_lanes, &quad4::QuadLanes::sheen_lanes, &quad4::QuadLanes::coat_lanes,
+        &quad4::QuadLanes::one_minus_metallic, &quad4::QuadLanes::two_roughness, &quad4::QuadLanes::schlick_o,
+        &quad4::QuadLanes::spec0_r, &quad4::QuadLanes::spec0_g, &quad4::QuadLanes::spec0_b,
+        &quad4::QuadLanes::sheen_r, &quad4::QuadLanes::sheen_g, &quad4::QuadLanes::sheen_b,
+        &quad4::QuadLanes::coat_weight, &quad4::QuadLanes::coat_a2, &quad4::QuadLanes::coat_a2_minus_1,
+        &quad4::QuadLanes::coat_pi_log, &quad4::QuadLanes::coat_g1};
     V QuadLanes::*wide[] = {
         &QuadLanes::px,   &QuadLanes::py,   &QuadLanes::pz,    &QuadLanes::nx,   &QuadLanes::ny,
         &QuadLanes::nz,   &QuadLanes::anx,  &QuadLanes::any,   &QuadLanes::anz,  &QuadLanes::tx,
@@ -335,11 +377,18 @@ inline void widen(const quad4::QuadLanes& q, QuadLanes& w) {
         &QuadLanes::abz,  &QuadLanes::kd_r, &QuadLanes::kd_g,  &QuadLanes::kd_b, &QuadLanes::ks_r,
         &QuadLanes::ks_g, &QuadLanes::ks_b, &QuadLanes::wox,   &QuadLanes::woy,  &QuadLanes::woz,
         &QuadLanes::cos_o, &QuadLanes::wr_x, &QuadLanes::wr_y, &QuadLanes::wr_z, &QuadLanes::a2,
-        &QuadLanes::g1,   &QuadLanes::four_cos_o, &QuadLanes::active, &QuadLanes::specular_lanes};
+        &QuadLanes::g1,   &QuadLanes::four_cos_o, &QuadLanes::active, &QuadLanes::specular_lanes,
+        &QuadLanes::disney_lanes, &QuadLanes::sheen_lanes, &QuadLanes::coat_lanes,
+        &QuadLanes::one_minus_metallic, &QuadLanes::two_roughness, &QuadLanes::schlick_o,
+        &QuadLanes::spec0_r, &QuadLanes::spec0_g, &QuadLanes::spec0_b,
+        &QuadLanes::sheen_r, &QuadLanes::sheen_g, &QuadLanes::sheen_b,
+        &QuadLanes::coat_weight, &QuadLanes::coat_a2, &QuadLanes::coat_a2_minus_1,
+        &QuadLanes::coat_pi_log, &QuadLanes::coat_g1};
     static_assert(sizeof fields / sizeof fields[0] == sizeof wide / sizeof wide[0]);
     for (std::size_t i = 0; i < sizeof wide / sizeof wide[0]; ++i) w.*wide[i] = twice(q.*fields[i]);
     w.specular = q.specular;
     w.covered = q.covered;
+    w.disney = q.disney;
 }
 
 // lc_cluster_error of `a` into errors_a[p] and of `b` into errors_b[p], at
@@ -349,7 +398,7 @@ template <class Kernel>
 void quad_pair_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode& a, const gpu::LightNode& b,
                       float min_distance2, float errors_a[4], float errors_b[4]) {
     V e;
-    cluster_errors<Kernel>(q, quad_nodes(kernel, a, b, min_distance2, q.specular != 0u), e);
+    cluster_errors<Kernel>(q, quad_nodes(kernel, a, b, min_distance2, q.specular != 0u || q.disney != 0u), e);
     _mm_storeu_ps(errors_a, _mm256_castps256_ps128(e));
     _mm_storeu_ps(errors_b, _mm256_extractf128_ps(e, 1));
 }
@@ -365,9 +414,9 @@ void quad_pair_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode& 
 // and for each point where the unit is not zero the shadow ray's direction
 // wi[p] and length t_max[p]: the scalar function's values bit for bit
 // (tests/test_quad_cut.cpp). False where this does not cover the case: a
-// directional light, or a Disney material at an active point. Points with a GGX lobe get their
-// BRDF from the scalar lc_brdf_cos, on the direction and cosine computed
-// here. A change to lc_light_unit or lc_brdf_cos (shaders/shared/shading.h)
+// directional light, or the points' lanes not covered (QuadLanes). Points
+// with a GGX lobe or the Disney BRDF get their BRDF from the scalar
+// lc_brdf_cos, on the direction and cosine computed here. A change to lc_light_unit or lc_brdf_cos (shaders/shared/shading.h)
 // must be made here too; the test fails until it is.
 template <class Kernel, class SurfacePoint>
 bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, const gpu::Light& light,
@@ -422,7 +471,7 @@ bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp
         if ((mask >> p & 1u) == 0u) continue;
         wi[p] = glm::vec3(v[3][p], v[4][p], v[5][p]);
         t_max[p] = v[6][p];
-        if ((q.specular >> p & 1u) != 0u)
+        if (((q.specular | q.disney) >> p & 1u) != 0u)
             unit[p] = kernel.lc_brdf_cos(sp[p].mat, sp[p].n, wi[p], sp[p].wo, v[7][p]) * v[8][p];
         else
             unit[p] = glm::vec3(v[0][p], v[1][p], v[2][p]);

@@ -30,7 +30,21 @@ struct QuadLanes {
     V active;             // all ones in the lanes of active points
     V specular_lanes;     // all ones in the lanes of active points with a GGX lobe
     unsigned specular;    // lanes whose material has a GGX lobe
-    bool covered = false; // no active point has the Disney BRDF
+    // The quad functions cover these points (a Disney material at some
+    // point under the seed report's lobe bound, a benchmark's switch, they
+    // do not).
+    bool covered = false;
+    // Points with the Disney BRDF: what lc_disney_bound needs of each point
+    // alone (set where `disney` has the lane's bit, anything elsewhere):
+    // 1 - metallic, 2 roughness, lc_schlick_weight(cos_o), lc_disney_spec0,
+    // lc_disney_sheen_color where the material has sheen, and of the
+    // clearcoat lobe 0.25 clearcoat, lc_gtr1_d's a2, a2 - 1 and kPi log(a2)
+    // for lc_clearcoat_alpha, and lc_smith_g1(cos_o, kClearcoatSmithAlpha).
+    unsigned disney = 0u;
+    V disney_lanes, sheen_lanes, coat_lanes;  // all ones where the point has the BRDF, the lobe
+    V one_minus_metallic, two_roughness, schlick_o;
+    V spec0_r, spec0_g, spec0_b, sheen_r, sheen_g, sheen_b;
+    V coat_weight, coat_a2, coat_a2_minus_1, coat_pi_log, coat_g1;
 };
 
 // The clusters lane by lane: their boxes, radii, intensities and falloff
@@ -51,7 +65,8 @@ struct QuadNodes {
 };
 
 // The clusters `a` and `b` as v_set2 lays them out; their radii only where
-// a point has a GGX lobe (`ggx`), the one bound that reads them.
+// a point has a GGX lobe or the Disney BRDF (`ggx`), the bounds that read
+// them.
 template <class Kernel>
 LC_ALWAYS_INLINE inline QuadNodes quad_nodes(Kernel& kernel, const gpu::LightNode& a, const gpu::LightNode& b,
                                              float min_distance2, bool ggx) {
@@ -126,41 +141,134 @@ LC_ALWAYS_INLINE inline void set_ggx_terms(QuadLanes& q, V alpha) {
     q.four_cos_o = v_mul(v_set1(4.0f), q.cos_o);
 }
 
-// lc_ggx_bound of each lane's box at its point: lc_box_cone, lc_cos_h_max,
-// lc_ggx_d and lc_smith_g1; 0 where cos_o <= 0, anything in lanes the
-// caller masks.
-template <class Kernel>
-LC_ALWAYS_INLINE inline V ggx_bounds(const QuadLanes& q, const QuadNodes& n) {
+// lc_box_cone of each lane's box at its point: whether the point is outside
+// the bounding sphere (else any direction), the unit axis a and sin_c, cos_c
+// of the half-angle.
+struct BoxCones {
+    V outside, a_x, a_y, a_z, sin_c, cos_c;
+};
+
+LC_ALWAYS_INLINE inline BoxCones box_cones(const QuadLanes& q, const QuadNodes& n) {
     const V zero = v_zero(), one = v_set1(1.0f), half = v_set1(0.5f);
-    // lc_box_cone: the box seen from each point.
     const V c_x = v_mul(half, v_add(v_sub(n.min_x, q.px), v_sub(n.max_x, q.px)));
     const V c_y = v_mul(half, v_add(v_sub(n.min_y, q.py), v_sub(n.max_y, q.py)));
     const V c_z = v_mul(half, v_add(v_sub(n.min_z, q.pz), v_sub(n.max_z, q.pz)));
     const V dist = v_sqrt(dot4(c_x, c_y, c_z, c_x, c_y, c_z));
-    const V outside = v_cmpgt(dist, n.radius);  // else any direction: cos_h_max = 1
-    const V a_x = v_div(c_x, dist), a_y = v_div(c_y, dist), a_z = v_div(c_z, dist);
-    const V sin_c = v_min(v_div(n.radius, dist), one);
-    // lc_cos_h_max.
-    const V cos_r = dot4(q.wr_x, q.wr_y, q.wr_z, a_x, a_y, a_z);
-    const V cos_c = v_sqrt(v_max(v_sub(one, v_mul(sin_c, sin_c)), zero));
-    const V in_cone = v_cmpge(cos_r, cos_c);  // the mirror direction in the cone: 1
-    const V x_x = v_sub(v_mul(q.wr_y, a_z), v_mul(a_y, q.wr_z));
-    const V x_y = v_sub(v_mul(q.wr_z, a_x), v_mul(a_z, q.wr_x));
-    const V x_z = v_sub(v_mul(q.wr_x, a_y), v_mul(a_x, q.wr_y));
+    BoxCones cone;
+    cone.outside = v_cmpgt(dist, n.radius);
+    cone.a_x = v_div(c_x, dist), cone.a_y = v_div(c_y, dist), cone.a_z = v_div(c_z, dist);
+    cone.sin_c = v_min(v_div(n.radius, dist), one);
+    cone.cos_c = v_sqrt(v_max(v_sub(one, v_mul(cone.sin_c, cone.sin_c)), zero));
+    return cone;
+}
+
+// lc_cos_h_max at each lane's point for its box's cone.
+template <class Kernel>
+LC_ALWAYS_INLINE inline V cos_h_max(const QuadLanes& q, const BoxCones& cone) {
+    const V one = v_set1(1.0f), half = v_set1(0.5f), zero = v_zero();
+    const V cos_r = dot4(q.wr_x, q.wr_y, q.wr_z, cone.a_x, cone.a_y, cone.a_z);
+    const V in_cone = v_cmpge(cos_r, cone.cos_c);  // the mirror direction in the cone: 1
+    const V x_x = v_sub(v_mul(q.wr_y, cone.a_z), v_mul(cone.a_y, q.wr_z));
+    const V x_y = v_sub(v_mul(q.wr_z, cone.a_x), v_mul(cone.a_z, q.wr_x));
+    const V x_z = v_sub(v_mul(q.wr_x, cone.a_y), v_mul(cone.a_x, q.wr_y));
     const V sin_r = v_sqrt(dot4(x_x, x_y, x_z, x_x, x_y, x_z));
-    const V cos_delta =
-        v_min(v_add(v_add(v_mul(cos_r, cos_c), v_mul(sin_r, sin_c)), v_set1(Kernel::kCosineAbsSlack)), one);
+    const V cos_delta = v_min(
+        v_add(v_add(v_mul(cos_r, cone.cos_c), v_mul(sin_r, cone.sin_c)), v_set1(Kernel::kCosineAbsSlack)), one);
     const V narrowed =
         v_min(v_mul(v_sqrt(v_max(v_add(half, v_mul(half, cos_delta)), zero)), v_set1(Kernel::kBoundSlack)), one);
-    const V wide = v_andnot(outside, one);
-    const V narrow = v_and(outside, v_or(v_and(in_cone, one), v_andnot(in_cone, narrowed)));
-    const V cos_h = v_or(wide, narrow);
-    // lc_ggx_d(cos_h, alpha) * lc_smith_g1(cos_o, alpha) / (4 cos_o) * kBoundSlack.
+    const V wide = v_andnot(cone.outside, one);
+    const V narrow = v_and(cone.outside, v_or(v_and(in_cone, one), v_andnot(in_cone, narrowed)));
+    return v_or(wide, narrow);
+}
+
+// lc_ggx_d(cos_h, alpha) lane by lane.
+template <class Kernel>
+LC_ALWAYS_INLINE inline V ggx_d(const QuadLanes& q, V cos_h) {
     const V c2 = v_mul(cos_h, cos_h);
-    const V denom = v_add(v_sub(one, c2), v_mul(q.a2, c2));
-    const V d = v_div(q.a2, v_mul(v_mul(v_set1(Kernel::kPi), denom), denom));
-    const V bound = v_mul(v_div(v_mul(d, q.g1), q.four_cos_o), v_set1(Kernel::kBoundSlack));
-    return v_and(bound, v_cmpnle(q.cos_o, zero));  // lc_ggx_bound: 0 where cos_o <= 0
+    const V denom = v_add(v_sub(v_set1(1.0f), c2), v_mul(q.a2, c2));
+    return v_div(q.a2, v_mul(v_mul(v_set1(Kernel::kPi), denom), denom));
+}
+
+// lc_ggx_bound of each lane's box at its point: lc_box_cone, lc_cos_h_max,
+// lc_ggx_d and lc_smith_g1; 0 where cos_o <= 0, anything in lanes the
+// caller masks.
+template <class Kernel>
+LC_ALWAYS_INLINE inline V ggx_bounds(const QuadLanes& q, V cos_h) {
+    const V bound = v_mul(v_div(v_mul(ggx_d<Kernel>(q, cos_h), q.g1), q.four_cos_o), v_set1(Kernel::kBoundSlack));
+    return v_and(bound, v_cmpnle(q.cos_o, v_zero()));  // lc_ggx_bound: 0 where cos_o <= 0
+}
+
+// lc_schlick_weight lane by lane.
+LC_ALWAYS_INLINE inline V schlick_weight(V cos_x) {
+    const V m = v_min(v_max(v_sub(v_set1(1.0f), cos_x), v_zero()), v_set1(1.0f));
+    const V m2 = v_mul(m, m);
+    return v_mul(v_mul(m2, m2), m);
+}
+
+// lc_disney_bound at each lane's point (cosine bound cos_bound) into r, g,
+// b: lc_cos_d_range, then the lobes; anything in lanes without the BRDF.
+template <class Kernel>
+LC_ALWAYS_INLINE inline void disney_bounds(const QuadLanes& q, const BoxCones& cone, V cos_h, V cos_bound, V& r, V& g,
+                                           V& b) {
+    const V zero = v_zero(), one = v_set1(1.0f), half = v_set1(0.5f), minus_one = v_set1(-1.0f);
+    const V slack = v_set1(Kernel::kBoundSlack);
+    // lc_cos_d_range: cos(angle_o -+ (theta_c + kAngleSlack)), their half
+    // angles' cosines; (0, 1) inside the sphere.
+    const V cos_o = v_min(v_max(dot4(q.wox, q.woy, q.woz, cone.a_x, cone.a_y, cone.a_z), minus_one), one);
+    const V x_x = v_sub(v_mul(q.woy, cone.a_z), v_mul(cone.a_y, q.woz));
+    const V x_y = v_sub(v_mul(q.woz, cone.a_x), v_mul(cone.a_z, q.wox));
+    const V x_z = v_sub(v_mul(q.wox, cone.a_y), v_mul(cone.a_x, q.woy));
+    const V sin_o = v_min(v_sqrt(dot4(x_x, x_y, x_z, x_x, x_y, x_z)), one);
+    const V sin_c = v_min(cone.sin_c, one);
+    const V cos_c = v_sqrt(v_max(v_sub(one, v_mul(sin_c, sin_c)), zero));
+    const V slack_cos = v_set1(Kernel::kAngleSlackCos), slack_sin = v_set1(Kernel::kAngleSlackSin);
+    const V cos_cs = v_sub(v_mul(cos_c, slack_cos), v_mul(sin_c, slack_sin));
+    const V sin_cs = v_add(v_mul(sin_c, slack_cos), v_mul(cos_c, slack_sin));
+    const V cos_near =
+        v_select(v_cmpge(cos_o, cos_cs), one, v_min(v_add(v_mul(cos_o, cos_cs), v_mul(sin_o, sin_cs)), one));
+    const V cos_far = v_select(v_cmpge(v_mul(cos_cs, minus_one), cos_o), minus_one,
+                               v_max(v_sub(v_mul(cos_o, cos_cs), v_mul(sin_o, sin_cs)), minus_one));
+    const V d_min = v_select(
+        cone.outside,
+        v_max(v_sub(v_div(v_sqrt(v_add(half, v_mul(half, cos_far))), slack), v_set1(Kernel::kCosineAbsSlack)), zero),
+        zero);
+    const V d_max = v_select(cone.outside, v_min(v_mul(v_sqrt(v_add(half, v_mul(half, cos_near))), slack), one), one);
+    // The diffuse lobe: F_D90 at the largest cos_d.
+    const V fd90 = v_add(half, v_mul(v_mul(q.two_roughness, d_max), d_max));
+    const V retro = v_mul(v_max(fd90, one), v_add(one, v_mul(v_sub(fd90, one), q.schlick_o)));
+    const V diffuse = v_div(v_mul(v_mul(q.one_minus_metallic, retro), cos_bound), v_set1(Kernel::kPi));
+    r = v_mul(q.kd_r, diffuse);
+    g = v_mul(q.kd_g, diffuse);
+    b = v_mul(q.kd_b, diffuse);
+    // The specular lobe at the largest cos_h, Schlick's weight at the
+    // smallest cos_d.
+    const V w = schlick_weight(d_min);
+    const V ggx = v_div(v_mul(ggx_d<Kernel>(q, cos_h), q.g1), q.four_cos_o);
+    const V one_minus_w = v_sub(one, w), w_of_one = v_mul(one, w);
+    r = v_add(r, v_mul(v_add(v_mul(q.spec0_r, one_minus_w), w_of_one), ggx));
+    g = v_add(g, v_mul(v_add(v_mul(q.spec0_g, one_minus_w), w_of_one), ggx));
+    b = v_add(b, v_mul(v_add(v_mul(q.spec0_b, one_minus_w), w_of_one), ggx));
+    if (Kernel::kEnableSheen) {
+        const V weight = v_mul(w, cos_bound);
+        r = v_select(q.sheen_lanes, v_add(r, v_mul(q.sheen_r, weight)), r);
+        g = v_select(q.sheen_lanes, v_add(g, v_mul(q.sheen_g, weight)), g);
+        b = v_select(q.sheen_lanes, v_add(b, v_mul(q.sheen_b, weight)), b);
+    }
+    if (Kernel::kEnableClearcoat) {
+        const V c2 = v_mul(cos_h, cos_h);
+        const V gtr1 = v_div(q.coat_a2_minus_1,
+                             v_mul(q.coat_pi_log, v_add(v_sub(one, c2), v_mul(q.coat_a2, c2))));
+        const V coat = v_div(v_mul(gtr1, q.coat_g1), q.four_cos_o);
+        const V fresnel = v_add(v_mul(v_set1(0.04f), one_minus_w), w_of_one);
+        const V lobe = v_mul(v_mul(q.coat_weight, fresnel), coat);
+        r = v_select(q.coat_lanes, v_add(r, lobe), r);
+        g = v_select(q.coat_lanes, v_add(g, lobe), g);
+        b = v_select(q.coat_lanes, v_add(b, lobe), b);
+    }
+    const V lit = v_cmpgt(q.cos_o, zero);  // lc_disney_bound: 0 where !(cos_o > 0)
+    r = v_and(v_mul(r, slack), lit);
+    g = v_and(v_mul(g, slack), lit);
+    b = v_and(v_mul(b, slack), lit);
 }
 
 // lc_emission_bound of each lane's cluster at its point, from the box
@@ -242,13 +350,24 @@ LC_ALWAYS_INLINE inline bool cluster_errors(const QuadLanes& q, const QuadNodes&
     V r = v_mul(q.kd_r, cos_over_pi);
     V g = v_mul(q.kd_g, cos_over_pi);
     V b = v_mul(q.kd_b, cos_over_pi);
-    if (q.specular != 0u) {
-        // The lobe counts at points that have one, where the cosine bound
-        // is above 0 (or NaN), as in lc_cluster_bound.
-        const V ggx = v_and(ggx_bounds<Kernel>(q, n), v_and(positive, q.specular_lanes));
-        r = v_add(r, v_mul(q.ks_r, ggx));
-        g = v_add(g, v_mul(q.ks_g, ggx));
-        b = v_add(b, v_mul(q.ks_b, ggx));
+    if (q.specular != 0u || q.disney != 0u) {
+        const BoxCones cone = box_cones(q, n);
+        const V cos_h = cos_h_max<Kernel>(q, cone);
+        if (q.specular != 0u) {
+            // The lobe counts at points that have one, where the cosine bound
+            // is above 0 (or NaN), as in lc_cluster_bound.
+            const V ggx = v_and(ggx_bounds<Kernel>(q, cos_h), v_and(positive, q.specular_lanes));
+            r = v_add(r, v_mul(q.ks_r, ggx));
+            g = v_add(g, v_mul(q.ks_g, ggx));
+            b = v_add(b, v_mul(q.ks_b, ggx));
+        }
+        if (q.disney != 0u) {
+            V dr, dg, db;
+            disney_bounds<Kernel>(q, cone, cos_h, cosines, dr, dg, db);
+            r = v_select(q.disney_lanes, dr, r);
+            g = v_select(q.disney_lanes, dg, g);
+            b = v_select(q.disney_lanes, db, b);
+        }
     }
     r = v_mul(v_mul(r, factor), n.intensity_r);
     g = v_mul(v_mul(g, factor), n.intensity_g);

@@ -97,7 +97,7 @@ public:
         sp_ = sp;
         active_ = active;
 #if defined(__SSE2__)
-        lanes_ = quad_lanes(sp, active);
+        lanes_ = quad_lanes(k_, sp, active);
         wide_ = lanes_.covered && cpu_has_avx2();
         if (wide_) quad8::widen(lanes_, lanes8_);
 #endif

@@ -10,6 +10,7 @@
 
 #include "cpu_kernel.h"
 #include "quad_cut.h"
+#include "scene/materials.h"
 #include "test_util.h"
 
 namespace lc {
@@ -28,7 +29,22 @@ Kernel::SurfacePoint random_point(Kernel& k, std::mt19937& rng, glm::vec3 x, boo
     Kernel::SurfacePoint s = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f));
     const glm::vec3 kd(u(rng), u(rng), u(rng)), ks(u(rng), u(rng), u(rng));
     s.mat = u(rng) < 0.5f ? test::lambert(kd) : test::glossy(kd, ks, std::pow(10.0f, -3.0f * u(rng)));
-    if (disney) s.mat.flags |= gpu::kMaterialDisney;
+    if (disney) {
+        // Any Disney material: metal or not, rough or polished, with and
+        // without specular, sheen and clearcoat lobes.
+        const auto maybe = [&](float v) { return u(rng) < 0.25f ? 0.0f : v; };
+        loader::DisneyParams p;
+        p.base_color = kd;
+        p.metallic = u(rng) < 0.2f ? 1.0f : maybe(u(rng));
+        p.roughness = u(rng) < 0.1f ? 0.0f : u(rng);
+        p.specular = maybe(u(rng));
+        p.specular_tint = u(rng);
+        p.sheen = maybe(u(rng));
+        p.sheen_tint = u(rng);
+        p.clearcoat = maybe(u(rng));
+        p.clearcoat_gloss = u(rng);
+        s.mat = loader::make_disney_material(p);
+    }
     return s;
 }
 
@@ -44,7 +60,7 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
     Kernel k;
     k.materials = materials.data();  // lc_make_surface's; each point's own is set after it
     k.vpl_min_distance2 = 0.01f;
-    int trials = 0, covered = 0, checked = 0, nonzero = 0, pairs = 0, cone_lit = 0, cone_dark = 0;
+    int trials = 0, covered = 0, checked = 0, nonzero = 0, pairs = 0, cone_lit = 0, cone_dark = 0, disney_lit = 0;
     gpu::LightNode previous{};
     bool have_previous = false;
     for (int trial = 0; trial < 40000; ++trial) {
@@ -75,16 +91,17 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
         node.intensity_r = 10.0f * u(rng), node.intensity_g = 10.0f * u(rng), node.intensity_b = 10.0f * u(rng);
         Kernel::SurfacePoint sp[4];
         const unsigned active = trial % 5 == 0 ? unsigned(rng() & 0xFu) : 0xFu;
-        const bool disney = trial % 11 == 0;
+        // Disney materials at all four points, or at some of them.
+        const int disney = trial % 4;  // 0: none, 1: all, 2 and 3: each point at random
         for (Kernel::SurfacePoint& s : sp) {
             glm::vec3 x = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 6.0f;
             if (u(rng) < 0.1f) x = glm::vec3(node.min_x, node.min_y + 0.5f * (node.max_y - node.min_y), node.max_z);
-            s = random_point(k, rng, x, disney);
+            s = random_point(k, rng, x, disney == 1 || (disney > 1 && u(rng) < 0.5f));
         }
         const float min_distance2 = u(rng) < 0.5f ? 1e-8f : 0.05f;
         float errors[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
 #if defined(__SSE2__)
-        const cpu::QuadLanes lanes = cpu::quad_lanes(sp, active);
+        const cpu::QuadLanes lanes = cpu::quad_lanes(k, sp, active);
         const bool took = cpu::quad_errors(k, lanes, sp, node, min_distance2, errors);
 #else
         const bool took = false;
@@ -101,6 +118,7 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
             ++checked;
             nonzero += scalar > 0.0f ? 1 : 0;
             if (!(node.cos_theta_o <= -1.0f)) ++(scalar > 0.0f ? cone_lit : cone_dark);
+            if ((sp[p].mat.flags & gpu::kMaterialDisney) != 0u && scalar > 0.0f) ++disney_lit;
             // Bit for bit: the same float (or both NaN), not merely close.
             ASSERT_TRUE(errors[p] == scalar || (std::isnan(errors[p]) && std::isnan(scalar)))
                 << "trial " << trial << " lane " << p << ": " << errors[p] << " against " << scalar;
@@ -135,6 +153,7 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
     // Clusters with emission cones, lit and unlit by them.
     EXPECT_GT(cone_lit, checked / 20);
     EXPECT_GT(cone_dark, checked / 20);
+    EXPECT_GT(disney_lit, checked / 10);  // Disney points with a bound above zero
     if (cpu::cpu_has_avx2()) {
         EXPECT_GT(pairs, covered / 2);
     }
@@ -219,7 +238,7 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
         float t_max[4];
 #if defined(__SSE2__)
         const bool took =
-            cpu::quad_light_units(k, cpu::quad_lanes(sp, active), sp, light, min_distance2, unit, wi, t_max);
+            cpu::quad_light_units(k, cpu::quad_lanes(k, sp, active), sp, light, min_distance2, unit, wi, t_max);
 #else
         const bool took = false;
 #endif
