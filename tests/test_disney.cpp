@@ -19,24 +19,6 @@ using Kernel = cpu::ShadeKernel;
 using test::random_unit;
 constexpr double kPi = 3.14159265358979323846;
 
-// Random parameters; each lobe is switched off entirely in about a quarter
-// of the cases, so every combination of lobes occurs.
-loader::DisneyParams random_params(std::mt19937& rng) {
-    std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    const auto maybe = [&](float v) { return u(rng) < 0.25f ? 0.0f : v; };
-    loader::DisneyParams p;
-    p.base_color = glm::vec3(u(rng), u(rng), u(rng)) * (u(rng) < 0.1f ? 0.0f : 1.0f);
-    p.metallic = u(rng) < 0.2f ? 1.0f : maybe(u(rng));
-    p.roughness = u(rng) < 0.1f ? 0.0f : u(rng);
-    p.specular = maybe(u(rng));
-    p.specular_tint = u(rng);
-    p.sheen = maybe(u(rng));
-    p.sheen_tint = u(rng);
-    p.clearcoat = maybe(u(rng));
-    p.clearcoat_gloss = u(rng);
-    return p;
-}
-
 // Burley's disney.brdf (BRDF Explorer) in double precision, written as
 // there: smithG_GGX(c, a) = 1 / (c + sqrt(a^2 + c^2 - a^2 c^2)), which
 // already holds the 1 / (2 cos) of each direction, and D in the textbook
@@ -95,7 +77,7 @@ TEST(Disney, MatchesBurleysFormulas) {
     const glm::vec3 n(0.0f, 0.0f, 1.0f);
     int checked = 0;
     for (int trial = 0; trial < 20000; ++trial) {
-        loader::DisneyParams p = random_params(rng);
+        loader::DisneyParams p = test::random_disney_params(rng);
         p.roughness = 0.3f + 0.7f * u(rng);
         p.clearcoat_gloss *= 0.5f;
         const gpu::Material m = loader::make_disney_material(p);
@@ -156,7 +138,7 @@ TEST(Disney, NonNegativeAndReciprocal) {
     Kernel k;
     int checked = 0;
     for (int trial = 0; trial < 100000; ++trial) {
-        const gpu::Material m = loader::make_disney_material(random_params(rng));
+        const gpu::Material m = loader::make_disney_material(test::random_disney_params(rng));
         const glm::vec3 n = random_unit(rng);
         const glm::vec3 a = direction_above(rng, n), b = direction_above(rng, n);
         const float ca = glm::dot(n, a), cb = glm::dot(n, b);
@@ -248,7 +230,7 @@ TEST(DisneyBounds, EveryLobeBoundIsConservative) {
     int zero_bounds = 0;
     for (int trial = 0; trial < 100000; ++trial) {
         const bool directional = trial % 5 == 0;
-        materials[0] = loader::make_disney_material(random_params(rng));
+        materials[0] = loader::make_disney_material(test::random_disney_params(rng));
         const gpu::Material& m = materials[0];
         std::vector<glm::vec3> pts(1 + trial % 8);
         glm::vec3 lo(1e30f), hi(-1e30f);

@@ -10,7 +10,6 @@
 
 #include "cpu_kernel.h"
 #include "quad_cut.h"
-#include "scene/materials.h"
 #include "test_util.h"
 
 namespace lc {
@@ -32,17 +31,8 @@ Kernel::SurfacePoint random_point(Kernel& k, std::mt19937& rng, glm::vec3 x, boo
     if (disney) {
         // Any Disney material: metal or not, rough or polished, with and
         // without specular, sheen and clearcoat lobes.
-        const auto maybe = [&](float v) { return u(rng) < 0.25f ? 0.0f : v; };
-        loader::DisneyParams p;
+        loader::DisneyParams p = test::random_disney_params(rng);
         p.base_color = kd;
-        p.metallic = u(rng) < 0.2f ? 1.0f : maybe(u(rng));
-        p.roughness = u(rng) < 0.1f ? 0.0f : u(rng);
-        p.specular = maybe(u(rng));
-        p.specular_tint = u(rng);
-        p.sheen = maybe(u(rng));
-        p.sheen_tint = u(rng);
-        p.clearcoat = maybe(u(rng));
-        p.clearcoat_gloss = u(rng);
         s.mat = loader::make_disney_material(p);
     }
     return s;

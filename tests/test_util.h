@@ -17,6 +17,7 @@
 
 #include "lightcuts/render.h"
 #include "lightcuts/scene.h"
+#include "scene/materials.h"
 
 namespace lc::test {
 
@@ -157,6 +158,24 @@ inline gpu::Light oriented_light(glm::vec3 p, glm::vec3 normal, glm::vec3 intens
 }
 
 // Adds a triangle with its face normal (or the given vertex normals).
+// Random Disney parameters; each lobe is switched off entirely in about a
+// quarter of the cases, so every combination of lobes occurs.
+inline loader::DisneyParams random_disney_params(std::mt19937& rng) {
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const auto maybe = [&](float v) { return u(rng) < 0.25f ? 0.0f : v; };
+    loader::DisneyParams p;
+    p.base_color = glm::vec3(u(rng), u(rng), u(rng)) * (u(rng) < 0.1f ? 0.0f : 1.0f);
+    p.metallic = u(rng) < 0.2f ? 1.0f : maybe(u(rng));
+    p.roughness = u(rng) < 0.1f ? 0.0f : u(rng);
+    p.specular = maybe(u(rng));
+    p.specular_tint = u(rng);
+    p.sheen = maybe(u(rng));
+    p.sheen_tint = u(rng);
+    p.clearcoat = maybe(u(rng));
+    p.clearcoat_gloss = u(rng);
+    return p;
+}
+
 // A uniformly distributed unit vector.
 inline glm::vec3 random_unit(std::mt19937& rng) {
     std::normal_distribution<float> g;
