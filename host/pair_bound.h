@@ -13,9 +13,10 @@
 //
 // The quad functions below do the same for one cluster at the four shaded
 // points of a 2x2 quad (host/quad_cut.h), the points in the lanes: its
-// bound with the GGX lobe's and the emission cone's of spots, oriented
-// lights and VPLs (quad_errors; the code in quad_bounds_body.h; a change to
-// lc_emission_bound or lc_ggx_bound must be made there too),
+// bound with the GGX lobe's, the Disney BRDF's and the emission cone's of
+// spots, oriented lights and VPLs (quad_errors; the code in
+// quad_bounds_body.h; a change to lc_emission_bound, lc_ggx_bound or
+// lc_disney_bound must be made there too),
 // two clusters' bounds at once where the CPU has AVX2
 // (quad8::quad_pair_errors), and a representative's contribution
 // (quad_light_units), bit for bit the scalar functions'
@@ -231,7 +232,7 @@ QuadLanes quad_lanes(Kernel& kernel, const SurfacePoint* sp, unsigned active) {
     q.covered = true;
     // The Disney terms (QuadLanes), each from the scalar function
     // lc_disney_bound calls, so that the lanes hold its very floats.
-    alignas(16) float d[19][4] = {};
+    alignas(16) float d[14][4] = {};
     alignas(16) std::uint32_t dmask[3][4] = {};
     for (unsigned p = 0; p < 4u; ++p) {
         const bool on = (active >> p & 1u) != 0u;
@@ -261,7 +262,7 @@ QuadLanes quad_lanes(Kernel& kernel, const SurfacePoint* sp, unsigned active) {
         const glm::vec3 spec0 = kernel.lc_disney_spec0(m);
         const glm::vec3 sheen_color = sheen ? kernel.lc_disney_sheen_color(m) : glm::vec3(0.0f);
         const float alpha_c = kernel.lc_clearcoat_alpha(m), a2 = alpha_c * alpha_c;
-        const float terms[19] = {1.0f - m.metallic,
+        const float terms[14] = {1.0f - m.metallic,
                                  2.0f * m.roughness,
                                  kernel.lc_schlick_weight(cos_o),
                                  spec0.x, spec0.y, spec0.z,
@@ -270,9 +271,8 @@ QuadLanes quad_lanes(Kernel& kernel, const SurfacePoint* sp, unsigned active) {
                                  a2,
                                  a2 - 1.0f,
                                  Kernel::kPi * std::log(a2),
-                                 kernel.lc_smith_g1(cos_o, Kernel::kClearcoatSmithAlpha),
-                                 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
-        for (unsigned i = 0; i < 19u; ++i) d[i][p] = terms[i];
+                                 kernel.lc_smith_g1(cos_o, Kernel::kClearcoatSmithAlpha)};
+        for (unsigned i = 0; i < 14u; ++i) d[i][p] = terms[i];
         dmask[0][p] = ~0u;
         dmask[1][p] = sheen ? ~0u : 0u;
         dmask[2][p] = coat ? ~0u : 0u;
@@ -416,8 +416,9 @@ void quad_pair_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode& 
 // (tests/test_quad_cut.cpp). False where this does not cover the case: a
 // directional light, or the points' lanes not covered (QuadLanes). Points
 // with a GGX lobe or the Disney BRDF get their BRDF from the scalar
-// lc_brdf_cos, on the direction and cosine computed here. A change to lc_light_unit or lc_brdf_cos (shaders/shared/shading.h)
-// must be made here too; the test fails until it is.
+// lc_brdf_cos, on the direction and cosine computed here. A change to
+// lc_light_unit or lc_brdf_cos (shaders/shared/shading.h) must be made here
+// too; the test fails until it is.
 template <class Kernel, class SurfacePoint>
 bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, const gpu::Light& light,
                       float min_distance2, glm::vec3 unit[4], glm::vec3 wi[4], float t_max[4]) {

@@ -8,10 +8,10 @@
 // v_abs, v_min and v_max (GLSL's min and max, see glsl_min), v_movemask,
 // and v_set2(a, b): the first cluster's value a and the second's b.
 // Every value is computed with the same operations in the same order as
-// the scalar lc_cluster_bound, lc_ggx_bound and lc_emission_bound
-// (shaders/shared), so the results are theirs bit for bit
-// (tests/test_quad_cut.cpp). The emission bound has no acos, asin or cos
-// for this: sqrt, like the rest, is rounded the same way in every lane.
+// the scalar lc_cluster_bound, lc_ggx_bound, lc_disney_bound and
+// lc_emission_bound (shaders/shared), so the results are theirs bit for bit
+// (tests/test_quad_cut.cpp). Those bounds form no angles (no acos, asin or
+// cos) for this: sqrt, like the rest, is rounded the same way in every lane.
 // No include guard: included once per vector width.
 
 // The shaded points lane by lane: positions, frames, the diffuse and
@@ -219,8 +219,9 @@ LC_ALWAYS_INLINE inline void disney_bounds(const QuadLanes& q, const BoxCones& c
     const V x_y = v_sub(v_mul(q.woz, cone.a_x), v_mul(cone.a_z, q.wox));
     const V x_z = v_sub(v_mul(q.wox, cone.a_y), v_mul(cone.a_x, q.woy));
     const V sin_o = v_min(v_sqrt(dot4(x_x, x_y, x_z, x_x, x_y, x_z)), one);
-    const V sin_c = v_min(cone.sin_c, one);
-    const V cos_c = v_sqrt(v_max(v_sub(one, v_mul(sin_c, sin_c)), zero));
+    // lc_cos_d_range's min(cone.w, 1) and its cosine are box_cones' sin_c
+    // and cos_c, float for float.
+    const V sin_c = cone.sin_c, cos_c = cone.cos_c;
     const V slack_cos = v_set1(Kernel::kAngleSlackCos), slack_sin = v_set1(Kernel::kAngleSlackSin);
     const V cos_cs = v_sub(v_mul(cos_c, slack_cos), v_mul(sin_c, slack_sin));
     const V sin_cs = v_add(v_mul(sin_c, slack_cos), v_mul(cos_c, slack_sin));
