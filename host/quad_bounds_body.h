@@ -245,10 +245,11 @@ LC_ALWAYS_INLINE inline void disney_bounds(const QuadLanes& q, const BoxCones& c
     // smallest cos_d.
     const V w = schlick_weight(d_min);
     const V ggx = v_div(v_mul(ggx_d<Kernel>(q, cos_h), q.g1), q.four_cos_o);
-    const V one_minus_w = v_sub(one, w), w_of_one = v_mul(one, w);
-    r = v_add(r, v_mul(v_add(v_mul(q.spec0_r, one_minus_w), w_of_one), ggx));
-    g = v_add(g, v_mul(v_add(v_mul(q.spec0_g, one_minus_w), w_of_one), ggx));
-    b = v_add(b, v_mul(v_add(v_mul(q.spec0_b, one_minus_w), w_of_one), ggx));
+    // glm's mix(x, 1, w) is x (1 - w) + 1 w, and 1 w is w, bit for bit.
+    const V one_minus_w = v_sub(one, w);
+    r = v_add(r, v_mul(v_add(v_mul(q.spec0_r, one_minus_w), w), ggx));
+    g = v_add(g, v_mul(v_add(v_mul(q.spec0_g, one_minus_w), w), ggx));
+    b = v_add(b, v_mul(v_add(v_mul(q.spec0_b, one_minus_w), w), ggx));
     if (Kernel::kEnableSheen) {
         const V weight = v_mul(w, cos_bound);
         r = v_select(q.sheen_lanes, v_add(r, v_mul(q.sheen_r, weight)), r);
@@ -260,7 +261,7 @@ LC_ALWAYS_INLINE inline void disney_bounds(const QuadLanes& q, const BoxCones& c
         const V gtr1 = v_div(q.coat_a2_minus_1,
                              v_mul(q.coat_pi_log, v_add(v_sub(one, c2), v_mul(q.coat_a2, c2))));
         const V coat = v_div(v_mul(gtr1, q.coat_g1), q.four_cos_o);
-        const V fresnel = v_add(v_mul(v_set1(0.04f), one_minus_w), w_of_one);
+        const V fresnel = v_add(v_mul(v_set1(0.04f), one_minus_w), w);
         const V lobe = v_mul(v_mul(q.coat_weight, fresnel), coat);
         r = v_select(q.coat_lanes, v_add(r, lobe), r);
         g = v_select(q.coat_lanes, v_add(g, lobe), g);
