@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <vector>
 
@@ -286,16 +287,47 @@ struct BasicShadeKernel {
     }
 
     // A refinement's two children's lc_cluster_error: both at once in SSE
-    // lanes where pair_errors covers them (host/pair_bound.h), the same
-    // values bit for bit.
+    // lanes where pair_errors covers them (host/pair_bound.h); else, where
+    // the CPU has AVX2 and the quads' evaluation covers them (emission
+    // cones, the Disney BRDF), in its eight lanes with the point in the
+    // first of each half (the others idle): the point's lanes are made
+    // again only when the point changes. The same values bit for bit.
     vec2 lc_child_errors(const SurfacePoint& sp, const Material& m, const LightNode& left, const LightNode& right,
                          float min_distance2) {
         vec2 errors;
         if (tightest_bound)
             return vec2(tightest_error(sp, left, min_distance2), tightest_error(sp, right, min_distance2));
         if (pair_errors(*this, sp, m, left, right, min_distance2, errors)) return errors;
+#if defined(__SSE2__)
+        if (quad_bound_covers(left) && quad_bound_covers(right) && cpu_has_avx2()) {
+            if (!lanes_made || std::memcmp(&sp, &lanes_point, offsetof(SurfacePoint, mat)) != 0 ||
+                std::memcmp(&m, &lanes_point.mat, sizeof m) != 0) {
+                SurfacePoint point = sp;
+                point.mat = m;
+                const SurfacePoint four[4] = {point, point, point, point};
+                const QuadLanes q = quad_lanes(*this, four, 1u);
+                lanes_covered = q.covered;
+                if (lanes_covered) quad8::widen(q, point_lanes);
+                lanes_point = point;
+                lanes_made = true;
+            }
+            if (lanes_covered) {
+                float a[4], b[4];
+                quad8::quad_pair_errors(*this, point_lanes, left, right, min_distance2, a, b);
+                return vec2(a[0], b[0]);
+            }
+        }
+#endif
         return vec2(lc_cluster_error(sp, m, left, min_distance2), lc_cluster_error(sp, m, right, min_distance2));
     }
+#if defined(__SSE2__)
+    // lc_child_errors' lanes, of lanes_point (its material the one it was
+    // given), compared byte for byte: SurfacePoint has no padding.
+    static_assert(offsetof(SurfacePoint, mat) == 5 * sizeof(vec3) + sizeof(uint) + sizeof(vec2));
+    quad8::QuadLanes point_lanes;
+    SurfacePoint lanes_point;
+    bool lanes_made = false, lanes_covered = false;
+#endif
 
     // The smallest error bound of Walter's form, material * geometry *
     // emission bounded over the cluster and visibility by 1: the largest

@@ -100,11 +100,15 @@ TEST(LightcutsBounds, EveryBoundIsConservative) {
 }
 
 // The CPU evaluates a refinement's two children's bounds together in SSE
-// lanes (host/pair_bound.h): over random pairs of clusters (points, VPLs,
-// oriented and directional ones, leaves), points (far, near, inside a box,
-// on its face) and materials (Lambert, GGX, Disney), its errors are the
-// scalar lc_cluster_error's bit for bit, and the pair path is taken for
-// most of them.
+// lanes (host/pair_bound.h), or where those do not cover them (emission
+// cones, the Disney BRDF) in the quads' AVX2 lanes with the point in the
+// first of each half (lc_child_errors): over random pairs of clusters
+// (points, VPLs, oriented lights, spots and directional ones, leaves),
+// points (far, near, inside a box, on its face) and materials (Lambert,
+// GGX, Disney), its errors are the scalar lc_cluster_error's bit for bit,
+// and the pair path is taken for most of them, the quads' for many of the
+// rest. Trials change the point, the material or both, so lanes kept from
+// the last trial's point or material would fail it.
 TEST(LightcutsBounds, PairOfChildErrorsIsTheScalarOneBitForBit) {
     std::mt19937 rng(777);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
@@ -112,34 +116,54 @@ TEST(LightcutsBounds, PairOfChildErrorsIsTheScalarOneBitForBit) {
     Kernel k;
     k.materials = materials.data();
     k.vpl_min_distance2 = 0.01f;
-    int paired = 0, trials = 0, nonzero = 0;
+    int paired = 0, laned = 0, trials = 0, nonzero = 0;
+    glm::vec3 x(0.0f), n(0.0f, 1.0f, 0.0f), wo(0.0f, 1.0f, 0.0f);
     for (int trial = 0; trial < 100000; ++trial) {
+        // A new material and a new point, or one of them new and the other
+        // the last trial's.
+        const bool new_material = trial % 3 != 1, new_point = trial % 3 != 2;
         gpu::Material& m = materials[0];
-        const glm::vec3 kd(u(rng), u(rng), u(rng));
-        const int kind = trial % 7;
-        m = kind < 3 ? test::lambert(kd)
-                     : test::glossy(kd, glm::vec3(u(rng), u(rng), u(rng)), std::pow(10.0f, -3.0f * u(rng)));
-        if (kind == 6) m.flags |= gpu::kMaterialDisney;
+        if (new_material) {
+            const glm::vec3 kd(u(rng), u(rng), u(rng));
+            const int kind = trial % 7;
+            m = kind < 3 ? test::lambert(kd)
+                         : test::glossy(kd, glm::vec3(u(rng), u(rng), u(rng)), std::pow(10.0f, -3.0f * u(rng)));
+            if (kind == 6) {
+                loader::DisneyParams p = test::random_disney_params(rng);
+                p.base_color = kd;
+                m = loader::make_disney_material(p);
+            }
+        }
         gpu::LightNode nodes[2];
         for (gpu::LightNode& node : nodes) {
             const glm::vec3 centre = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 4.0f;
             const glm::vec3 half = glm::vec3(u(rng), u(rng), u(rng)) * (u(rng) < 0.2f ? 0.0f : 0.7f);
             const float pick = u(rng);
-            const std::uint32_t type = pick < 0.7f ? gpu::kLightPoint
-                                       : pick < 0.8f ? gpu::kLightVpl
-                                       : pick < 0.9f ? gpu::kLightOriented
+            const std::uint32_t type = pick < 0.6f   ? gpu::kLightPoint
+                                       : pick < 0.7f ? gpu::kLightVpl
+                                       : pick < 0.8f ? gpu::kLightOriented
+                                       : pick < 0.9f ? gpu::kLightSpot
                                                      : gpu::kLightDirectional;
             node = test::node_with_box(centre - half, centre + half, type);
             if (type == gpu::kLightOriented) node.cos_theta_o = 0.5f;
+            if (type == gpu::kLightSpot) {
+                node.axis_oct = std::uint32_t(rng());
+                node.cos_theta_o = 1.0f - 1.5f * u(rng);
+                node.cos_theta_e = 1.0f - u(rng);
+                node.falloff_width = std::max(1e-3f, u(rng));
+            }
             if (u(rng) < 0.05f) node.flags |= gpu::kNodeLeaf;
             node.intensity_r = 10.0f * u(rng), node.intensity_g = 10.0f * u(rng), node.intensity_b = 10.0f * u(rng);
         }
-        glm::vec3 x = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 6.0f;
-        if (u(rng) < 0.2f) x = glm::vec3(nodes[0].min_x, nodes[0].min_y + 0.5f * (nodes[0].max_y - nodes[0].min_y),
-                                         nodes[0].max_z);  // on a face
-        glm::vec3 n = random_unit(rng);
-        glm::vec3 wo = random_unit(rng);
-        if (glm::dot(wo, n) < 0.0f) wo = -wo;
+        if (new_point) {
+            x = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 6.0f;
+            if (u(rng) < 0.2f)
+                x = glm::vec3(nodes[0].min_x, nodes[0].min_y + 0.5f * (nodes[0].max_y - nodes[0].min_y),
+                              nodes[0].max_z);  // on a face
+            n = random_unit(rng);
+            wo = random_unit(rng);
+            if (glm::dot(wo, n) < 0.0f) wo = -wo;
+        }
         const Kernel::SurfacePoint sp = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f));
         const float min_distance2 = u(rng) < 0.5f ? 1e-8f : 0.05f;
         glm::vec2 pair(-1.0f);
@@ -149,6 +173,7 @@ TEST(LightcutsBounds, PairOfChildErrorsIsTheScalarOneBitForBit) {
         const glm::vec2 used = k.lc_child_errors(sp, m, nodes[0], nodes[1], min_distance2);
         ++trials;
         paired += took ? 1 : 0;
+        laned += !took && cpu::quad_bound_covers(nodes[0]) && cpu::quad_bound_covers(nodes[1]) ? 1 : 0;
         nonzero += scalar.x > 0.0f ? 1 : 0;
         // Bit for bit: the same float, not merely close.
         ASSERT_EQ(used.x, scalar.x) << "trial " << trial;
@@ -160,6 +185,7 @@ TEST(LightcutsBounds, PairOfChildErrorsIsTheScalarOneBitForBit) {
     }
 #if defined(__SSE2__)
     EXPECT_GT(paired, trials / 4);
+    EXPECT_GT(laned, trials / 10);
 #endif
     EXPECT_GT(nonzero, trials / 4);
 }
