@@ -456,10 +456,17 @@ bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp
     const __m128 lit = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(d, zero), _mm_cmpnle_ps(cos_i, zero)),
                                   _mm_and_ps(_mm_cmpgt_ps(factor, zero), q.active));
     const __m128 c = _mm_div_ps(cos_i, _mm_set1_ps(Kernel::kPi));
-    alignas(16) float v[9][4];
+    alignas(16) float v[12][4];
     _mm_store_ps(v[0], _mm_mul_ps(_mm_mul_ps(q.kd_r, c), factor));
     _mm_store_ps(v[1], _mm_mul_ps(_mm_mul_ps(q.kd_g, c), factor));
     _mm_store_ps(v[2], _mm_mul_ps(_mm_mul_ps(q.kd_b, c), factor));
+    if (q.disney != 0u) {
+        __m128 r, g, b;
+        quad4::disney_values<Kernel>(q, wx, wy, wz, cos_i, r, g, b);
+        _mm_store_ps(v[9], _mm_mul_ps(r, factor));
+        _mm_store_ps(v[10], _mm_mul_ps(g, factor));
+        _mm_store_ps(v[11], _mm_mul_ps(b, factor));
+    }
     _mm_store_ps(v[3], wx);
     _mm_store_ps(v[4], wy);
     _mm_store_ps(v[5], wz);
@@ -472,7 +479,9 @@ bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp
         if ((mask >> p & 1u) == 0u) continue;
         wi[p] = glm::vec3(v[3][p], v[4][p], v[5][p]);
         t_max[p] = v[6][p];
-        if (((q.specular | q.disney) >> p & 1u) != 0u)
+        if ((q.disney >> p & 1u) != 0u)
+            unit[p] = glm::vec3(v[9][p], v[10][p], v[11][p]);
+        else if ((q.specular >> p & 1u) != 0u)
             unit[p] = kernel.lc_brdf_cos(sp[p].mat, sp[p].n, wi[p], sp[p].wo, v[7][p]) * v[8][p];
         else
             unit[p] = glm::vec3(v[0][p], v[1][p], v[2][p]);

@@ -273,6 +273,61 @@ LC_ALWAYS_INLINE inline void disney_bounds(const QuadLanes& q, const BoxCones& c
     b = v_and(v_mul(b, slack), lit);
 }
 
+// lc_disney_brdf_cos at each lane's point for the unit direction wi, whose
+// cosine with the normal is cos_i > 0, into r, g, b (the BRDF times cos_i):
+// 0 where cos_o <= 0, anything in lanes without the BRDF.
+template <class Kernel>
+LC_ALWAYS_INLINE inline void disney_values(const QuadLanes& q, V wi_x, V wi_y, V wi_z, V cos_i, V& r, V& g, V& b) {
+    const V zero = v_zero(), one = v_set1(1.0f), two = v_set1(2.0f), half = v_set1(0.5f);
+    // The half vector, glm's normalize: v * (1 / sqrt(dot(v, v))).
+    const V s_x = v_add(wi_x, q.wox), s_y = v_add(wi_y, q.woy), s_z = v_add(wi_z, q.woz);
+    const V inverse = v_div(one, v_sqrt(dot4(s_x, s_y, s_z, s_x, s_y, s_z)));
+    const V h_x = v_mul(s_x, inverse), h_y = v_mul(s_y, inverse), h_z = v_mul(s_z, inverse);
+    const V cos_h = v_max(dot4(q.nx, q.ny, q.nz, h_x, h_y, h_z), zero);
+    const V cos_d = v_min(v_max(dot4(wi_x, wi_y, wi_z, h_x, h_y, h_z), zero), one);
+    const V w = schlick_weight(cos_d);
+    // The diffuse lobe (lc_disney_diffuse).
+    const V fd90 = v_add(half, v_mul(v_mul(q.two_roughness, cos_d), cos_d));
+    const V fl = v_add(one, v_mul(v_sub(fd90, one), schlick_weight(cos_i)));
+    const V fv = v_add(one, v_mul(v_sub(fd90, one), q.schlick_o));
+    const V diffuse = v_div(v_mul(v_mul(v_mul(q.one_minus_metallic, fl), fv), cos_i), v_set1(Kernel::kPi));
+    r = v_mul(q.kd_r, diffuse);
+    g = v_mul(q.kd_g, diffuse);
+    b = v_mul(q.kd_b, diffuse);
+    // The specular lobe (lc_microfacet_cos; lc_smith_g1 at cos_i).
+    const V g1_i =
+        v_div(v_mul(two, cos_i), v_add(cos_i, v_sqrt(v_add(q.a2, v_mul(v_mul(v_sub(one, q.a2), cos_i), cos_i)))));
+    const V specular = v_div(v_mul(v_mul(ggx_d<Kernel>(q, cos_h), g1_i), q.g1), q.four_cos_o);
+    // glm's mix(x, 1, w) is x (1 - w) + 1 w, and 1 w is w, bit for bit.
+    const V one_minus_w = v_sub(one, w);
+    r = v_add(r, v_mul(v_add(v_mul(q.spec0_r, one_minus_w), w), specular));
+    g = v_add(g, v_mul(v_add(v_mul(q.spec0_g, one_minus_w), w), specular));
+    b = v_add(b, v_mul(v_add(v_mul(q.spec0_b, one_minus_w), w), specular));
+    if (Kernel::kEnableSheen) {
+        const V weight = v_mul(w, cos_i);
+        r = v_select(q.sheen_lanes, v_add(r, v_mul(q.sheen_r, weight)), r);
+        g = v_select(q.sheen_lanes, v_add(g, v_mul(q.sheen_g, weight)), g);
+        b = v_select(q.sheen_lanes, v_add(b, v_mul(q.sheen_b, weight)), b);
+    }
+    if (Kernel::kEnableClearcoat) {
+        const V c2 = v_mul(cos_h, cos_h);
+        const V gtr1 = v_div(q.coat_a2_minus_1, v_mul(q.coat_pi_log, v_add(v_sub(one, c2), v_mul(q.coat_a2, c2))));
+        const V a2 = v_set1(Kernel::kClearcoatSmithAlpha * Kernel::kClearcoatSmithAlpha);
+        const V coat_g1_i =
+            v_div(v_mul(two, cos_i), v_add(cos_i, v_sqrt(v_add(a2, v_mul(v_mul(v_sub(one, a2), cos_i), cos_i)))));
+        const V coat = v_div(v_mul(v_mul(gtr1, coat_g1_i), q.coat_g1), q.four_cos_o);
+        const V fresnel = v_add(v_mul(v_set1(0.04f), one_minus_w), w);
+        const V lobe = v_mul(v_mul(q.coat_weight, fresnel), coat);
+        r = v_select(q.coat_lanes, v_add(r, lobe), r);
+        g = v_select(q.coat_lanes, v_add(g, lobe), g);
+        b = v_select(q.coat_lanes, v_add(b, lobe), b);
+    }
+    const V seen = v_cmpgt(q.cos_o, zero);  // lc_disney_brdf_cos: 0 where !(cos_o > 0)
+    r = v_and(r, seen);
+    g = v_and(g, seen);
+    b = v_and(b, seen);
+}
+
 // lc_emission_bound of each lane's cluster at its point, from the box
 // relative to the point (lo, hi: box - p) and its centre c; 1 where the
 // cluster emits everywhere.

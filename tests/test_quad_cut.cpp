@@ -189,7 +189,7 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
     const std::vector<gpu::Material> materials = {test::lambert(glm::vec3(0.5f))};
     Kernel k;
     k.materials = materials.data();
-    int covered = 0, lanes = 0, lit = 0, trials = 0, lit_cones = 0;
+    int covered = 0, lanes = 0, lit = 0, trials = 0, lit_cones = 0, lit_disney = 0;
     for (int trial = 0; trial < 40000; ++trial) {
         const glm::vec3 at = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 4.0f;
         // Point lights, spots (narrow to wide, hard-edged too), one- and
@@ -216,12 +216,13 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
         }
         Kernel::SurfacePoint sp[4];
         const unsigned active = trial % 5 == 0 ? unsigned(rng() & 0xFu) : 0xFu;
-        const bool disney = trial % 13 == 0;
+        // Disney materials at all four points, or at some of them.
+        const int disney = trial % 4;  // 0: none, 1: all, 2 and 3: each point at random
         for (Kernel::SurfacePoint& s : sp) {
             // Some points on the light itself (no direction), some close.
             const float spread = u(rng) < 0.3f ? 0.01f : 6.0f;
             const glm::vec3 x = u(rng) < 0.02f ? at : at + (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * spread;
-            s = random_point(k, rng, x, disney);
+            s = random_point(k, rng, x, disney == 1 || (disney > 1 && u(rng) < 0.5f));
         }
         const float min_distance2 = u(rng) < 0.5f ? 1e-8f : 0.05f;
         glm::vec3 unit[4], wi[4];
@@ -248,6 +249,7 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
             if (!(scalar.x + scalar.y + scalar.z > 0.0f)) continue;
             ++lit;
             lit_cones += (light.type & gpu::kLightTypeMask) != gpu::kLightPoint;
+            lit_disney += (sp[p].mat.flags & gpu::kMaterialDisney) != 0u;
             ASSERT_EQ(wi[p], scalar_wi) << "trial " << trial << " lane " << p;
             ASSERT_EQ(t_max[p], scalar_t_max) << "trial " << trial << " lane " << p;
         }
@@ -256,6 +258,7 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
     EXPECT_GT(covered, trials / 2);
     EXPECT_GT(lit, lanes / 5);
     EXPECT_GT(lit_cones, lit / 5);  // spots, cosine emitters and VPLs that light their points
+    EXPECT_GT(lit_disney, lit / 4);  // points with the Disney BRDF that a light reaches
 #endif
 }
 
