@@ -291,7 +291,8 @@ struct BasicShadeKernel {
     // the CPU has AVX2 and the quads' evaluation covers them (emission
     // cones, the Disney BRDF), in its eight lanes with the point in the
     // first of each half (the others idle): the point's lanes are made
-    // again only when the point changes. The same values bit for bit.
+    // again only when the point or its material changes. The same values
+    // bit for bit.
     vec2 lc_child_errors(const SurfacePoint& sp, const Material& m, const LightNode& left, const LightNode& right,
                          float min_distance2) {
         vec2 errors;

@@ -6,7 +6,9 @@
 // same operations in the same order, so the results are the scalar ones bit
 // for bit (tests/test_lightcuts.cpp checks it); the GGX lobe's bound stays
 // scalar. Every other case (leaves, directional or oriented clusters, the
-// Disney BRDF) returns false and the caller evaluates one child at a time.
+// Disney BRDF) returns false; the caller (BasicShadeKernel::lc_child_errors)
+// then takes the quad evaluation below with the point in one lane where it
+// covers both children, else evaluates one child at a time.
 // A change to lc_cluster_bound, lc_cosine_bound, lc_box_distance2 or
 // lc_luminance (shaders/shared) must be made here too; the test fails until
 // it is.
@@ -414,11 +416,12 @@ void quad_pair_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode& 
 // and for each point where the unit is not zero the shadow ray's direction
 // wi[p] and length t_max[p]: the scalar function's values bit for bit
 // (tests/test_quad_cut.cpp). False where this does not cover the case: a
-// directional light, or the points' lanes not covered (QuadLanes). Points
-// with a GGX lobe or the Disney BRDF get their BRDF from the scalar
-// lc_brdf_cos, on the direction and cosine computed here. A change to
-// lc_light_unit or lc_brdf_cos (shaders/shared/shading.h) must be made here
-// too; the test fails until it is.
+// directional light, or the points' lanes not covered (QuadLanes). The
+// Disney BRDF is evaluated in the lanes too (quad4::disney_values); points
+// with a GGX lobe get their BRDF from the scalar lc_brdf_cos, on the
+// direction and cosine computed here. A change to lc_light_unit,
+// lc_brdf_cos or lc_disney_brdf_cos (shaders/shared/shading.h) must be made
+// here too; the test fails until it is.
 template <class Kernel, class SurfacePoint>
 bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, const gpu::Light& light,
                       float min_distance2, glm::vec3 unit[4], glm::vec3 wi[4], float t_max[4]) {
