@@ -205,6 +205,40 @@ LC_ALWAYS_INLINE inline V schlick_weight(V cos_x) {
     return v_mul(v_mul(m2, m2), m);
 }
 
+// lc_gtr1_d(cos_h, lc_clearcoat_alpha) lane by lane, from the point's terms.
+LC_ALWAYS_INLINE inline V gtr1_d(const QuadLanes& q, V cos_h) {
+    const V c2 = v_mul(cos_h, cos_h);
+    return v_div(q.coat_a2_minus_1, v_mul(q.coat_pi_log, v_add(v_sub(v_set1(1.0f), c2), v_mul(q.coat_a2, c2))));
+}
+
+// The Disney BRDF's lobes after the diffuse one, added to r, g, b in the
+// order of lc_disney_bound and lc_disney_brdf_cos: the specular lobe's
+// microfacet term `specular` times glm's mix(spec0, 1, w), which is
+// spec0 (1 - w) + 1 w, and 1 w is w, bit for bit; sheen times w * cos; the
+// clearcoat lobe from its microfacet term coat() (called only where the
+// kernel has the lobe).
+template <class Kernel, class Coat>
+LC_ALWAYS_INLINE inline void add_disney_lobes(const QuadLanes& q, V w, V specular, V cos, Coat coat, V& r, V& g,
+                                              V& b) {
+    const V one_minus_w = v_sub(v_set1(1.0f), w);
+    r = v_add(r, v_mul(v_add(v_mul(q.spec0_r, one_minus_w), w), specular));
+    g = v_add(g, v_mul(v_add(v_mul(q.spec0_g, one_minus_w), w), specular));
+    b = v_add(b, v_mul(v_add(v_mul(q.spec0_b, one_minus_w), w), specular));
+    if (Kernel::kEnableSheen) {
+        const V weight = v_mul(w, cos);
+        r = v_select(q.sheen_lanes, v_add(r, v_mul(q.sheen_r, weight)), r);
+        g = v_select(q.sheen_lanes, v_add(g, v_mul(q.sheen_g, weight)), g);
+        b = v_select(q.sheen_lanes, v_add(b, v_mul(q.sheen_b, weight)), b);
+    }
+    if (Kernel::kEnableClearcoat) {
+        const V fresnel = v_add(v_mul(v_set1(0.04f), one_minus_w), w);
+        const V lobe = v_mul(v_mul(q.coat_weight, fresnel), coat());
+        r = v_select(q.coat_lanes, v_add(r, lobe), r);
+        g = v_select(q.coat_lanes, v_add(g, lobe), g);
+        b = v_select(q.coat_lanes, v_add(b, lobe), b);
+    }
+}
+
 // lc_disney_bound at each lane's point (cosine bound cos_bound) into r, g,
 // b: lc_cos_d_range, then the lobes; anything in lanes without the BRDF.
 template <class Kernel>
@@ -245,28 +279,8 @@ LC_ALWAYS_INLINE inline void disney_bounds(const QuadLanes& q, const BoxCones& c
     // smallest cos_d.
     const V w = schlick_weight(d_min);
     const V ggx = v_div(v_mul(ggx_d<Kernel>(q, cos_h), q.g1), q.four_cos_o);
-    // glm's mix(x, 1, w) is x (1 - w) + 1 w, and 1 w is w, bit for bit.
-    const V one_minus_w = v_sub(one, w);
-    r = v_add(r, v_mul(v_add(v_mul(q.spec0_r, one_minus_w), w), ggx));
-    g = v_add(g, v_mul(v_add(v_mul(q.spec0_g, one_minus_w), w), ggx));
-    b = v_add(b, v_mul(v_add(v_mul(q.spec0_b, one_minus_w), w), ggx));
-    if (Kernel::kEnableSheen) {
-        const V weight = v_mul(w, cos_bound);
-        r = v_select(q.sheen_lanes, v_add(r, v_mul(q.sheen_r, weight)), r);
-        g = v_select(q.sheen_lanes, v_add(g, v_mul(q.sheen_g, weight)), g);
-        b = v_select(q.sheen_lanes, v_add(b, v_mul(q.sheen_b, weight)), b);
-    }
-    if (Kernel::kEnableClearcoat) {
-        const V c2 = v_mul(cos_h, cos_h);
-        const V gtr1 = v_div(q.coat_a2_minus_1,
-                             v_mul(q.coat_pi_log, v_add(v_sub(one, c2), v_mul(q.coat_a2, c2))));
-        const V coat = v_div(v_mul(gtr1, q.coat_g1), q.four_cos_o);
-        const V fresnel = v_add(v_mul(v_set1(0.04f), one_minus_w), w);
-        const V lobe = v_mul(v_mul(q.coat_weight, fresnel), coat);
-        r = v_select(q.coat_lanes, v_add(r, lobe), r);
-        g = v_select(q.coat_lanes, v_add(g, lobe), g);
-        b = v_select(q.coat_lanes, v_add(b, lobe), b);
-    }
+    add_disney_lobes<Kernel>(
+        q, w, ggx, cos_bound, [&] { return v_div(v_mul(gtr1_d(q, cos_h), q.coat_g1), q.four_cos_o); }, r, g, b);
     const V lit = v_cmpgt(q.cos_o, zero);  // lc_disney_bound: 0 where !(cos_o > 0)
     r = v_and(v_mul(r, slack), lit);
     g = v_and(v_mul(g, slack), lit);
@@ -298,30 +312,16 @@ LC_ALWAYS_INLINE inline void disney_values(const QuadLanes& q, V wi_x, V wi_y, V
     const V g1_i =
         v_div(v_mul(two, cos_i), v_add(cos_i, v_sqrt(v_add(q.a2, v_mul(v_mul(v_sub(one, q.a2), cos_i), cos_i)))));
     const V specular = v_div(v_mul(v_mul(ggx_d<Kernel>(q, cos_h), g1_i), q.g1), q.four_cos_o);
-    // glm's mix(x, 1, w) is x (1 - w) + 1 w, and 1 w is w, bit for bit.
-    const V one_minus_w = v_sub(one, w);
-    r = v_add(r, v_mul(v_add(v_mul(q.spec0_r, one_minus_w), w), specular));
-    g = v_add(g, v_mul(v_add(v_mul(q.spec0_g, one_minus_w), w), specular));
-    b = v_add(b, v_mul(v_add(v_mul(q.spec0_b, one_minus_w), w), specular));
-    if (Kernel::kEnableSheen) {
-        const V weight = v_mul(w, cos_i);
-        r = v_select(q.sheen_lanes, v_add(r, v_mul(q.sheen_r, weight)), r);
-        g = v_select(q.sheen_lanes, v_add(g, v_mul(q.sheen_g, weight)), g);
-        b = v_select(q.sheen_lanes, v_add(b, v_mul(q.sheen_b, weight)), b);
-    }
-    if (Kernel::kEnableClearcoat) {
-        const V c2 = v_mul(cos_h, cos_h);
-        const V gtr1 = v_div(q.coat_a2_minus_1, v_mul(q.coat_pi_log, v_add(v_sub(one, c2), v_mul(q.coat_a2, c2))));
-        const V a2 = v_set1(Kernel::kClearcoatSmithAlpha * Kernel::kClearcoatSmithAlpha);
-        const V coat_g1_i =
-            v_div(v_mul(two, cos_i), v_add(cos_i, v_sqrt(v_add(a2, v_mul(v_mul(v_sub(one, a2), cos_i), cos_i)))));
-        const V coat = v_div(v_mul(v_mul(gtr1, coat_g1_i), q.coat_g1), q.four_cos_o);
-        const V fresnel = v_add(v_mul(v_set1(0.04f), one_minus_w), w);
-        const V lobe = v_mul(v_mul(q.coat_weight, fresnel), coat);
-        r = v_select(q.coat_lanes, v_add(r, lobe), r);
-        g = v_select(q.coat_lanes, v_add(g, lobe), g);
-        b = v_select(q.coat_lanes, v_add(b, lobe), b);
-    }
+    add_disney_lobes<Kernel>(
+        q, w, specular, cos_i,
+        [&] {
+            // lc_smith_g1(cos_i, kClearcoatSmithAlpha).
+            const V a2 = v_set1(Kernel::kClearcoatSmithAlpha * Kernel::kClearcoatSmithAlpha);
+            const V g1_coat_i = v_div(v_mul(two, cos_i),
+                                      v_add(cos_i, v_sqrt(v_add(a2, v_mul(v_mul(v_sub(one, a2), cos_i), cos_i)))));
+            return v_div(v_mul(v_mul(gtr1_d(q, cos_h), g1_coat_i), q.coat_g1), q.four_cos_o);
+        },
+        r, g, b);
     const V seen = v_cmpgt(q.cos_o, zero);  // lc_disney_brdf_cos: 0 where !(cos_o > 0)
     r = v_and(r, seen);
     g = v_and(g, seen);
