@@ -126,18 +126,23 @@ LC_ALWAYS_INLINE inline V dot4(V ax, V ay, V az, V vx, V vy, V vz) {
     return v_add(v_add(v_mul(ax, vx), v_mul(ay, vy)), v_mul(az, vz));
 }
 
+// lc_smith_g1(cos_v, alpha) lane by lane, with a2 = alpha * alpha.
+LC_ALWAYS_INLINE inline V smith_g1(V cos_v, V a2) {
+    return v_div(v_mul(v_set1(2.0f), cos_v),
+                 v_add(cos_v, v_sqrt(v_add(a2, v_mul(v_mul(v_sub(v_set1(1.0f), a2), cos_v), cos_v)))));
+}
+
 // The point-only terms of QuadLanes from its positions, frames, view
 // directions and the roughness `alpha`.
 LC_ALWAYS_INLINE inline void set_ggx_terms(QuadLanes& q, V alpha) {
-    const V one = v_set1(1.0f), two = v_set1(2.0f);
+    const V two = v_set1(2.0f);
     q.cos_o = dot4(q.nx, q.ny, q.nz, q.wox, q.woy, q.woz);
     const V two_cos_o = v_mul(two, q.cos_o);
     q.wr_x = v_sub(v_mul(two_cos_o, q.nx), q.wox);
     q.wr_y = v_sub(v_mul(two_cos_o, q.ny), q.woy);
     q.wr_z = v_sub(v_mul(two_cos_o, q.nz), q.woz);
     q.a2 = v_mul(alpha, alpha);
-    q.g1 = v_div(v_mul(two, q.cos_o),
-                 v_add(q.cos_o, v_sqrt(v_add(q.a2, v_mul(v_mul(v_sub(one, q.a2), q.cos_o), q.cos_o)))));
+    q.g1 = smith_g1(q.cos_o, q.a2);
     q.four_cos_o = v_mul(v_set1(4.0f), q.cos_o);
 }
 
@@ -292,7 +297,7 @@ LC_ALWAYS_INLINE inline void disney_bounds(const QuadLanes& q, const BoxCones& c
 // 0 where cos_o <= 0, anything in lanes without the BRDF.
 template <class Kernel>
 LC_ALWAYS_INLINE inline void disney_values(const QuadLanes& q, V wi_x, V wi_y, V wi_z, V cos_i, V& r, V& g, V& b) {
-    const V zero = v_zero(), one = v_set1(1.0f), two = v_set1(2.0f), half = v_set1(0.5f);
+    const V zero = v_zero(), one = v_set1(1.0f), half = v_set1(0.5f);
     // The half vector, glm's normalize: v * (1 / sqrt(dot(v, v))).
     const V s_x = v_add(wi_x, q.wox), s_y = v_add(wi_y, q.woy), s_z = v_add(wi_z, q.woz);
     const V inverse = v_div(one, v_sqrt(dot4(s_x, s_y, s_z, s_x, s_y, s_z)));
@@ -309,16 +314,12 @@ LC_ALWAYS_INLINE inline void disney_values(const QuadLanes& q, V wi_x, V wi_y, V
     g = v_mul(q.kd_g, diffuse);
     b = v_mul(q.kd_b, diffuse);
     // The specular lobe (lc_microfacet_cos; lc_smith_g1 at cos_i).
-    const V g1_i =
-        v_div(v_mul(two, cos_i), v_add(cos_i, v_sqrt(v_add(q.a2, v_mul(v_mul(v_sub(one, q.a2), cos_i), cos_i)))));
-    const V specular = v_div(v_mul(v_mul(ggx_d<Kernel>(q, cos_h), g1_i), q.g1), q.four_cos_o);
+    const V specular = v_div(v_mul(v_mul(ggx_d<Kernel>(q, cos_h), smith_g1(cos_i, q.a2)), q.g1), q.four_cos_o);
     add_disney_lobes<Kernel>(
         q, w, specular, cos_i,
         [&] {
-            // lc_smith_g1(cos_i, kClearcoatSmithAlpha).
-            const V a2 = v_set1(Kernel::kClearcoatSmithAlpha * Kernel::kClearcoatSmithAlpha);
-            const V g1_coat_i = v_div(v_mul(two, cos_i),
-                                      v_add(cos_i, v_sqrt(v_add(a2, v_mul(v_mul(v_sub(one, a2), cos_i), cos_i)))));
+            const V g1_coat_i =
+                smith_g1(cos_i, v_set1(Kernel::kClearcoatSmithAlpha * Kernel::kClearcoatSmithAlpha));
             return v_div(v_mul(v_mul(gtr1_d(q, cos_h), g1_coat_i), q.coat_g1), q.four_cos_o);
         },
         r, g, b);
