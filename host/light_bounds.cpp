@@ -75,7 +75,6 @@ EmissionCone EmissionCone::of_light(const gpu::Light& light) {
     return cone;
 }
 
-float EmissionCone::cos_beta() const { return std::cos(std::min(theta_o, kPi)); }
 
 EmissionCone cone_union(const EmissionCone& a, const EmissionCone& b) {
     EmissionCone u = EmissionCone::everywhere();
@@ -106,15 +105,12 @@ EmissionCone cone_union(const EmissionCone& a, const EmissionCone& b) {
     return u;
 }
 
-float union_cos_beta(const EmissionCone& a, float cos_beta_a, const EmissionCone& b, float cos_beta_b) {
-    if (a.emits_everywhere() || b.emits_everywhere()) return EmissionCone::everywhere().cos_beta();
-    const float theta_d = angle_between(a.axis, b.axis);
-    if (std::min(theta_d + b.theta_o, kPi) <= a.theta_o) return cos_beta_a;
-    if (std::min(theta_d + a.theta_o, kPi) <= b.theta_o) return cos_beta_b;
-    const float theta_o = 0.5f * (a.theta_o + theta_d + b.theta_o);
-    const glm::vec3 w = glm::cross(a.axis, b.axis);
-    if (theta_o >= kPi || glm::dot(w, w) == 0.0f) return EmissionCone::everywhere().cos_beta();
-    return std::cos(theta_o);
+ConeSpread ConeSpread::of(const EmissionCone& cone) {
+    if (cone.emits_everywhere()) return ConeSpread{-2.0f, 0.0f, -1.0f};
+    const float half = 0.5f * cone.theta_o;
+    const float sin_half = std::sin(half);
+    // 1 - 2 sin^2: accurate for the narrow cones, where 1 - cos beta is small.
+    return ConeSpread{std::cos(half), sin_half, 1.0f - 2.0f * sin_half * sin_half};
 }
 
 EmissionCone quantized(const EmissionCone& cone, std::uint32_t& packed) {

@@ -83,36 +83,6 @@ struct Build {
     const ClusterCone& cone(std::uint32_t id) const { return cones.empty() ? everywhere : cones[id]; }
 };
 
-// What merge_cost reads of a cluster. The fast builder gathers these in
-// Morton order every round, so a window of partners is contiguous memory,
-// not clusters scattered over Build::all (gathering cut the build of 10^6 lights
-// from 3.45 s to 2.79 s).
-struct CostKey {
-    glm::vec3 lo, hi;
-    double weight;
-    EmissionCone cone;
-    float cos_beta;  // cone.cos_beta()
-};
-
-CostKey cost_key(const Build& b, std::uint32_t id) {
-    const Cluster& c = b.all[id];
-    const EmissionCone& cone = b.cone(id).cone;
-    return CostKey{c.lo, c.hi, c.weight, cone, cone.cos_beta()};
-}
-
-// Walter 2005 §4.1: I_C * (alpha_C^2 + c^2 (1 - cos beta_C)^2) for the
-// cluster x and y would make.
-double merge_cost(const Build& b, const CostKey& x, const CostKey& y) {
-    glm::dvec3 d = glm::dvec3(glm::max(x.hi, y.hi)) - glm::dvec3(glm::min(x.lo, y.lo));
-    double size = glm::dot(d, d);
-    if (b.cone_weight > 0.0) {
-        const double spread = 1.0 - double(union_cos_beta(x.cone, x.cos_beta, y.cone, y.cos_beta));
-        size += b.cone_weight * spread * spread;
-    }
-    return (x.weight + y.weight) * size;
-}
-
-
 // Merges clusters a and b (build ids) into the cluster of build id `id`.
 // The representative is one of the children's, chosen with probability
 // proportional to their intensities from a hash of (seed, new id), so the
@@ -266,7 +236,126 @@ void radix_sort(std::vector<std::pair<std::uint64_t, std::uint32_t>>& keyed, int
     if (from != keyed.data()) std::copy(from, from + n, keyed.data());
 }
 
-// The cheapest partner of keys[i] within kWindow positions each side.
+// What the metric reads of the clusters, one array per value: the boxes
+// and weights and, for trees with a cone term, the cones' axes and
+// spreads (ConeSpread). The fast builder keeps the clusters of a round in
+// Morton order here, so that best_partners reads the partners of a block
+// of clusters as contiguous floats, in vector instructions.
+struct MetricKeys {
+    std::vector<float> lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, weight;
+    std::vector<float> axis_x, axis_y, axis_z, cos_half, sin_half, cos_beta;  // with cones only
+    bool cones = false;
+    float cone_weight = 0.0f;  // Build::cone_weight
+
+    explicit MetricKeys(const Build& b) : cones(b.cone_weight > 0.0), cone_weight(float(b.cone_weight)) {}
+    std::size_t size() const { return weight.size(); }
+    void resize(std::size_t n) {
+        auto fit = [n](std::vector<float>& v) {
+            if (v.capacity() < n) reserve_huge(v, n);
+            v.resize(n);
+        };
+        for (auto* v : {&lo_x, &lo_y, &lo_z, &hi_x, &hi_y, &hi_z, &weight}) fit(*v);
+        if (cones)
+            for (auto* v : {&axis_x, &axis_y, &axis_z, &cos_half, &sin_half, &cos_beta}) fit(*v);
+    }
+    // Slot i takes build id `id`.
+    void set(std::size_t i, const Build& b, std::uint32_t id) {
+        const Cluster& c = b.all[id];
+        lo_x[i] = c.lo.x; lo_y[i] = c.lo.y; lo_z[i] = c.lo.z;
+        hi_x[i] = c.hi.x; hi_y[i] = c.hi.y; hi_z[i] = c.hi.z;
+        weight[i] = float(c.weight);
+        if (!cones) return;
+        const EmissionCone& cone = b.cone(id).cone;
+        const ConeSpread spread = ConeSpread::of(cone);
+        axis_x[i] = cone.axis.x; axis_y[i] = cone.axis.y; axis_z[i] = cone.axis.z;
+        cos_half[i] = spread.cos_half; sin_half[i] = spread.sin_half; cos_beta[i] = spread.cos_beta;
+    }
+    void copy(std::size_t i, const MetricKeys& from, std::size_t j) {
+        lo_x[i] = from.lo_x[j]; lo_y[i] = from.lo_y[j]; lo_z[i] = from.lo_z[j];
+        hi_x[i] = from.hi_x[j]; hi_y[i] = from.hi_y[j]; hi_z[i] = from.hi_z[j];
+        weight[i] = from.weight[j];
+        if (!cones) return;
+        axis_x[i] = from.axis_x[j]; axis_y[i] = from.axis_y[j]; axis_z[i] = from.axis_z[j];
+        cos_half[i] = from.cos_half[j]; sin_half[i] = from.sin_half[j]; cos_beta[i] = from.cos_beta[j];
+    }
+};
+
+// Walter 2005 §4.1, I_C * (alpha_C^2 + c^2 (1 - cos beta_C)^2) for the
+// cluster two clusters would make, in float, for the clusters [i, i +
+// count) and each one's d-th successor: out[t] for cluster i + t. With
+// the cone term where Cones (union_cos_beta). (The restrict-qualified
+// copies of the arrays let the compiler vectorize.)
+template <bool Cones>
+void successor_costs(const MetricKeys& k, std::size_t i, std::size_t count, std::size_t d, float* __restrict out) {
+    const float* __restrict lx = k.lo_x.data() + i;
+    const float* __restrict ly = k.lo_y.data() + i;
+    const float* __restrict lz = k.lo_z.data() + i;
+    const float* __restrict hx = k.hi_x.data() + i;
+    const float* __restrict hy = k.hi_y.data() + i;
+    const float* __restrict hz = k.hi_z.data() + i;
+    const float* __restrict wt = k.weight.data() + i;
+    if constexpr (!Cones) {
+        for (std::size_t t = 0; t < count; ++t) {
+            const float dx = std::max(hx[t], hx[t + d]) - std::min(lx[t], lx[t + d]);
+            const float dy = std::max(hy[t], hy[t + d]) - std::min(ly[t], ly[t + d]);
+            const float dz = std::max(hz[t], hz[t + d]) - std::min(lz[t], lz[t + d]);
+            out[t] = (wt[t] + wt[t + d]) * (dx * dx + dy * dy + dz * dz);
+        }
+    } else {
+        const float* __restrict ax = k.axis_x.data() + i;
+        const float* __restrict ay = k.axis_y.data() + i;
+        const float* __restrict az = k.axis_z.data() + i;
+        const float* __restrict ch = k.cos_half.data() + i;
+        const float* __restrict sh = k.sin_half.data() + i;
+        const float* __restrict cb = k.cos_beta.data() + i;
+        const float cone_weight = k.cone_weight;
+        std::size_t t = 0;
+#if defined(__SSE2__)
+        // Four pairs at a time: the scalar loop's floats (union_cos_beta4).
+        const __m128 weight4 = _mm_set1_ps(cone_weight), one = _mm_set1_ps(1.0f);
+        const auto extent = [](const float* lo, const float* hi, std::size_t t, std::size_t d) {
+            return _mm_sub_ps(_mm_max_ps(_mm_loadu_ps(hi + t), _mm_loadu_ps(hi + t + d)),
+                              _mm_min_ps(_mm_loadu_ps(lo + t), _mm_loadu_ps(lo + t + d)));
+        };
+        const auto lanes = [&](std::size_t at) {
+            return ConeLanes{_mm_loadu_ps(ax + at), _mm_loadu_ps(ay + at), _mm_loadu_ps(az + at),
+                             _mm_loadu_ps(ch + at), _mm_loadu_ps(sh + at), _mm_loadu_ps(cb + at)};
+        };
+        for (; t + 4 <= count; t += 4) {
+            const __m128 dx = extent(lx, hx, t, d), dy = extent(ly, hy, t, d), dz = extent(lz, hz, t, d);
+            const __m128 size = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+            const __m128 spread = _mm_sub_ps(one, union_cos_beta4(lanes(t), lanes(t + d)));
+            const __m128 weights = _mm_add_ps(_mm_loadu_ps(wt + t), _mm_loadu_ps(wt + t + d));
+            _mm_storeu_ps(out + t, _mm_mul_ps(weights, _mm_add_ps(size, _mm_mul_ps(weight4, _mm_mul_ps(spread, spread)))));
+        }
+#endif
+        for (; t < count; ++t) {
+            const float dx = std::max(hx[t], hx[t + d]) - std::min(lx[t], lx[t + d]);
+            const float dy = std::max(hy[t], hy[t + d]) - std::min(ly[t], ly[t + d]);
+            const float dz = std::max(hz[t], hz[t + d]) - std::min(lz[t], lz[t + d]);
+            const float cos_beta =
+                union_cos_beta(glm::vec3(ax[t], ay[t], az[t]), ConeSpread{ch[t], sh[t], cb[t]},
+                               glm::vec3(ax[t + d], ay[t + d], az[t + d]), ConeSpread{ch[t + d], sh[t + d], cb[t + d]});
+            const float spread = 1.0f - cos_beta;
+            out[t] = (wt[t] + wt[t + d]) * ((dx * dx + dy * dy + dz * dz) + cone_weight * (spread * spread));
+        }
+    }
+}
+
+// The metric of slots i and j of `k`.
+float pair_cost(const MetricKeys& k, std::size_t i, std::size_t j) {
+    float cost;
+    const std::size_t first = std::min(i, j), d = std::max(i, j) - first;
+    if (k.cones)
+        successor_costs<true>(k, first, 1, d, &cost);
+    else
+        successor_costs<false>(k, first, 1, d, &cost);
+    return cost;
+}
+
+// The cheapest partner of cluster i within kWindow positions each side,
+// for a cluster within kWindow of either end of the keys, and for interior
+// clusters whose window holds no finite cost.
 //
 // Ties go to the nearer index; between i - d and i + d to the right when
 // i / d is even, else the left. Any choice at equal distance keeps the
@@ -276,86 +365,14 @@ void radix_sort(std::vector<std::pair<std::uint64_t, std::uint32_t>>& keyed, int
 // every cost is equal, which they are for coincident lights (cost 0):
 // O(n^2) rounds' work and a tree as deep as n (8000 coincident lights took
 // 5 s).
-std::size_t best_partner(const Build& b, const std::vector<CostKey>& keys, std::size_t i) {
-    const std::size_t n = keys.size();
-    const std::size_t jb = i >= std::size_t(kWindow) ? i - kWindow : 0;
-    const std::size_t je = std::min(n, i + kWindow + 1);
-    double best_cost = std::numeric_limits<double>::infinity();
-    std::size_t best_j = i == 0 ? 1 : i - 1;
-    for (std::size_t j = jb; j < je; ++j) {
-        if (j == i) continue;
-        const double cost = merge_cost(b, keys[i], keys[j]);
-        if (cost > best_cost) continue;
-        if (cost == best_cost) {
-            // The tie rule, off the common path: its division cost as much
-            // as the metric.
-            const std::size_t dist = j > i ? j - i : i - j;
-            const std::size_t best_dist = best_j > i ? best_j - i : i - best_j;
-            if (dist > best_dist) continue;
-            if (dist == best_dist && (j > i) != ((i / dist) % 2 == 0)) continue;
-        } else if (!(cost < best_cost)) {
-            continue;  // NaN: never chosen, as before
-        }
-        best_cost = cost;
-        best_j = j;
-    }
-    return best_j;
-}
-
-// The boxes and weights of the clusters of a round in Morton order, one
-// array per coordinate, for trees without a cone term: the metric then
-// needs nothing else, and best_partners_points reads the partners of a
-// block of clusters as contiguous floats, in vector instructions.
-struct PointKeys {
-    std::vector<float> lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, weight;
-    void resize(std::size_t n) {
-        for (auto* v : {&lo_x, &lo_y, &lo_z, &hi_x, &hi_y, &hi_z, &weight}) {
-            if (v->capacity() < n) reserve_huge(*v, n);
-            v->resize(n);
-        }
-    }
-    void set(std::size_t i, const Cluster& c) {
-        lo_x[i] = c.lo.x; lo_y[i] = c.lo.y; lo_z[i] = c.lo.z;
-        hi_x[i] = c.hi.x; hi_y[i] = c.hi.y; hi_z[i] = c.hi.z;
-        weight[i] = float(c.weight);
-    }
-    void copy(std::size_t i, const PointKeys& from, std::size_t j) {
-        lo_x[i] = from.lo_x[j]; lo_y[i] = from.lo_y[j]; lo_z[i] = from.lo_z[j];
-        hi_x[i] = from.hi_x[j]; hi_y[i] = from.hi_y[j]; hi_z[i] = from.hi_z[j];
-        weight[i] = from.weight[j];
-    }
-};
-
-// Walter 2005 §4.1 without the cone term, in float, for the clusters
-// [i, i + count) and each one's d-th successor: out[t] for cluster i + t.
-// (The restrict-qualified copies of the arrays let the compiler vectorize.)
-void successor_costs(const PointKeys& k, std::size_t i, std::size_t count, std::size_t d, float* __restrict out) {
-    const float* __restrict lx = k.lo_x.data() + i;
-    const float* __restrict ly = k.lo_y.data() + i;
-    const float* __restrict lz = k.lo_z.data() + i;
-    const float* __restrict hx = k.hi_x.data() + i;
-    const float* __restrict hy = k.hi_y.data() + i;
-    const float* __restrict hz = k.hi_z.data() + i;
-    const float* __restrict wt = k.weight.data() + i;
-    for (std::size_t t = 0; t < count; ++t) {
-        const float dx = std::max(hx[t], hx[t + d]) - std::min(lx[t], lx[t + d]);
-        const float dy = std::max(hy[t], hy[t + d]) - std::min(ly[t], ly[t + d]);
-        const float dz = std::max(hz[t], hz[t + d]) - std::min(lz[t], lz[t + d]);
-        out[t] = (wt[t] + wt[t + d]) * (dx * dx + dy * dy + dz * dz);
-    }
-}
-
-// best_partner for a cluster within kWindow of either end of the keys,
-// over PointKeys, with the costs in float; also for interior clusters
-// whose window holds no finite cost.
-std::size_t best_partner_points_edge(const PointKeys& k, std::size_t i) {
-    const std::size_t n = k.weight.size();
+std::size_t best_partner_edge(const MetricKeys& k, std::size_t i) {
+    const std::size_t n = k.size();
     constexpr float inf = std::numeric_limits<float>::infinity();
     float cost[2 * kWindow + 1];
     const std::size_t jb = i >= std::size_t(kWindow) ? i - kWindow : 0;
     const std::size_t je = std::min(n, i + kWindow + 1);
     for (std::size_t j = jb; j < je; ++j)
-        if (j != i) successor_costs(k, std::min(i, j), 1, j > i ? j - i : i - j, cost + (j - jb));
+        if (j != i) cost[j - jb] = pair_cost(k, i, j);
     cost[i - jb] = inf;
     float smallest = inf;
     for (std::size_t t = 0; t < je - jb; ++t) smallest = cost[t] < smallest ? cost[t] : smallest;
@@ -376,25 +393,26 @@ std::size_t best_partner_points_edge(const PointKeys& k, std::size_t i) {
     return best_j;
 }
 
-// best_partner for trees without a cone term, over PointKeys, for the
-// clusters [begin, end): the same choices, tie rule included, with the
-// costs in float. The metric is symmetric to the last bit for finite
+// The cheapest partner of each of the clusters [begin, end) within
+// kWindow positions each side: best_partner_edge's choices, tie rule
+// included. The metric is symmetric to the last bit for finite
 // coordinates (max, min and the weights' sum do not depend on the order of
 // their operands, except for the sign of a zero difference, which squaring
-// drops; the loader refuses NaN positions), so each pair's cost is
-// computed once. The work runs over blocks of clusters, and each
+// drops; the loader refuses NaN positions; union_cos_beta is symmetric
+// too), so each pair's cost is computed once. The work runs over blocks of clusters, and each
 // step over a block's clusters at once, in vector instructions: row d of
 // `ahead` holds the costs of the clusters from r0 on to their d-th
 // successors; a cluster's smallest cost is the smallest of its row entries
 // and of its predecessors' entries that name it; then bit d - 1 of its
 // masks says which of the partners at distance d have that cost.
-void best_partners_points(const PointKeys& k, std::uint32_t* best, std::size_t begin, std::size_t end) {
+template <bool Cones>
+void best_partners(const MetricKeys& k, std::uint32_t* best, std::size_t begin, std::size_t end) {
     constexpr float inf = std::numeric_limits<float>::infinity();
     constexpr std::size_t w = kWindow;
     constexpr std::size_t kBlock = 256;         // a block's rows stay in the L1 cache
     constexpr std::size_t kRow = kBlock + w;    // clusters b0 - w .. b1 - 1
     static_assert(kWindow <= 32, "a 32-bit mask per side");
-    const std::size_t n = k.weight.size();
+    const std::size_t n = k.size();
     alignas(64) static thread_local float ahead[w][kRow];
     alignas(64) float smallest[kBlock];
     alignas(64) std::uint32_t left_mask[kBlock], right_mask[kBlock];
@@ -404,7 +422,7 @@ void best_partners_points(const PointKeys& k, std::uint32_t* best, std::size_t b
         const std::size_t i0 = std::max(b0, w), i1 = std::max(i0, std::min(b1, n - std::min(n, w)));
         if (i0 < i1) {
             const std::size_t r0 = i0 - w;  // cluster of each row's first entry
-            for (std::size_t d = 1; d <= w; ++d) successor_costs(k, r0, i1 - r0, d, ahead[d - 1]);
+            for (std::size_t d = 1; d <= w; ++d) successor_costs<Cones>(k, r0, i1 - r0, d, ahead[d - 1]);
             const std::size_t m = i1 - i0;
             for (std::size_t t = 0; t < m; ++t) smallest[t] = inf;
             // NaN never wins a comparison, so it is never the smallest.
@@ -427,12 +445,12 @@ void best_partners_points(const PointKeys& k, std::uint32_t* best, std::size_t b
                 }
             }
             // The nearest partner of that cost; both sides at the same
-            // distance: the tie rule of best_partner.
+            // distance: the tie rule of best_partner_edge.
             for (std::size_t t = 0; t < m; ++t) {
                 const std::size_t i = i0 + t;
                 const std::uint32_t either = left_mask[t] | right_mask[t];
                 if (!(smallest[t] < inf)) {  // no finite cost: the general rule
-                    best[i] = static_cast<std::uint32_t>(best_partner_points_edge(k, i));
+                    best[i] = static_cast<std::uint32_t>(best_partner_edge(k, i));
                     continue;
                 }
                 const std::size_t d = std::size_t(__builtin_ctz(either)) + 1;
@@ -443,44 +461,32 @@ void best_partners_points(const PointKeys& k, std::uint32_t* best, std::size_t b
             }
         }
         for (std::size_t i = b0; i < std::min(b1, i0); ++i)
-            best[i] = static_cast<std::uint32_t>(best_partner_points_edge(k, i));
+            best[i] = static_cast<std::uint32_t>(best_partner_edge(k, i));
         for (std::size_t i = std::max(b0, i1); i < b1; ++i)
-            best[i] = static_cast<std::uint32_t>(best_partner_points_edge(k, i));
+            best[i] = static_cast<std::uint32_t>(best_partner_edge(k, i));
     }
 }
 
 // Locally-ordered clustering of leaves given in Morton order (leaf_key);
 // returns the root's build id.
 std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
-    const bool points = !(build.cone_weight > 0.0);
     std::vector<std::uint32_t> best(active.size());
-    std::vector<CostKey> keys;
-    PointKeys point_keys, next_point_keys;
-    if (points) {
-        point_keys.resize(active.size());
-        parallel_for(active.size(), [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end; ++i) point_keys.set(i, build.all[active[i]]);
-        });
-    }
+    MetricKeys keys(build), next_keys(build);
+    keys.resize(active.size());
+    parallel_for(active.size(), [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) keys.set(i, build, active[i]);
+    });
     std::vector<std::uint32_t> next;
     std::vector<std::size_t> kept_before, merged_before;  // per thread: prefix counts
     while (active.size() > 1) {
         const std::size_t n = active.size();
         best.resize(n);
-        if (points) {
-            parallel_for(n, [&](std::size_t begin, std::size_t end) {
-                best_partners_points(point_keys, best.data(), begin, end);
-            });
-        } else {
-            keys.resize(n);
-            parallel_for(n, [&](std::size_t begin, std::size_t end) {
-                for (std::size_t i = begin; i < end; ++i) keys[i] = cost_key(build, active[i]);
-            });
-            parallel_for(n, [&](std::size_t begin, std::size_t end) {
-                for (std::size_t i = begin; i < end; ++i)
-                    best[i] = static_cast<std::uint32_t>(best_partner(build, keys, i));
-            });
-        }
+        parallel_for(n, [&](std::size_t begin, std::size_t end) {
+            if (keys.cones)
+                best_partners<true>(keys, best.data(), begin, end);
+            else
+                best_partners<false>(keys, best.data(), begin, end);
+        });
         // Mutual best pairs merge (in place of their first member, so the
         // Morton order holds); the others wait for the next round. Each
         // thread counts its range's survivors and merges first, so that the
@@ -509,7 +515,7 @@ std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
         build.all.resize(build.all.size() + merged);
         if (!build.cones.empty()) build.cones.resize(build.all.size());
         next.resize(kept_before[threads]);
-        if (points) next_point_keys.resize(next.size());
+        next_keys.resize(next.size());
         parallel_for_ranges(n, [&](std::size_t begin, std::size_t end, unsigned t) {
             std::size_t out = kept_before[t];
             auto id = static_cast<std::uint32_t>(first_id + merged_before[t]);
@@ -524,28 +530,26 @@ std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
                 const std::size_t j = best[i];
                 if (best[j] != i) {
                     next[out] = active[i];
-                    if (points) next_point_keys.copy(out, point_keys, i);
+                    next_keys.copy(out, keys, i);
                     ++out;
                 } else if (i < j) {
                     merge_into(build, active[i], active[j], id);
                     next[out] = id;
-                    if (points) next_point_keys.set(out, build.all[id]);
+                    next_keys.set(out, build, id);
                     ++out;
                     ++id;
                 }
             }
         });
-        if (points) std::swap(point_keys, next_point_keys);
+        std::swap(keys, next_keys);
         if (merged == 0) {
             // Cannot happen with the tie-breaking above (the cheapest pair in
             // any window is mutual); merge neighbours rather than loop forever.
             merge(build, active[0], active[1]);
             next.erase(next.begin(), next.begin() + 2);
             next.insert(next.begin(), static_cast<std::uint32_t>(build.all.size() - 1));
-            if (points) {
-                point_keys.resize(next.size());
-                for (std::size_t i = 0; i < next.size(); ++i) point_keys.set(i, build.all[next[i]]);
-            }
+            keys.resize(next.size());
+            for (std::size_t i = 0; i < next.size(); ++i) keys.set(i, build, next[i]);
         }
         active.swap(next);
     }
@@ -554,14 +558,18 @@ std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
 
 std::uint32_t cluster_exact(Build& build, std::vector<std::uint32_t> active) {
     UninitializedVector<Cluster>& all = build.all;
-    const double inf = std::numeric_limits<double>::infinity();
+    const float inf = std::numeric_limits<float>::infinity();
+    // The metric's keys by build id: the leaves', then each merge's.
+    MetricKeys keys(build);
+    keys.resize(2 * active.size());
+    for (const std::uint32_t id : active) keys.set(id, build, id);
     std::vector<std::uint32_t> best(active.size());
-    std::vector<double> best_cost(active.size(), inf);
+    std::vector<float> best_cost(active.size(), inf);
     auto rescan = [&](std::size_t i) {
         best_cost[i] = inf;
         for (std::size_t j = 0; j < active.size(); ++j) {
             if (j == i) continue;
-            double c = merge_cost(build, cost_key(build, active[i]), cost_key(build, active[j]));
+            const float c = pair_cost(keys, active[i], active[j]);
             if (c < best_cost[i]) {
                 best_cost[i] = c;
                 best[i] = static_cast<std::uint32_t>(j);
@@ -574,6 +582,7 @@ std::uint32_t cluster_exact(Build& build, std::vector<std::uint32_t> active) {
         std::size_t b = best[a];
         if (b < a) std::swap(a, b);
         merge(build, active[a], active[b]);
+        keys.set(all.size() - 1, build, static_cast<std::uint32_t>(all.size() - 1));
         // Slot a takes the merged cluster; slot b takes the last one.
         active[a] = static_cast<std::uint32_t>(all.size() - 1);
         std::size_t last = active.size() - 1;
@@ -592,7 +601,7 @@ std::uint32_t cluster_exact(Build& build, std::vector<std::uint32_t> active) {
             if (best[i] == a || best[i] == b) {
                 rescan(i);
             } else {
-                double c = merge_cost(build, cost_key(build, active[i]), cost_key(build, active[a]));
+                const float c = pair_cost(keys, active[i], active[a]);
                 if (c < best_cost[i]) {
                     best_cost[i] = c;
                     best[i] = static_cast<std::uint32_t>(a);

@@ -2,7 +2,7 @@
 // which device renders and what is reported are the library's decisions.
 //   lightcuts render SCENE -o OUT.exr [options]   render to EXR (+ PNG preview)
 //   lightcuts compare IMAGE REFERENCE [--heatmap]  error metrics between two EXRs
-//   lightcuts info SCENE                           what a scene holds
+//   lightcuts info SCENE [--area-samples N]        what a scene holds
 // SCENE is a scene JSON or a glTF 2.0 file (.gltf, .glb).
 #include <charconv>
 #include <chrono>
@@ -176,9 +176,10 @@ int run_compare(const std::string& image, const std::string& reference, const st
     return 0;
 }
 
-int run_info(const std::string& file, const lc::SceneOptions& options) {
+int run_info(const std::string& file, const lc::SceneOptions& options, std::optional<std::uint32_t> area_samples) {
     lc::Scene scene = lc::load_scene(file, options);
     print_load_notes(file, scene);
+    if (area_samples) scene.render.area_light_samples = *area_samples;
     std::printf("%s\n", file.c_str());
     std::printf("  triangles          %zu (%zu degenerate dropped)\n", scene.triangles.size(),
                 scene.degenerate_triangles_dropped);
@@ -292,6 +293,9 @@ int main(int argc, char** argv) {
     auto* info = app.add_subcommand("info", "Print what a scene holds and the memory it needs");
     info->add_option("scene", info_scene, "Scene file (JSON, or glTF 2.0: .gltf or .glb)")->required();
     info->add_option("--camera", info_options.camera, "glTF scenes: the perspective camera of this name");
+    std::optional<std::uint32_t> info_area_samples;
+    info->add_option("--area-samples", info_area_samples, "Point lights the emissive surfaces become, as render's")
+        ->transform(setting(lc::kSettingAreaLightSamples));
 
     CLI11_PARSE(app, argc, argv);
     // Ctrl-C or a kill during a render leaves no temporary beside its outputs.
@@ -299,7 +303,7 @@ int main(int argc, char** argv) {
     try {
         if (*render) return run_render(r);
         if (*compare) return run_compare(cmp_image, cmp_ref, cmp_heatmap, cmp_json);
-        if (*info) return run_info(info_scene, info_options);
+        if (*info) return run_info(info_scene, info_options, info_area_samples);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "error: %s\n", e.what());
         return 1;

@@ -37,6 +37,10 @@ awk '/^relative RMSE/ { exit !($3 > 0 && $3 < 0.1) }' "$tmp/cmp.txt" ||
   fail "brute force against lightcuts: $(grep 'relative RMSE' "$tmp/cmp.txt")"
 
 "$exe" info "$root/scenes/room/room.json" | grep "point lights       1000" >/dev/null || fail "info"
+# info sizes the buffers for the area-light samples asked for, as render would make them.
+"$exe" info "$root/scenes/panels/panels.json" --area-samples 5000 | grep "area-light samples 5000$" >/dev/null ||
+  fail "info --area-samples"
+"$exe" info "$root/scenes/panels/panels.json" --area-samples 0 2>/dev/null && fail "info --area-samples 0 accepted"
 
 # Bad input: message names the file and the field, exit is non-zero, no output.
 expect_error() {  # expected-substring, then the command's arguments

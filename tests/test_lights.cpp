@@ -1,6 +1,7 @@
 // Spot and oriented lights: their emission against closed forms, and the
 // emission cones of the light tree against every light they bound.
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <random>
 
@@ -239,6 +240,63 @@ TEST(EmissionBound, ConeUnionAndPackingHoldTheirInputs) {
     }
 }
 
+// The tree metric's spread of a union, found without angles, is that of
+// cone_union's cone (up to the few ulps by which cone_union widens it
+// after turning the axis), also where one cone holds the other, where the
+// axes are equal or opposite, and where either cone emits everywhere; and
+// it is the same to the last bit with the cones swapped, as the builder
+// computes each pair's cost once for both.
+TEST(EmissionBound, UnionCosBetaIsConeUnions) {
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    int contained = 0, general = 0, everywhere = 0;
+    for (int trial = 0; trial < 200000; ++trial) {
+        EmissionCone a = EmissionCone::everywhere(), b = EmissionCone::everywhere();
+        const float kind = u(rng);
+        a.axis = random_unit(rng);
+        b.axis = kind < 0.1f ? a.axis : kind < 0.15f ? -a.axis : random_unit(rng);
+        if (u(rng) > 0.05f) a.theta_o = u(rng) < 0.3f ? 0.0f : kPi * u(rng) * u(rng);
+        if (u(rng) > 0.05f) b.theta_o = u(rng) < 0.3f ? 0.0f : kPi * u(rng) * u(rng);
+        const EmissionCone c = cone_union(a, b);
+        const float expected = c.emits_everywhere() ? -1.0f : std::cos(c.theta_o);
+        const ConeSpread sa = ConeSpread::of(a), sb = ConeSpread::of(b);
+        const float found = union_cos_beta(a.axis, sa, b.axis, sb);
+        ASSERT_NEAR(found, expected, 2e-5f) << "trial " << trial << " theta " << a.theta_o << " " << b.theta_o
+                                            << " between " << std::acos(glm::dot(a.axis, b.axis));
+        const float swapped = union_cos_beta(b.axis, sb, a.axis, sa);
+        ASSERT_EQ(std::memcmp(&found, &swapped, sizeof found), 0) << "trial " << trial;
+#if defined(__SSE2__)
+        // The four-lane version, this pair in lane trial % 4 (the others
+        // hold the pair swapped): the same floats.
+        float lanes[4][12];
+        for (int l = 0; l < 4; ++l) {
+            const bool mine = l == trial % 4;
+            const EmissionCone& x = mine ? a : b;
+            const EmissionCone& y = mine ? b : a;
+            const ConeSpread sx = mine ? sa : sb, sy = mine ? sb : sa;
+            const float values[12] = {x.axis.x, x.axis.y, x.axis.z, sx.cos_half, sx.sin_half, sx.cos_beta,
+                                      y.axis.x, y.axis.y, y.axis.z, sy.cos_half, sy.sin_half, sy.cos_beta};
+            for (int v = 0; v < 12; ++v) lanes[l][v] = values[v];
+        }
+        const auto column = [&](int v) {
+            return _mm_setr_ps(lanes[0][v], lanes[1][v], lanes[2][v], lanes[3][v]);
+        };
+        const ConeLanes la{column(0), column(1), column(2), column(3), column(4), column(5)};
+        const ConeLanes lb{column(6), column(7), column(8), column(9), column(10), column(11)};
+        float four[4];
+        _mm_storeu_ps(four, union_cos_beta4(la, lb));
+        for (int l = 0; l < 4; ++l)
+            ASSERT_EQ(std::memcmp(&four[l], &found, sizeof found), 0) << "trial " << trial << " lane " << l;
+#endif
+        everywhere += c.emits_everywhere();
+        contained += !c.emits_everywhere() && (c.theta_o == a.theta_o || c.theta_o == b.theta_o);
+        general += !c.emits_everywhere() && c.theta_o != a.theta_o && c.theta_o != b.theta_o;
+    }
+    // Every case is drawn often.
+    EXPECT_GT(everywhere, 10000);
+    EXPECT_GT(contained, 10000);
+    EXPECT_GT(general, 10000);
+}
 
 // Radiance of an upward Lambert plane point p (albedo 0.5) from a set of
 // lights, unshadowed.
