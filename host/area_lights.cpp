@@ -1,11 +1,14 @@
 // Area-light sampling (host/area_lights.h).
 #include "area_lights.h"
 
+#include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include <glm/glm.hpp>
 
 #include "cpu_kernel.h"
+#include "scene/huge_pages.h"
 #include "shared/color.h"
 
 namespace lc {
@@ -36,10 +39,9 @@ float radical_inverse(std::uint32_t k) {
     return float(bits) * 2.3283064e-10f;
 }
 
-// m stratified samples on one triangle, appended to `out`.
+// m stratified samples on one triangle, written to out[0, samples).
 void sample_triangle(const TriangleEmission& source, std::size_t index, const gpu::Triangle& t,
-                     const gpu::Material& m, std::uint32_t samples, std::uint32_t hash,
-                     std::vector<gpu::Light>& out) {
+                     const gpu::Material& m, std::uint32_t samples, std::uint32_t hash, gpu::Light* out) {
     const glm::vec3 a = vertex(t, 0), b = vertex(t, 1), c = vertex(t, 2);
     const glm::vec3 cross = glm::cross(b - a, c - a);
     const float area = 0.5f * glm::length(cross);
@@ -58,7 +60,7 @@ void sample_triangle(const TriangleEmission& source, std::size_t index, const gp
         l.r = intensity.x; l.g = intensity.y; l.b = intensity.z;
         l.axis_x = normal.x; l.axis_y = normal.y; l.axis_z = normal.z;
         l.type = gpu::kLightOriented | ((m.flags & gpu::kMaterialEmitsBothSides) ? gpu::kLightTwoSided : 0u);
-        out.push_back(l);
+        out[k] = l;
     }
 }
 
@@ -111,13 +113,14 @@ double TriangleEmission::power(std::size_t i) const {
     return 3.14159265358979323846 * area * sides * double(gpu::lc_luminance(mean(i)));
 }
 
-std::vector<gpu::Light> sample_area_lights(const Scene& scene, std::uint32_t count, std::uint32_t seed) {
+UninitializedVector<gpu::Light> sample_area_lights(const Scene& scene, std::uint32_t count, std::uint32_t seed) {
     return sample_area_lights(TriangleEmission(scene), scene.triangles, scene.materials, count, seed);
 }
 
-std::vector<gpu::Light> sample_area_lights(const TriangleEmission& emission, std::span<const gpu::Triangle> triangles,
-                                           std::span<const gpu::Material> materials, std::uint32_t count,
-                                           std::uint32_t seed) {
+UninitializedVector<gpu::Light> sample_area_lights(const TriangleEmission& emission,
+                                                   std::span<const gpu::Triangle> triangles,
+                                                   std::span<const gpu::Material> materials, std::uint32_t count,
+                                                   std::uint32_t seed, unsigned threads) {
     // Power of each emitting triangle, in double: many small triangles add up.
     std::vector<double> power(triangles.size(), 0.0);
     double total = 0.0;
@@ -125,15 +128,20 @@ std::vector<gpu::Light> sample_area_lights(const TriangleEmission& emission, std
         power[i] = emission.power(i);
         total += power[i];
     }
-    std::vector<gpu::Light> lights;
+    UninitializedVector<gpu::Light> lights;
     if (!(total > 0.0) || count == 0) return lights;
-    lights.reserve(count);
     // Systematic sampling: sample k stands at (k + offset) / count of the
     // cumulative power; a triangle gets the samples that fall on its share.
     const double offset = gpu::lc_unit_float(gpu::lc_hash(seed ^ 0x9E3779B9u));
     std::size_t last_emitter = 0;
     for (std::size_t i = 0; i < triangles.size(); ++i)
         if (power[i] > 0.0) last_emitter = i;
+    struct Share {
+        std::size_t triangle, first;  // its samples are lights [first, first + samples)
+        std::uint32_t samples;
+    };
+    std::vector<Share> shares;
+    std::size_t placed = 0;
     double before = 0.0;
     for (std::size_t i = 0; i < triangles.size(); ++i) {
         if (power[i] <= 0.0) continue;
@@ -144,9 +152,31 @@ std::vector<gpu::Light> sample_area_lights(const TriangleEmission& emission, std
         before = after;
         const auto samples = std::uint32_t(std::max(0.0, last - first));
         if (samples == 0) continue;
-        sample_triangle(emission, i, triangles[i], materials[triangles[i].material], samples,
-                        gpu::lc_hash(seed ^ gpu::lc_hash(std::uint32_t(i))), lights);
+        shares.push_back({i, placed, samples});
+        placed += samples;
     }
+    // The triangles' samples on every core, each thread the shares that
+    // start in its range of the samples; each sample depends on its
+    // triangle alone, so the lights are the same whatever the threads. The
+    // array is not zeroed first: the threads that write it fault its pages
+    // in (10^7 samples are 480 MB).
+    reserve_huge(lights, placed);
+    lights.resize(placed);
+    if (threads == 0) threads = placed < 65536 ? 1u : std::max(1u, std::min(16u, std::thread::hardware_concurrency()));
+    auto run = [&](unsigned t) {
+        const std::size_t begin = placed * t / threads, end = placed * (t + 1) / threads;
+        auto starts_before = [](const Share& share, std::size_t at) { return share.first < at; };
+        auto it = std::lower_bound(shares.begin(), shares.end(), begin, starts_before);
+        for (; it != shares.end() && it->first < end; ++it) {
+            const gpu::Triangle& tri = triangles[it->triangle];
+            sample_triangle(emission, it->triangle, tri, materials[tri.material], it->samples,
+                            gpu::lc_hash(seed ^ gpu::lc_hash(std::uint32_t(it->triangle))), lights.data() + it->first);
+        }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(run, t);
+    run(0);
+    for (std::thread& th : pool) th.join();
     return lights;
 }
 

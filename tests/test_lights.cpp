@@ -339,7 +339,8 @@ TEST(AreaLight, SquareEmitterMatchesTheClosedForm) {
         return gpu::Triangle{p.x, p.y, p.z, q.x, q.y, q.z, r.x, r.y, r.z, 0u, 0u, 0u};
     };
     const std::vector<gpu::Triangle> triangles = {tri(a, b, c), tri(a, c, d)};
-    const std::vector<gpu::Light> lights = sample_area_lights(TriangleEmission(triangles, materials), triangles, materials, 65536, 1);
+    const auto sampled = sample_area_lights(TriangleEmission(triangles, materials), triangles, materials, 65536, 1);
+    const std::vector<gpu::Light> lights(sampled.begin(), sampled.end());
     ASSERT_EQ(lights.size(), 65536u);
     ASSERT_LT(lights[0].axis_y, -0.99f);
     const std::vector<glm::dvec3> square = {glm::dvec3(a), glm::dvec3(b), glm::dvec3(c), glm::dvec3(d)};
@@ -352,6 +353,30 @@ TEST(AreaLight, SquareEmitterMatchesTheClosedForm) {
     }
     // Above the emitter (behind it): nothing.
     EXPECT_EQ(plane_radiance(lights, {0, 2, 0}, {0, -1, 0}).x, 0.0);
+}
+
+// Each triangle's samples depend on it alone, so the threads that make
+// them do not change them: the same bytes from one thread as from three
+// (whose ranges of samples start and end inside triangles' shares) and as
+// from the default.
+TEST(AreaLight, SameSamplesWhateverTheThreadCount) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-5.0f, 5.0f);
+    std::vector<gpu::Material> materials = {test::lambert(glm::vec3(0.0f))};
+    materials[0].emission_r = 1.0f, materials[0].emission_g = 2.0f, materials[0].emission_b = 3.0f;
+    materials[0].flags |= gpu::kMaterialEmissive;
+    std::vector<gpu::Triangle> triangles;
+    for (int i = 0; i < 200; ++i)
+        triangles.push_back(gpu::Triangle{u(rng), u(rng), u(rng), u(rng), u(rng), u(rng), u(rng), u(rng), u(rng),
+                                          0u, 0u, 0u});
+    const TriangleEmission emission(triangles, materials);
+    const auto one = sample_area_lights(emission, triangles, materials, 100003, 7, 1);
+    ASSERT_EQ(one.size(), 100003u);
+    for (const unsigned threads : {3u, 0u}) {
+        const auto many = sample_area_lights(emission, triangles, materials, 100003, 7, threads);
+        ASSERT_EQ(many.size(), one.size());
+        EXPECT_EQ(std::memcmp(many.data(), one.data(), one.size() * sizeof(gpu::Light)), 0) << threads << " threads";
+    }
 }
 
 // A constant environment of radiance L over an upward Lambert plane of

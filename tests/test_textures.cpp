@@ -368,7 +368,7 @@ TEST(TexturedAreaLights, SamplesFollowTheEmissiveTexture) {
     EXPECT_EQ(emission.mean(1).x, 0.0f);
     EXPECT_GT(emission.power(0), 0.0);
     EXPECT_EQ(emission.power(1), 0.0);
-    const std::vector<gpu::Light> lights = sample_area_lights(t.scene, 1000, 7);
+    const auto lights = sample_area_lights(t.scene, 1000, 7);
     ASSERT_EQ(lights.size(), 1000u);
     double total = 0.0;
     for (const gpu::Light& l : lights) {
