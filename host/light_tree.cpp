@@ -284,7 +284,8 @@ struct MetricKeys {
 // cluster two clusters would make, in float, for the clusters [i, i +
 // count) and each one's d-th successor: out[t] for cluster i + t. With
 // the cone term where Cones (union_cos_beta). (The restrict-qualified
-// copies of the arrays let the compiler vectorize.)
+// copies of the arrays let the compiler vectorize; the box term written
+// out in each loop, as a lambda over them it did not.)
 template <bool Cones>
 void successor_costs(const MetricKeys& k, std::size_t i, std::size_t count, std::size_t d, float* __restrict out) {
     const float* __restrict lx = k.lo_x.data() + i;
