@@ -75,7 +75,6 @@ EmissionCone EmissionCone::of_light(const gpu::Light& light) {
     return cone;
 }
 
-
 EmissionCone cone_union(const EmissionCone& a, const EmissionCone& b) {
     EmissionCone u = EmissionCone::everywhere();
     u.theta_e = std::max(a.theta_e, b.theta_e);

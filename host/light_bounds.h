@@ -8,7 +8,6 @@
 // light tree's nodes; read by the kernels' lc_emission_bound.
 #pragma once
 
-#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
