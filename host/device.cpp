@@ -31,11 +31,14 @@ RenderResult render(const PreparedScene& prepared, const RenderOptions& options,
     // (lavapipe on the same cores is several times slower).
     if (options.method == "path") return render_cpu(prepared, options);
     if (choice.vulkan.gpu.empty()) {
-        const VulkanDevices found = choice.devices.valid() ? choice.devices.get() : find_vulkan_devices();
+        const GpuProbe probe = choice.devices.valid() ? choice.devices.get() : probe_gpus();
+        const VulkanDevices& found = probe.devices;
         if (!found.hardware) {
-            say(choice, found.names.empty() ? "no Vulkan device; rendering on the CPU"
-                                            : "only a software Vulkan device is present; rendering on the CPU "
-                                              "(device \"vulkan\" uses it anyway)");
+            say(choice, probe.skipped ? "no GPU on this machine (no device file in /dev that a GPU's driver uses); "
+                                        "rendering on the CPU"
+                        : found.names.empty() ? "no Vulkan device; rendering on the CPU"
+                                              : "only a software Vulkan device is present; rendering on the CPU "
+                                                "(device \"vulkan\" uses it anyway)");
             return render_cpu(prepared, options);
         }
     }

@@ -99,12 +99,13 @@ void print_load_notes(const std::string& file, const lc::Scene& scene) {
 
 int run_render(RenderArgs a) {
     // Device "auto" renders through Vulkan only on a GPU, and finding out
-    // loads every installed Vulkan driver (0.08 s where Mesa's are
-    // installed): that is done while the scene loads. Unless the command
-    // line already rules Vulkan out (the scene's render block may still do
-    // so; the answer then goes unread).
+    // loads every installed Vulkan driver (0.1 s where Mesa's are
+    // installed) unless the machine has no GPU device file (probe_gpus):
+    // that is done while the scene loads. Unless the command line already
+    // rules Vulkan out (the scene's render block may still do so; the
+    // answer then goes unread).
     if (a.device.device == "auto" && a.device.vulkan.gpu.empty() && a.method != "path")
-        a.device.devices = std::async(std::launch::async, lc::find_vulkan_devices).share();
+        a.device.devices = std::async(std::launch::async, lc::probe_gpus).share();
     const auto start = std::chrono::steady_clock::now();
     lc::Scene scene = lc::load_scene(a.scene, a.scene_options);
     const double load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cctype>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <stdexcept>
 
 #include "vk_check.h"
@@ -364,6 +366,32 @@ VulkanDevices find_vulkan_devices() {
         if (d.refusal.empty() && d.properties.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) found.hardware = true;
     }
     return found;
+}
+
+std::vector<std::string> gpu_device_files(const std::string& dev) {
+    std::vector<std::string> found;
+    std::error_code error;
+    auto add_matching = [&](const std::filesystem::path& folder, std::initializer_list<const char*> prefixes) {
+        for (std::filesystem::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
+            const std::string name = it->path().filename().string();
+            for (const char* prefix : prefixes)
+                if (name.rfind(prefix, 0) == 0)
+                    found.push_back(std::filesystem::relative(it->path(), dev, error).string());
+        }
+        error.clear();
+    };
+    add_matching(dev, {"nvidia", "dxg", "kgsl", "mali"});
+    add_matching(std::filesystem::path(dev) / "dri", {"renderD"});
+    std::sort(found.begin(), found.end());
+    return found;
+}
+
+GpuProbe probe_gpus() {
+#ifdef __linux__
+    const bool drivers_named = std::getenv("VK_DRIVER_FILES") != nullptr || std::getenv("VK_ICD_FILENAMES") != nullptr;
+    if (!drivers_named && gpu_device_files().empty()) return GpuProbe{VulkanDevices{}, true};
+#endif
+    return GpuProbe{find_vulkan_devices(), false};
 }
 
 std::vector<std::string> list_vulkan_devices() { return find_vulkan_devices().names; }

@@ -162,6 +162,25 @@ struct VulkanDevices {
 };
 VulkanDevices find_vulkan_devices();
 
+// The device files through which a GPU's Vulkan driver reaches its
+// hardware on Linux, found under `dev` (normally /dev): DRM render nodes
+// (dri/renderD*: AMD, Intel, Broadcom, virtio-gpu, ...), NVIDIA's
+// (nvidia0, ...), WSL's dxg, Qualcomm's kgsl* and Arm's mali*. Names
+// relative to `dev`, sorted; none on a machine without a GPU (or a
+// container not given one).
+std::vector<std::string> gpu_device_files(const std::string& dev = "/dev");
+
+// What device "auto" needs to know: find_vulkan_devices(), or, on Linux
+// where no gpu_device_files exist and the Vulkan loader is not pointed at
+// particular drivers (VK_DRIVER_FILES, VK_ICD_FILENAMES), no hardware
+// without loading any driver (`skipped` says so): no driver could reach a
+// GPU there, and loading Mesa's took 0.1 s of a 0.37 s render.
+struct GpuProbe {
+    VulkanDevices devices;
+    bool skipped = false;
+};
+GpuProbe probe_gpus();
+
 // find_vulkan_devices().names.
 std::vector<std::string> list_vulkan_devices();
 
@@ -173,10 +192,10 @@ struct DeviceChoice {
     // Receives the one line that says why "auto" renders on the CPU (no
     // hardware GPU, no Vulkan at all); unset: nothing is said.
     std::function<void(const std::string&)> note;
-    // "auto": find_vulkan_devices()'s answer where the caller asked for it
-    // early, e.g. while the scene loads (the CLI does); not valid(): it is
-    // asked when needed.
-    std::shared_future<VulkanDevices> devices;
+    // "auto": probe_gpus()'s answer where the caller asked for it early,
+    // e.g. while the scene loads (the CLI does); not valid(): it is asked
+    // when needed.
+    std::shared_future<GpuProbe> devices;
 };
 
 // What is wrong with a device name, or "" for "auto", "cpu" and "vulkan".

@@ -5,9 +5,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <future>
 #include <random>
 #include <string>
+
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -75,25 +78,49 @@ TEST_F(Vulkan, NoMatchingDeviceListsTheDevicesAndWhy) {
     EXPECT_THROW(render_vulkan(p, options("brute", 8, 8), v), std::runtime_error);
 }
 
-// Device "auto" decides from an answer of find_vulkan_devices given early
-// (the CLI asks while the scene loads) instead of asking again: told of no
-// device, or of a software one only, it renders on the CPU and says which,
-// whatever this machine has.
+// Device "auto" decides from an answer of probe_gpus given early (the CLI
+// asks while the scene loads) instead of asking again: told of no device,
+// of a software one only, or of no GPU device file (no driver loaded), it
+// renders on the CPU and says which, whatever this machine has.
 TEST(DeviceChoiceAuto, DecidesFromTheDevicesFoundEarly) {
     PreparedScene p = prepare_scene(random_scene(6, 4, 0, 8, 8), 1);
     const RenderOptions o = options("lightcuts", 8, 8);
-    for (const VulkanDevices& told : {VulkanDevices{}, VulkanDevices{{"a software rasterizer"}, false}}) {
-        std::promise<VulkanDevices> answer;
+    const std::pair<GpuProbe, std::string> cases[] = {
+        {GpuProbe{VulkanDevices{}, false}, "no Vulkan device; rendering on the CPU"},
+        {GpuProbe{VulkanDevices{{"a software rasterizer"}, false}, false},
+         "only a software Vulkan device is present; rendering on the CPU (device \"vulkan\" uses it anyway)"},
+        {GpuProbe{VulkanDevices{}, true},
+         "no GPU on this machine (no device file in /dev that a GPU's driver uses); rendering on the CPU"},
+    };
+    for (const auto& [told, expected] : cases) {
+        std::promise<GpuProbe> answer;
         answer.set_value(told);
         DeviceChoice choice;
         choice.devices = answer.get_future().share();
         std::string said;
         choice.note = [&](const std::string& line) { said = line; };
         EXPECT_EQ(render(p, o, choice).stats.device, "cpu");
-        EXPECT_EQ(said, told.names.empty() ? "no Vulkan device; rendering on the CPU"
-                                           : "only a software Vulkan device is present; rendering on the CPU "
-                                             "(device \"vulkan\" uses it anyway)");
+        EXPECT_EQ(said, expected);
     }
+}
+
+// The device files a GPU's driver would use, found under a /dev of our
+// making: render nodes under dri/ (not card nodes), NVIDIA's, WSL's, and
+// none of the rest.
+TEST(DeviceChoiceAuto, FindsTheDeviceFilesOfGpus) {
+    const std::filesystem::path dev = std::filesystem::temp_directory_path() /
+                                      ("lc_dev_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dev);
+    std::filesystem::create_directories(dev / "dri");
+    auto touch = [&](const std::string& name) { std::ofstream(dev / name).put('x'); };
+    EXPECT_TRUE(gpu_device_files(dev.string()).empty());
+    for (const char* name : {"null", "tty0", "dri/card0", "nvme0"}) touch(name);
+    EXPECT_TRUE(gpu_device_files(dev.string()).empty());
+    for (const char* name : {"dri/renderD128", "nvidia0", "nvidiactl", "dxg"}) touch(name);
+    EXPECT_EQ(gpu_device_files(dev.string()),
+              (std::vector<std::string>{"dri/renderD128", "dxg", "nvidia0", "nvidiactl"}));
+    EXPECT_TRUE(gpu_device_files((dev / "absent").string()).empty());
+    std::filesystem::remove_all(dev);
 }
 
 // --- Analytic truth (pbrt-v4 style): a point light of intensity pi * h^2 at
