@@ -371,17 +371,18 @@ VulkanDevices find_vulkan_devices() {
 std::vector<std::string> gpu_device_files(const std::string& dev) {
     std::vector<std::string> found;
     std::error_code error;
-    auto add_matching = [&](const std::filesystem::path& folder, std::initializer_list<const char*> prefixes) {
-        for (std::filesystem::directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
+    // The files of dev/`folder` whose names start with one of `prefixes`.
+    auto add_matching = [&](const std::string& folder, std::initializer_list<const char*> prefixes) {
+        for (std::filesystem::directory_iterator it(std::filesystem::path(dev) / folder, error), end;
+             !error && it != end; it.increment(error)) {
             const std::string name = it->path().filename().string();
             for (const char* prefix : prefixes)
-                if (name.rfind(prefix, 0) == 0)
-                    found.push_back(std::filesystem::relative(it->path(), dev, error).string());
+                if (name.rfind(prefix, 0) == 0) found.push_back(folder.empty() ? name : folder + "/" + name);
         }
         error.clear();
     };
-    add_matching(dev, {"nvidia", "dxg", "kgsl", "mali"});
-    add_matching(std::filesystem::path(dev) / "dri", {"renderD"});
+    add_matching("", {"nvidia", "dxg", "kgsl", "mali"});
+    add_matching("dri", {"renderD"});
     std::sort(found.begin(), found.end());
     return found;
 }
