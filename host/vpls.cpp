@@ -142,11 +142,11 @@ private:
 };
 
 // One path's VPLs, intensities not yet divided by the path count.
-void trace_path(const cpu::ShadeKernel& k, const Emitters& emitters, std::uint32_t seed, std::uint64_t index,
+// (`kernel` is the thread's own copy: its functions are non-const members.)
+void trace_path(cpu::ShadeKernel& kernel, const Emitters& emitters, std::uint32_t seed, std::uint64_t index,
                 std::uint32_t max_bounces, std::vector<gpu::Light>& out) {
     PathRandom rng(seed, index);
     glm::vec3 org, dir, flux;
-    cpu::ShadeKernel kernel = k;  // the kernel's functions are non-const members
     if (!emitters.start(kernel, rng, org, dir, flux)) return;
     for (std::uint32_t bounce = 1;; ++bounce) {
         float t, b1, b2;
@@ -212,9 +212,13 @@ VplSet trace_vpls(const Scene& scene, const Bvh& bvh, std::span<const gpu::Light
                 found[t].clear();
                 per_path[t].clear();
                 const std::size_t first = paths + round * t / threads, last = paths + round * (t + 1) / threads;
+                // Room for the VPLs the rate so far expects, and a tenth more.
+                found[t].reserve(std::size_t(double(last - first) * rate * 1.1) + 16);
+                per_path[t].reserve(last - first);
+                cpu::ShadeKernel kernel = k;
                 for (std::size_t p = first; p < last; ++p) {
                     const std::size_t before = found[t].size();
-                    trace_path(k, source, seed, p, settings.max_bounces, found[t]);
+                    trace_path(kernel, source, seed, p, settings.max_bounces, found[t]);
                     per_path[t].push_back(std::uint32_t(found[t].size() - before));
                 }
             });
