@@ -4,6 +4,7 @@
 // Tolerances: vulkan_test_support.h.
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -121,6 +122,28 @@ TEST(DeviceChoiceAuto, FindsTheDeviceFilesOfGpus) {
               (std::vector<std::string>{"dri/renderD128", "dxg", "nvidia0", "nvidiactl"}));
     EXPECT_TRUE(gpu_device_files((dev / "absent").string()).empty());
     std::filesystem::remove_all(dev);
+}
+
+// probe_gpus loads no driver exactly where this machine has no GPU device
+// file and the loader is not pointed at drivers; pointed at some (here the
+// drivers this machine lists, through VK_DRIVER_FILES), it asks the
+// loader, whatever /dev holds.
+TEST(DeviceChoiceAuto, ProbesTheDriversUnlessNoGpuCouldAnswer) {
+    const char* driver_files = std::getenv("VK_DRIVER_FILES");
+    const char* icd_filenames = std::getenv("VK_ICD_FILENAMES");
+    const bool named = driver_files != nullptr || icd_filenames != nullptr;
+    const GpuProbe probe = probe_gpus();
+    EXPECT_EQ(probe.skipped, !named && gpu_device_files().empty());
+    if (probe.skipped) EXPECT_TRUE(probe.devices.names.empty() && !probe.devices.hardware);
+    else EXPECT_EQ(probe.devices.names, list_vulkan_devices());
+    if (named) return;
+    const std::string all_drivers = "/usr/share/vulkan/icd.d";
+    if (!std::filesystem::is_directory(all_drivers)) return;  // no driver installed to point the loader at
+    ::setenv("VK_DRIVER_FILES", all_drivers.c_str(), 1);
+    const GpuProbe pointed = probe_gpus();
+    ::unsetenv("VK_DRIVER_FILES");
+    EXPECT_FALSE(pointed.skipped);
+    EXPECT_EQ(pointed.devices.names, list_vulkan_devices());
 }
 
 // --- Analytic truth (pbrt-v4 style): a point light of intensity pi * h^2 at
