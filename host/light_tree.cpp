@@ -400,12 +400,13 @@ std::size_t best_partner_edge(const MetricKeys& k, std::size_t i) {
 // coordinates (max, min and the weights' sum do not depend on the order of
 // their operands, except for the sign of a zero difference, which squaring
 // drops; the loader refuses NaN positions; union_cos_beta is symmetric
-// too), so each pair's cost is computed once. The work runs over blocks of clusters, and each
-// step over a block's clusters at once, in vector instructions: row d of
-// `ahead` holds the costs of the clusters from r0 on to their d-th
-// successors; a cluster's smallest cost is the smallest of its row entries
-// and of its predecessors' entries that name it; then bit d - 1 of its
-// masks says which of the partners at distance d have that cost.
+// too), so each pair's cost is computed once. The work runs over blocks of
+// clusters, and each step over a block's clusters at once, in vector
+// instructions: row d of `ahead` holds the costs of the clusters from r0
+// on to their d-th successors; a cluster's smallest cost is the smallest
+// of its row entries and of its predecessors' entries that name it; then
+// bit d - 1 of its masks says which of the partners at distance d have
+// that cost.
 template <bool Cones>
 void best_partners(const MetricKeys& k, std::uint32_t* best, std::size_t begin, std::size_t end) {
     constexpr float inf = std::numeric_limits<float>::infinity();
