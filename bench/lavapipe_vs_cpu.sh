@@ -28,26 +28,33 @@ export VK_DRIVER_FILES="${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_6
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 
-echo "| round | scene | binary | CPU s | Vulkan s | kernels s | Vulkan/CPU | kernels/CPU | rays/px CPU, Vulkan |"
-echo "|---|---|---|---|---|---|---|---|---|"
+echo "| round | scene | binary | CPU s | Vulkan s | kernels s | Vulkan/CPU | kernels/CPU | command CPU, Vulkan s | command Vulkan/CPU | rays/px CPU, Vulkan |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for round in $(seq 1 "$rounds"); do
   for scene in scenes/room/room_1e4.json scenes/room/room_1e5.json scenes/gltf/textured.gltf; do
     size=(--width "$side" --height "$side")
     case "$scene" in *.gltf) size=() ;; esac
     for exe in "${binaries[@]}"; do
       for device in cpu vulkan; do
+        begin=$(date +%s.%N)
         "$exe" render "$root/$scene" -o "$tmp/$device.exr" --method lightcuts "${size[@]}" \
           --device "$device" --stats "$tmp/$device.json" --no-png >"$tmp/log" 2>&1 ||
           { cat "$tmp/log" >&2; exit 1; }
+        echo "$begin $(date +%s.%N)" >"$tmp/$device.wall"
       done
-      python3 - "$round" "$scene" "$exe" "$tmp/cpu.json" "$tmp/vulkan.json" <<'PY'
+      python3 - "$round" "$scene" "$exe" "$tmp/cpu.json" "$tmp/vulkan.json" "$tmp/cpu.wall" "$tmp/vulkan.wall" <<'PY'
 import json, sys
-rnd, scene, exe, cpu_path, vk_path = sys.argv[1:]
+rnd, scene, exe, cpu_path, vk_path, cpu_wall, vk_wall = sys.argv[1:]
+def wall(path):
+    begin, end = map(float, open(path).read().split())
+    return end - begin
+wc, wv = wall(cpu_wall), wall(vk_wall)
 cpu, vk = json.load(open(cpu_path)), json.load(open(vk_path))
 tc, tv = cpu["seconds"]["render"], vk["seconds"]["render"]
 tk = vk["seconds"]["primary"] + vk["seconds"]["shading"]
 print(f"| {rnd} | {scene} ({vk['width']}x{vk['height']}) | {exe} | {tc:.3f} | {tv:.3f} | {tk:.3f} | "
-      f"{tv / tc:.2f} | {tk / tc:.2f} | {cpu['shadow_rays_per_pixel']:.1f}, {vk['shadow_rays_per_pixel']:.1f} |")
+      f"{tv / tc:.2f} | {tk / tc:.2f} | {wc:.3f}, {wv:.3f} | {wv / wc:.2f} | "
+      f"{cpu['shadow_rays_per_pixel']:.1f}, {vk['shadow_rays_per_pixel']:.1f} |")
 PY
     done
   done
