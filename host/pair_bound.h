@@ -444,9 +444,12 @@ bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp
         __m128 emission;
         if (type == gpu::kLightSpot) {
             const float width = std::max(1e-3f, light.cos_inner - light.cos_outer);
+            const __m128 one = _mm_set1_ps(1.0f);
             const __m128 s = glsl_min(
-                glsl_max(_mm_div_ps(_mm_sub_ps(cos_axis, _mm_set1_ps(light.cos_outer)), _mm_set1_ps(width)), zero),
-                _mm_set1_ps(1.0f));
+                glsl_max(_mm_div_ps(_mm_sub_ps(glsl_min(cos_axis, one), _mm_set1_ps(light.cos_outer)),
+                                    _mm_set1_ps(width)),
+                         zero),
+                one);
             emission = _mm_mul_ps(s, s);
         } else {
             emission = (light.type & gpu::kLightTwoSided) != 0u ? abs_lanes(cos_axis) : glsl_max(cos_axis, zero);

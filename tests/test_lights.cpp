@@ -189,10 +189,10 @@ TEST(EmissionBound, HoldsJustInsideTheRimOfTheCone) {
         const glm::vec3 x = glm::vec3(glm::dvec3(pos) + dir * distance);
         // The emission towards x as the kernel computes it, and in double.
         const glm::vec3 to_x = x - pos;
-        // Both cosines at most 1: in float the dot product of two unit
-        // vectors can round a few ulps above it (and a spot whose outer
-        // cosine rounds to 1 would then seem to emit on its axis).
-        const float cos_float = std::min(glm::dot(axis, to_x / glm::length(to_x)), 1.0f);
+        // The float cosine as the kernel computes it, which can round a few
+        // ulps above 1 (lc_spot_falloff takes it as 1; the narrow spots'
+        // outer cosines round to 1); the double one at most 1.
+        const float cos_float = glm::dot(axis, to_x / glm::length(to_x));
         const double cos_double =
             std::min(glm::dot(a, glm::normalize(glm::dvec3(x) - glm::dvec3(pos))), 1.0);
         double exact_float, exact_double;
@@ -203,7 +203,7 @@ TEST(EmissionBound, HoldsJustInsideTheRimOfTheCone) {
                                         0.0, 1.0);
             exact_double = s * s;
         } else {
-            exact_float = kind == 3 ? std::abs(cos_float) : std::max(cos_float, 0.0f);
+            exact_float = kind == 3 ? std::abs(std::min(cos_float, 1.0f)) : std::clamp(cos_float, 0.0f, 1.0f);
             exact_double = kind == 3 ? std::abs(cos_double) : std::max(cos_double, 0.0);
         }
         const float bound = k.lc_emission_bound(root, x);

@@ -315,8 +315,13 @@ vec3 lc_brdf_cos(LC_IN(Material) m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
 
 // glTF KHR_lights_punctual's spot falloff: s = clamp((cos - cos_outer) /
 // max(1e-3, cos_inner - cos_outer), 0, 1); the intensity is scaled by s^2.
+// The cosine is taken as at most 1: in float the dot product of two unit
+// vectors can round a few ulps above it, and a spot whose outer cosine
+// rounds to 1 (a cone under about 0.014 degrees) would then emit on its axis
+// where lc_emission_bound, rightly, says it emits nothing.
 float lc_spot_falloff(LC_IN(Light) light, float cos_theta) {
-    float s = clamp((cos_theta - light.cos_outer) / max(1e-3f, light.cos_inner - light.cos_outer), 0.0f, 1.0f);
+    float s = clamp((min(cos_theta, 1.0f) - light.cos_outer) / max(1e-3f, light.cos_inner - light.cos_outer), 0.0f,
+                    1.0f);
     return s * s;
 }
 
