@@ -191,7 +191,10 @@ TEST(EmissionBound, HoldsJustInsideTheRimOfTheCone) {
         const glm::vec3 to_x = x - pos;
         // The float cosine as the kernel computes it, which can round a few
         // ulps above 1 (lc_spot_falloff takes it as 1; the narrow spots'
-        // outer cosines round to 1); the double one at most 1.
+        // outer cosines round to 1); the double one at most 1. A cosine
+        // emitter's emission is compared at most 1: the kernel's can be 1
+        // plus an ulp or two on the axis, where the bound gives 1, a relative
+        // 1e-7 that culls nothing (a spot's 1e-8 against a bound of 0 did).
         const float cos_float = glm::dot(axis, to_x / glm::length(to_x));
         const double cos_double =
             std::min(glm::dot(a, glm::normalize(glm::dvec3(x) - glm::dvec3(pos))), 1.0);
