@@ -141,6 +141,8 @@ LC_CONST uint kCutDone = 1u;       // result added to the pixel; later dispatche
 LC_CONST uint kCutFroze = 2u;      // the cut froze clusters out of a full heap
 LC_CONST uint kCutSelected = 4u;   // stochastic: the cut is final; its clusters are being shaded
 LC_CONST uint kCutFreshKeys = 8u;  // quadcuts.comp: the heap's keys are from the current estimates
+LC_CONST uint kCutHeapMode = 16u;     // quadcuts.comp: the cut's list is a heap, refined largest first
+LC_CONST uint kCutPassUnderWay = 32u; // quadcuts.comp: a pass is under way (its marks in the keys' sign bits)
 // quadcuts.comp keeps a quad's cut in the same record, one per lane: `shaded`
 // holds the bits of the quad's summed root bounds, `draw` those of the
 // lane's weight (host/quad_cut.h, update_weights).

@@ -1,16 +1,17 @@
 // Lightcuts with one cut per 2x2 quad of pixels (cut_sharing "quad"), the
 // cut the CPU's QuadCut (host/quad_cut.h) selects, step for step: a cluster
 // is refined while its error bound exceeds relative_error times the
-// estimate of any of the four points. Each point keeps its own estimate,
-// shadow rays and sums.
+// estimate of any of the four points, in passes while the cut's list has
+// room and largest bound first through a heap once it is full. Each point
+// keeps its own estimate, shadow rays and sums.
 //
 // The four points are the four lanes of a subgroup quad. Each lane keeps
-// the whole heap in its own slots: the nodes and the heap's order `key`
-// (the largest ratio of a cluster's bound to a point's estimate over the
-// quad, exchanged with subgroupQuadSwap*) are the same in all four, the
-// error bound and the representative's visibility the lane's own. So the
-// four make the same heap moves in step, and each traces its own shadow
-// rays. A lane whose pixel sees no surface, or lies past the tile, keeps
+// the whole list (or heap) in its own slots: the nodes, their places, the
+// pass's marks and the `key` (the largest ratio of a cluster's bound to a
+// point's estimate over the quad, exchanged with subgroupQuadSwap*) are the
+// same in all four, the error bound and the representative's visibility
+// the lane's own. So the four make the same moves in step, and each traces
+// its own shadow rays. A lane whose pixel sees no surface, or lies past the tile, keeps
 // the heap with the others, with zero bounds. Quad sums are added (0 + 1) +
 // (2 + 3), as on the CPU, so every lane has the same bits.
 //
@@ -44,9 +45,17 @@ vec3 q_fixed;       // final estimates: leaves and frozen clusters
 vec3 q_heap_sum;    // running sum of the heap's estimates
 float q_weight;     // 1 / estimate (update_weights)
 float q_root_bounds;  // the roots' finite bounds summed over the quad, times 1/4
-bool q_fresh_keys;  // the keys are from the current weights
+bool q_heap_mode;   // the list is a heap (lc_quad_add), refined largest first
+bool q_fresh_keys;  // heap mode: the keys are from the current weights
+bool q_pass;        // list mode: a pass is under way, its marked entries still to refine
 uint q_frozen;      // clusters frozen out of a full heap
 ShadeStats q_stats;
+// QuadCut::refine_all's marks, a bit per place in the list: the entries
+// the pass under way refines. Kept here during a dispatch; at a pause they
+// go into the saved entries' keys, as the sign bit (a key is never
+// negative).
+const uint kMarkWords = (kHeapSlots + 31u) / 32u;
+uint q_marks[kMarkWords];
 
 float lc_quad_sum(float v) {
     v += subgroupQuadSwapHorizontal(v);
@@ -137,6 +146,29 @@ void lc_quad_rekey() {
     for (uint i = q_size / 2u; i > 0u; --i) lc_heap_sift_down(i - 1u, q_size, LC_HEAP_LOAD(i - 1u));
 }
 
+bool lc_quad_marked(uint i) { return (q_marks[i >> 5u] >> (i & 31u) & 1u) != 0u; }
+
+void lc_quad_set_mark(uint i, bool on) {
+    q_marks[i >> 5u] = (q_marks[i >> 5u] & ~(1u << (i & 31u))) | ((on ? 1u : 0u) << (i & 31u));
+}
+
+// QuadCut::add: appended, unmarked, while the list has room; the first
+// entry to find it full turns it into a heap (every key from the current
+// estimates) and is pushed, as is every later one.
+void lc_quad_add(QuadCutEntry e) {
+    if (q_heap_mode) {
+        lc_quad_push(e);
+    } else if (q_size < kHeapSlots) {
+        LC_HEAP_STORE(q_size, e);
+        q_size += 1u;
+    } else {
+        q_heap_mode = true;
+        lc_quad_rekey();
+        e.key = lc_quad_key(e.error);
+        lc_quad_push(e);
+    }
+}
+
 float lc_quad_error(LightNode node) {
     return q_active ? lc_cluster_error(q_sp, q_sp.mat, node, frame.min_distance2) : 0.0f;
 }
@@ -146,7 +178,9 @@ void lc_quad_start() {
     q_fixed = vec3(0.0f);
     q_heap_sum = vec3(0.0f);
     q_root_bounds = 0.0f;
+    q_heap_mode = false;
     q_fresh_keys = false;
+    q_pass = false;
     q_frozen = 0u;
     q_stats.cut_size = 0u;
     q_stats.cut_indirect = frame.roots[kLightVpl] != kInvalidIndex ? 1u : 0u;
@@ -166,18 +200,18 @@ void lc_quad_start() {
         if (lc_quad_enter(index, root, error, unit, visible, e)) {
             lc_quad_update_weights();
             e.key = lc_quad_key(e.error);
-            lc_quad_push(e);
+            lc_quad_add(e);
         }
         q_stats.cut_size += 1u;
     }
     lc_quad_update_weights();
 }
 
-// QuadCut::refine_top: the cluster at the top of the heap is replaced by
-// its children; the child with the parent's representative keeps its
-// visibility, the other's comes from one new shadow ray per lane.
-void lc_quad_refine_top() {
-    QuadCutEntry top = LC_HEAP_LOAD(0u);
+// QuadCut::split: the cluster `top` is replaced by its children, a (the
+// child with the parent's representative, which keeps its visibility) and
+// b (whose contribution comes from one new shadow ray per lane); has_a and
+// has_b say which of them enter the heap's list (lc_quad_enter).
+void lc_quad_split(QuadCutEntry top, out QuadCutEntry a, out QuadCutEntry b, out bool has_a, out bool has_b) {
     LightNode node = LC_LIGHT_NODE(lc_entry_node(top));
     vec3 kept_unit = lc_entry_unit(q_sp, top, node, frame.min_distance2);  // the kept child's too
     q_heap_sum -= kept_unit * lc_node_intensity(node);
@@ -193,11 +227,43 @@ void lc_quad_refine_top() {
     bool fresh_visible = false;
     if (q_active && (fresh_leaf || fresh_error > 0.0f))
         fresh_unit = lc_rep_unit(q_sp, fresh_node.rep_light, frame.min_distance2, fresh_visible, q_stats);
-    QuadCutEntry a, b;
-    bool has_a = lc_quad_enter(kept_index, kept_node, kept_error, kept_unit, lc_entry_visible(top), a);
-    bool has_b = lc_quad_enter(fresh_index, fresh_node, fresh_error, fresh_unit, fresh_visible, b);
+    has_a = lc_quad_enter(kept_index, kept_node, kept_error, kept_unit, lc_entry_visible(top), a);
+    has_b = lc_quad_enter(fresh_index, fresh_node, fresh_error, fresh_unit, fresh_visible, b);
     q_stats.cut_size += 1u;
     if (lc_node_type(node) == kLightVpl) q_stats.cut_indirect += 1u;
+}
+
+// QuadCut::refine_at: the cluster at place `at` of the list is replaced
+// by its children (lc_quad_split); the kept child keeps the place
+// (unmarked), the other is added. Where the kept child leaves the cut, the
+// list's last entry takes its place, mark and all.
+void lc_quad_refine_at(uint at) {
+    QuadCutEntry a, b;
+    bool has_a, has_b;
+    lc_quad_split(LC_HEAP_LOAD(at), a, b, has_a, has_b);
+    if (has_a) {
+        a.key = lc_quad_key(a.error);
+        LC_HEAP_STORE(at, a);
+    } else {
+        q_size -= 1u;
+        if (at != q_size) {
+            LC_HEAP_STORE(at, LC_HEAP_LOAD(q_size));
+            lc_quad_set_mark(at, lc_quad_marked(q_size));
+            lc_quad_set_mark(q_size, false);
+        }
+    }
+    if (has_b) {
+        b.key = lc_quad_key(b.error);
+        lc_quad_add(b);
+    }
+}
+
+// QuadCut::refine_top: the cluster at the top of the heap is replaced by
+// its children (lc_quad_split).
+void lc_quad_refine_top() {
+    QuadCutEntry a, b;
+    bool has_a, has_b;
+    lc_quad_split(LC_HEAP_LOAD(0u), a, b, has_a, has_b);
     lc_quad_update_weights();
     a.key = has_a ? lc_quad_key(a.error) : 0.0f;
     b.key = has_b ? lc_quad_key(b.error) : 0.0f;
@@ -221,9 +287,48 @@ void lc_quad_refine_top() {
 }
 
 // QuadCut::refine_all, one refinement at a time: false once the cut is
-// final (every key at most relative_error, checked with fresh keys) or at
-// max_cut.
+// final or at max_cut. In passes while the list has room (a pass takes the
+// weights once, marks the entries whose key is above relative_error, and
+// refines them lowest place first; final when a pass marks none), then
+// largest first through the heap (final when every key is at most
+// relative_error, checked with fresh keys).
 bool lc_quad_refine() {
+    while (!q_heap_mode) {
+        if (!q_pass) {
+            lc_quad_update_weights();
+            bool any = false;
+            for (uint w = 0u; w < kMarkWords; ++w) q_marks[w] = 0u;
+            for (uint i = 0u; i < q_size; ++i) {
+                QuadCutEntry e = LC_HEAP_LOAD(i);
+                e.key = lc_quad_key(e.error);
+                LC_HEAP_STORE(i, e);
+                bool above = e.key > frame.relative_error;
+                q_marks[i >> 5u] |= (above ? 1u : 0u) << (i & 31u);
+                any = any || above;
+            }
+            if (!any) return false;
+            q_pass = true;
+        }
+        uint at = kInvalidIndex;
+        for (uint w = 0u; w < kMarkWords && at == kInvalidIndex; ++w)
+            if (q_marks[w] != 0u) at = 32u * w + uint(findLSB(q_marks[w]));
+        if (at == kInvalidIndex) {
+            q_pass = false;
+            continue;
+        }
+        lc_quad_set_mark(at, false);
+        if (q_stats.cut_size >= frame.max_cut) {
+            q_stats.hit_max_cut = 1u;
+            return false;
+        }
+        lc_quad_refine_at(at);
+        // QuadCut::refine_heap starts from the current estimates.
+        if (q_heap_mode) {
+            lc_quad_update_weights();
+            q_fresh_keys = false;
+        }
+        return true;
+    }
     while (q_size > 0u) {
         float top_key = lc_quad_key(LC_HEAP_LOAD(0u).error);
         if (!(top_key > frame.relative_error)) {
@@ -284,11 +389,24 @@ void main() {
         q_stats.shadow_rays = s.shadow_rays;
         q_frozen = (s.flags & kCutFroze) != 0u ? 1u : 0u;
         q_fresh_keys = (s.flags & kCutFreshKeys) != 0u;
+        q_heap_mode = (s.flags & kCutHeapMode) != 0u;
+        q_pass = (s.flags & kCutPassUnderWay) != 0u;
         q_fixed = vec3(s.fixed_r, s.fixed_g, s.fixed_b);
         q_heap_sum = vec3(s.heap_r, s.heap_g, s.heap_b);
         q_root_bounds = uintBitsToFloat(s.shaded);
         q_weight = uintBitsToFloat(s.draw);
         lc_heap_restore(q_size);
+        // A pass's marks, from the saved keys' sign bits.
+        for (uint w = 0u; w < kMarkWords; ++w) q_marks[w] = 0u;
+        if (q_pass) {
+            for (uint i = 0u; i < q_size; ++i) {
+                QuadCutEntry e = LC_HEAP_LOAD(i);
+                uint bits = floatBitsToUint(e.key);
+                lc_quad_set_mark(i, (bits & 0x80000000u) != 0u);
+                e.key = uintBitsToFloat(bits & 0x7FFFFFFFu);
+                LC_HEAP_STORE(i, e);
+            }
+        }
     }
 
     bool done = false;
@@ -303,13 +421,22 @@ void main() {
             if ((push.cut_flags & kCutFirstDispatch) != 0u) ps.paused_samples += 1u;
             pixel_stats[i] = ps;
         }
+        if (q_pass) {
+            for (uint i = 0u; i < q_size; ++i)
+                if (lc_quad_marked(i)) {
+                    QuadCutEntry e = LC_HEAP_LOAD(i);
+                    e.key = uintBitsToFloat(floatBitsToUint(e.key) | 0x80000000u);
+                    LC_HEAP_STORE(i, e);
+                }
+        }
         lc_heap_save(q_size);
         CutState s;
         s.heap_size = q_size;
         s.cut_size = q_stats.cut_size;
         s.cut_indirect = q_stats.cut_indirect;
         s.shadow_rays = q_stats.shadow_rays;
-        s.flags = (q_frozen > 0u ? kCutFroze : 0u) | (q_fresh_keys ? kCutFreshKeys : 0u);
+        s.flags = (q_frozen > 0u ? kCutFroze : 0u) | (q_fresh_keys ? kCutFreshKeys : 0u) |
+                  (q_heap_mode ? kCutHeapMode : 0u) | (q_pass ? kCutPassUnderWay : 0u);
         s.fixed_r = q_fixed.x; s.fixed_g = q_fixed.y; s.fixed_b = q_fixed.z;
         s.heap_r = q_heap_sum.x; s.heap_g = q_heap_sum.y; s.heap_b = q_heap_sum.z;
         s.shaded = floatBitsToUint(q_root_bounds);

@@ -98,10 +98,14 @@ struct TransformCase {
 // ScaledTo1em4 brute 1.8e-7, none; lightcuts 2.1e-5, none (when first
 // measured; 1.5e-7 for both on a later host, where no cut differed).
 const TransformCase kTransforms[] = {
-    {"TranslatedBy1e5", 50.0f, 1.0f, {1e5f, 1e5f, -1e5f}, 0.02, 0.1, {0.019, 0.013}, {{5.5e-4, 0.005}, {4e-4, 0.002}}},  // 0.0127, 0.0087
+    // Lightcuts against brute force measured 0.0127, 0.0087 (5 pixels of 576 above 5%) with the quads' cuts
+    // refined largest first throughout; 0.0126, 0.0139 (8 pixels) since they are refined in passes while the
+    // list has room (host/quad_cut.h; on the shipped scenes no larger error and no more pixels above 2%, the
+    // gallery's 54.0% against 55.0% aside: docs/results/speed.md). Limits 1.5 times the measurement.
+    {"TranslatedBy1e5", 50.0f, 1.0f, {1e5f, 1e5f, -1e5f}, 0.02, 0.1, {0.019, 0.021}, {{5.5e-4, 0.005}, {4e-4, 0.002}}},
     // 0.0115, 0.0104 with a heap the tree cannot fill; 0.0115, 0.0208 with the default heap of 64 slots
     {"SmallRoomTranslatedBy1e5", 1.0f, 1.0f, {1e5f, 1e5f, -1e5f}, -1.0, 0.0, {0.018, 0.03}, {{0.02, 0.25}, {0.02, 0.25}}},
-    {"ScaledTo1em4", 1.0f, 1e-4f, {0.0f, 0.0f, 0.0f}, 1e-6, 0.002, {0.019, 0.013}, {{5e-7, 0.002}, {6e-5, 0.002}}},  // 0.0126, 0.0087
+    {"ScaledTo1em4", 1.0f, 1e-4f, {0.0f, 0.0f, 0.0f}, 1e-6, 0.002, {0.019, 0.013}, {{5e-7, 0.002}, {6e-5, 0.002}}},  // 0.0125, 0.0104 (0.0126, 0.0087 largest first)
 };
 
 // gtest prints a parameter next to the test's name (and ctest shows it).
