@@ -58,12 +58,12 @@ struct QuadEntry {
     QuadColor unit;
 };
 
-// The quad's cut heap: `slot` lists the refinable clusters and `key` their
-// keys (the largest ratio of a cluster's bound to a point's estimate),
-// `entries` the clusters the list refers to, which stay where they are
-// while the list moves their 8-byte handles, and `marks` a bit per place:
-// the clusters the current pass refines. The list is a heap (a max-heap on
-// key) once it has been full (QuadCut::add).
+// The quad's cut heap: `slot` lists the refinable clusters, `entries` the
+// clusters the list refers to, which stay where they are while the list
+// moves their 8-byte handles, and `marks` a bit per place: the clusters
+// the current pass refines. Once the list has been full it is a heap, a
+// max-heap on `key` (the largest ratio of a cluster's bound to a point's
+// estimate; QuadCut::add).
 class QuadHeap {
 public:
     explicit QuadHeap(std::size_t slots = 0)
@@ -145,7 +145,7 @@ public:
             root_bounds_ = quad_sum(root_quarters);
             if (enter(root, e)) {
                 update_weights();
-                add(key_of(e), slot);
+                add(slot);
             } else {
                 free_[free_count_++] = slot;
             }
@@ -260,22 +260,22 @@ private:
     }
 
     // Adds the entry in `slot` (its estimates already in heap_sum_) to the
-    // cut's refinable clusters: appended with `key`, unmarked, while the
-    // list has room; the first entry to find it full turns it into a heap
-    // (rekey: every key from the current estimates) and is pushed, and so
-    // is every later one (push: a full heap freezes its smallest entry).
-    void add(float key, uint slot) {
-        if (heap_mode_) {
-            push(key, slot);
-        } else if (size_ < capacity_) {
-            key_[size_] = key;
+    // cut's refinable clusters: appended, unmarked, while the list has room
+    // (a list's keys are not kept: a pass computes them); the first entry
+    // to find it full turns it into a heap (rekey: every key from the
+    // current estimates) and is pushed with its key, as is every later one
+    // (push: a full heap freezes its smallest entry).
+    void add(uint slot) {
+        if (!heap_mode_ && size_ < capacity_) {
             slot_[size_] = slot;
             size_ += 1u;
-        } else {
+            return;
+        }
+        if (!heap_mode_) {
             heap_mode_ = true;
             rekey();
-            push(key_of(entries_[slot]), slot);
         }
+        push(key_of(entries_[slot]), slot);
     }
 
     // Refines in passes while the list has room, then largest first. A pass
@@ -296,8 +296,7 @@ private:
             bool any = false;
             for (uint w = 0; w < words; ++w) marks_[w] = 0u;
             for (uint i = 0; i < size_; ++i) {
-                key_[i] = key_of(entries_[slot_[i]]);
-                const bool above = key_[i] > f_.relative_error;
+                const bool above = key_of(entries_[slot_[i]]) > f_.relative_error;
                 marks_[i >> 5] |= uint(above) << (i & 31u);
                 any |= above;
             }
@@ -501,18 +500,15 @@ private:
     void refine_at(uint at) {
         const uint kept_slot = slot_[at];
         const auto [fresh_slot, has_kept, has_fresh] = split(kept_slot);
-        if (has_kept) {
-            key_[at] = key_of(entries_[kept_slot]);
-        } else {
+        if (!has_kept) {
             size_ -= 1u;
             if (at != size_) {
-                key_[at] = key_[size_];
                 slot_[at] = slot_[size_];
                 set_mark(at, marked(size_));
                 set_mark(size_, false);
             }
         }
-        if (has_fresh) add(key_of(entries_[fresh_slot]), fresh_slot);
+        if (has_fresh) add(fresh_slot);
     }
 
     // Replaces the cluster at the top of the heap by its children (split).

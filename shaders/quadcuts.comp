@@ -152,21 +152,22 @@ void lc_quad_set_mark(uint i, bool on) {
     q_marks[i >> 5u] = (q_marks[i >> 5u] & ~(1u << (i & 31u))) | ((on ? 1u : 0u) << (i & 31u));
 }
 
-// QuadCut::add: appended, unmarked, while the list has room; the first
-// entry to find it full turns it into a heap (every key from the current
-// estimates) and is pushed, as is every later one.
+// QuadCut::add: appended, unmarked, while the list has room (a list's
+// keys are not kept: a pass marks from the errors); the first entry to
+// find it full turns it into a heap (every key from the current estimates)
+// and is pushed with its key, as is every later one.
 void lc_quad_add(QuadCutEntry e) {
-    if (q_heap_mode) {
-        lc_quad_push(e);
-    } else if (q_size < kHeapSlots) {
+    if (!q_heap_mode && q_size < kHeapSlots) {
         LC_HEAP_STORE(q_size, e);
         q_size += 1u;
-    } else {
+        return;
+    }
+    if (!q_heap_mode) {
         q_heap_mode = true;
         lc_quad_rekey();
-        e.key = lc_quad_key(e.error);
-        lc_quad_push(e);
     }
+    e.key = lc_quad_key(e.error);
+    lc_quad_push(e);
 }
 
 float lc_quad_error(LightNode node) {
@@ -199,7 +200,6 @@ void lc_quad_start() {
         QuadCutEntry e;
         if (lc_quad_enter(index, root, error, unit, visible, e)) {
             lc_quad_update_weights();
-            e.key = lc_quad_key(e.error);
             lc_quad_add(e);
         }
         q_stats.cut_size += 1u;
@@ -242,7 +242,6 @@ void lc_quad_refine_at(uint at) {
     bool has_a, has_b;
     lc_quad_split(LC_HEAP_LOAD(at), a, b, has_a, has_b);
     if (has_a) {
-        a.key = lc_quad_key(a.error);
         LC_HEAP_STORE(at, a);
     } else {
         q_size -= 1u;
@@ -252,10 +251,7 @@ void lc_quad_refine_at(uint at) {
             lc_quad_set_mark(q_size, false);
         }
     }
-    if (has_b) {
-        b.key = lc_quad_key(b.error);
-        lc_quad_add(b);
-    }
+    if (has_b) lc_quad_add(b);
 }
 
 // QuadCut::refine_top: the cluster at the top of the heap is replaced by
@@ -296,15 +292,22 @@ bool lc_quad_refine() {
     while (!q_heap_mode) {
         if (!q_pass) {
             lc_quad_update_weights();
+            // An entry's key is above relative_error where its ratio is at
+            // some lane: each lane's tests of 32 entries, one word, ORed
+            // over the quad (two exchanges a word, where the keys took two
+            // an entry).
             bool any = false;
-            for (uint w = 0u; w < kMarkWords; ++w) q_marks[w] = 0u;
-            for (uint i = 0u; i < q_size; ++i) {
-                QuadCutEntry e = LC_HEAP_LOAD(i);
-                e.key = lc_quad_key(e.error);
-                LC_HEAP_STORE(i, e);
-                bool above = e.key > frame.relative_error;
-                q_marks[i >> 5u] |= (above ? 1u : 0u) << (i & 31u);
-                any = any || above;
+            for (uint w = 0u; w < kMarkWords; ++w) {
+                uint bits = 0u;
+                for (uint j = 0u; j < 32u && 32u * w + j < q_size; ++j) {
+                    float error = LC_HEAP_LOAD(32u * w + j).error;
+                    bool above = error > 0.0f && error * q_weight > frame.relative_error;
+                    bits |= (above ? 1u : 0u) << j;
+                }
+                bits |= subgroupQuadSwapHorizontal(bits);
+                bits |= subgroupQuadSwapVertical(bits);
+                q_marks[w] = bits;
+                any = any || bits != 0u;
             }
             if (!any) return false;
             q_pass = true;
