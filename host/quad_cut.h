@@ -286,8 +286,8 @@ private:
     // child finds the list full (add), Walter's order takes over
     // (refine_heap): a full list then spends its slots where the bounds are
     // largest. (Passes alone lost accuracy where the list fills: the stress
-    // tests' million lights, relative RMSE 0.0140 -> 0.0179; a heap alone
-    // spends 12% of the room's render on its sifts and on the estimates
+    // tests' million lights, relative RMSE 0.0140 -> 0.0179; with a heap
+    // alone the room renders 10% slower, for its sifts and the estimates
     // taken again after every refinement: docs/results/speed.md.)
     void refine_all() {
         while (!heap_mode_) {
