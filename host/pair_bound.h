@@ -411,20 +411,169 @@ void quad_pair_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode& 
 #pragma GCC pop_options
 #endif
 
+// Whether this CPU has AVX-512F and AVX-512DQ (quad16). Asked once.
+inline bool cpu_has_avx512dq() {
+    static const bool has = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+    return has;
+}
+
+// Four clusters at once in the sixteen lanes of AVX-512: two refinements'
+// children (QuadCut::refine_all pairs a pass's refinements), cluster k in
+// lanes 4k to 4k+3, the points in every quarter. Each pair's nodes are laid
+// out by quad8::quad_nodes and the halves joined, so every lane holds the
+// floats quad8 would give it; the same operations in the same order after
+// that, so the errors are quad8's and the scalar ones, bit for bit
+// (tests/test_quad_cut.cpp). Only where cpu_has_avx512dq().
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2,avx512f,avx512dq"))), apply_to = function)
+#else
+#pragma GCC push_options
+#pragma GCC target("avx2,avx512f,avx512dq")
+#endif
+namespace quad16 {
+using V = __m512;
+inline V v_set1(float x) { return _mm512_set1_ps(x); }
+inline V v_zero() { return _mm512_setzero_ps(); }
+inline V v_add(V a, V b) { return _mm512_add_ps(a, b); }
+inline V v_sub(V a, V b) { return _mm512_sub_ps(a, b); }
+inline V v_mul(V a, V b) { return _mm512_mul_ps(a, b); }
+inline V v_div(V a, V b) { return _mm512_div_ps(a, b); }
+// sqrt, min and max through their zero-masking forms with every lane on
+// (the same instructions): GCC 12 warns that the plain ones' undefined
+// pass-through operand is used uninitialized (its bug 105593).
+inline V v_sqrt(V a) { return _mm512_maskz_sqrt_ps(__mmask16(0xFFFF), a); }
+inline V v_and(V a, V b) { return _mm512_and_ps(a, b); }
+inline V v_andnot(V a, V b) { return _mm512_andnot_ps(a, b); }
+inline V v_or(V a, V b) { return _mm512_or_ps(a, b); }
+// A compare's lanes as all ones or zeros, as the SSE and AVX compares give
+// them; the predicates are quad8's.
+inline V v_lanes(__mmask16 m) { return _mm512_castsi512_ps(_mm512_movm_epi32(m)); }
+inline V v_cmpgt(V a, V b) { return v_lanes(_mm512_cmp_ps_mask(a, b, _CMP_GT_OS)); }
+inline V v_cmpge(V a, V b) { return v_lanes(_mm512_cmp_ps_mask(a, b, _CMP_GE_OS)); }
+inline V v_cmpnle(V a, V b) { return v_lanes(_mm512_cmp_ps_mask(a, b, _CMP_NLE_US)); }
+inline V v_abs(V a) { return _mm512_andnot_ps(_mm512_set1_ps(-0.0f), a); }
+inline V v_min(V x, V y) { return _mm512_maskz_min_ps(__mmask16(0xFFFF), y, x); }
+inline V v_max(V x, V y) { return _mm512_maskz_max_ps(__mmask16(0xFFFF), y, x); }
+inline int v_movemask(V a) { return int(_mm512_movepi32_mask(_mm512_castps_si512(a))); }
+// The body's quad_nodes is not used here (join below); a and b alternate by quarter.
+inline V v_set2(float a, float b) {
+    return _mm512_setr_ps(a, a, a, a, b, b, b, b, a, a, a, a, b, b, b, b);
+}
+#include "quad_bounds_body.h"
+
+inline V join(__m256 lo, __m256 hi) { return _mm512_insertf32x8(_mm512_castps256_ps512(lo), hi, 1); }
+
+// The quad's lanes in all four quarters.
+inline void widen(const quad8::QuadLanes& q, QuadLanes& w) {
+    const __m256 quad8::QuadLanes::*fields[] = {
+        &quad8::QuadLanes::px,   &quad8::QuadLanes::py,   &quad8::QuadLanes::pz,    &quad8::QuadLanes::nx,
+        &quad8::QuadLanes::ny,   &quad8::QuadLanes::nz,   &quad8::QuadLanes::anx,   &quad8::QuadLanes::any,
+        &quad8::QuadLanes::anz,  &quad8::QuadLanes::tx,   &quad8::QuadLanes::ty,    &quad8::QuadLanes::tz,
+        &quad8::QuadLanes::atx,  &quad8::QuadLanes::aty,  &quad8::QuadLanes::atz,   &quad8::QuadLanes::bx,
+        &quad8::QuadLanes::by,   &quad8::QuadLanes::bz,   &quad8::QuadLanes::abx,   &quad8::QuadLanes::aby,
+        &quad8::QuadLanes::abz,  &quad8::QuadLanes::kd_r, &quad8::QuadLanes::kd_g,  &quad8::QuadLanes::kd_b,
+        &quad8::QuadLanes::ks_r, &quad8::QuadLanes::ks_g, &quad8::QuadLanes::ks_b,  &quad8::QuadLanes::wox,
+        &quad8::QuadLanes::woy,  &quad8::QuadLanes::woz,  &quad8::QuadLanes::cos_o, &quad8::QuadLanes::wr_x,
+        &quad8::QuadLanes::wr_y, &quad8::QuadLanes::wr_z, &quad8::QuadLanes::a2,    &quad8::QuadLanes::g1,
+        &quad8::QuadLanes::four_cos_o, &quad8::QuadLanes::active, &quad8::QuadLanes::specular_lanes,
+        &quad8::QuadLanes::disney_lanes, &quad8::QuadLanes::sheen_lanes, &quad8::QuadLanes::coat_lanes,
+        &quad8::QuadLanes::one_minus_metallic, &quad8::QuadLanes::two_roughness, &quad8::QuadLanes::schlick_o,
+        &quad8::QuadLanes::spec0_r, &quad8::QuadLanes::spec0_g, &quad8::QuadLanes::spec0_b,
+        &quad8::QuadLanes::sheen_r, &quad8::QuadLanes::sheen_g, &quad8::QuadLanes::sheen_b,
+        &quad8::QuadLanes::coat_weight, &quad8::QuadLanes::coat_a2, &quad8::QuadLanes::coat_a2_minus_1,
+        &quad8::QuadLanes::coat_pi_log, &quad8::QuadLanes::coat_g1};
+    V QuadLanes::*wide[] = {
+        &QuadLanes::px,   &QuadLanes::py,   &QuadLanes::pz,    &QuadLanes::nx,   &QuadLanes::ny,
+        &QuadLanes::nz,   &QuadLanes::anx,  &QuadLanes::any,   &QuadLanes::anz,  &QuadLanes::tx,
+        &QuadLanes::ty,   &QuadLanes::tz,   &QuadLanes::atx,   &QuadLanes::aty,  &QuadLanes::atz,
+        &QuadLanes::bx,   &QuadLanes::by,   &QuadLanes::bz,    &QuadLanes::abx,  &QuadLanes::aby,
+        &QuadLanes::abz,  &QuadLanes::kd_r, &QuadLanes::kd_g,  &QuadLanes::kd_b, &QuadLanes::ks_r,
+        &QuadLanes::ks_g, &QuadLanes::ks_b, &QuadLanes::wox,   &QuadLanes::woy,  &QuadLanes::woz,
+        &QuadLanes::cos_o, &QuadLanes::wr_x, &QuadLanes::wr_y, &QuadLanes::wr_z, &QuadLanes::a2,
+        &QuadLanes::g1,   &QuadLanes::four_cos_o, &QuadLanes::active, &QuadLanes::specular_lanes,
+        &QuadLanes::disney_lanes, &QuadLanes::sheen_lanes, &QuadLanes::coat_lanes,
+        &QuadLanes::one_minus_metallic, &QuadLanes::two_roughness, &QuadLanes::schlick_o,
+        &QuadLanes::spec0_r, &QuadLanes::spec0_g, &QuadLanes::spec0_b,
+        &QuadLanes::sheen_r, &QuadLanes::sheen_g, &QuadLanes::sheen_b,
+        &QuadLanes::coat_weight, &QuadLanes::coat_a2, &QuadLanes::coat_a2_minus_1,
+        &QuadLanes::coat_pi_log, &QuadLanes::coat_g1};
+    static_assert(sizeof fields / sizeof fields[0] == sizeof wide / sizeof wide[0]);
+    for (std::size_t i = 0; i < sizeof wide / sizeof wide[0]; ++i) w.*wide[i] = join(q.*fields[i], q.*fields[i]);
+    w.specular = q.specular;
+    w.covered = q.covered;
+    w.disney = q.disney;
+}
+
+// Two pairs' quad8::QuadNodes as one: (a, b) in lanes 0-7, (c, d) in 8-15.
+// A pair without emission cones gets the fields of clusters that emit
+// everywhere (cone zero), where the other has some.
+inline QuadNodes join(const quad8::QuadNodes& x, const quad8::QuadNodes& y) {
+    QuadNodes n;
+    n.min_x = join(x.min_x, y.min_x), n.min_y = join(x.min_y, y.min_y), n.min_z = join(x.min_z, y.min_z);
+    n.max_x = join(x.max_x, y.max_x), n.max_y = join(x.max_y, y.max_y), n.max_z = join(x.max_z, y.max_z);
+    n.radius = join(x.radius, y.radius);
+    n.intensity_r = join(x.intensity_r, y.intensity_r);
+    n.intensity_g = join(x.intensity_g, y.intensity_g);
+    n.intensity_b = join(x.intensity_b, y.intensity_b);
+    n.clamp = join(x.clamp, y.clamp);
+    n.any_cone = x.any_cone || y.any_cone;
+    if (!n.any_cone) return n;
+    const __m256 none = _mm256_setzero_ps();
+    const auto cones = [&](const quad8::QuadNodes& h, __m256 quad8::QuadNodes::*f) {
+        return h.any_cone ? h.*f : none;
+    };
+    __m256 quad8::QuadNodes::*fields[] = {&quad8::QuadNodes::cone,    &quad8::QuadNodes::axis_x,
+                                          &quad8::QuadNodes::axis_y,  &quad8::QuadNodes::axis_z,
+                                          &quad8::QuadNodes::cos_o,   &quad8::QuadNodes::sin_o,
+                                          &quad8::QuadNodes::cos_e,   &quad8::QuadNodes::edge,
+                                          &quad8::QuadNodes::falloff_width, &quad8::QuadNodes::two_sided,
+                                          &quad8::QuadNodes::cosine,  &quad8::QuadNodes::spot};
+    V QuadNodes::*wide[] = {&QuadNodes::cone,  &QuadNodes::axis_x, &QuadNodes::axis_y,        &QuadNodes::axis_z,
+                            &QuadNodes::cos_o, &QuadNodes::sin_o,  &QuadNodes::cos_e,         &QuadNodes::edge,
+                            &QuadNodes::falloff_width,             &QuadNodes::two_sided,     &QuadNodes::cosine,
+                            &QuadNodes::spot};
+    static_assert(sizeof fields / sizeof fields[0] == sizeof wide / sizeof wide[0]);
+    for (std::size_t i = 0; i < sizeof wide / sizeof wide[0]; ++i)
+        n.*wide[i] = join(cones(x, fields[i]), cones(y, fields[i]));
+    return n;
+}
+
+// lc_cluster_error of nodes[k] into errors[k][p] at the quad's points (zero
+// in inactive lanes). For clusters that quad_errors covers (the caller
+// checks).
+template <class Kernel>
+void quad_four_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode* const nodes[4], float min_distance2,
+                      float errors[4][4]) {
+    const bool ggx = q.specular != 0u || q.disney != 0u;
+    V e;
+    cluster_errors<Kernel>(q, join(quad8::quad_nodes(kernel, *nodes[0], *nodes[1], min_distance2, ggx),
+                                   quad8::quad_nodes(kernel, *nodes[2], *nodes[3], min_distance2, ggx)),
+                           e);
+    alignas(64) float out[16];
+    _mm512_store_ps(out, e);
+    for (unsigned k = 0; k < 4u; ++k)
+        for (unsigned p = 0; p < 4u; ++p) errors[k][p] = out[4u * k + p];
+}
+}  // namespace quad16
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
+#pragma GCC pop_options
+#endif
+
 // lc_light_unit of one point, spot, oriented light or VPL `light` at the
 // quad's four points, lane by lane, into unit[p] (zero in inactive lanes),
 // and for each point where the unit is not zero the shadow ray's direction
 // wi[p] and length t_max[p]: the scalar function's values bit for bit
 // (tests/test_quad_cut.cpp). False where this does not cover the case: a
 // directional light, or the points' lanes not covered (QuadLanes). The
-// Disney BRDF is evaluated in the lanes too (quad4::disney_values); points
-// with a GGX lobe get their BRDF from the scalar lc_brdf_cos, on the
-// direction and cosine computed here. A change to lc_light_unit,
-// lc_brdf_cos or lc_disney_brdf_cos (shaders/shared/shading.h) must be made
-// here too; the test fails until it is.
-template <class Kernel, class SurfacePoint>
-bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp, const gpu::Light& light,
-                      float min_distance2, glm::vec3 unit[4], glm::vec3 wi[4], float t_max[4]) {
+// BRDF is evaluated in the lanes too, the GGX lobe's and the Disney BRDF's
+// (quad4::disney_values). A change to lc_light_unit, lc_brdf_cos or
+// lc_disney_brdf_cos (shaders/shared/shading.h) must be made here too; the
+// test fails until it is.
+template <class Kernel>
+bool quad_light_units(Kernel& kernel, const QuadLanes& q, const gpu::Light& light, float min_distance2,
+                      glm::vec3 unit[4], glm::vec3 wi[4], float t_max[4]) {
     const std::uint32_t type = light.type & gpu::kLightTypeMask;
     if (!q.covered || type == gpu::kLightDirectional || type > gpu::kLightVpl) return false;
     const __m128 zero = _mm_setzero_ps();
@@ -462,10 +611,27 @@ bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp
     const __m128 lit = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(d, zero), _mm_cmpnle_ps(cos_i, zero)),
                                   _mm_and_ps(_mm_cmpgt_ps(factor, zero), q.active));
     const __m128 c = _mm_div_ps(cos_i, _mm_set1_ps(Kernel::kPi));
+    __m128 r = _mm_mul_ps(q.kd_r, c), g = _mm_mul_ps(q.kd_g, c), b = _mm_mul_ps(q.kd_b, c);
+    if (Kernel::kEnableGgx && q.specular != 0u) {
+        // lc_brdf_cos's GGX lobe where cos_o > 0: h = normalize(wi + wo)
+        // (glm's: v * (1 / sqrt(dot(v, v)))), then D G1(cos_i) G1(cos_o) /
+        // (4 cos_o), the point's terms from QuadLanes (set_ggx_terms).
+        const __m128 hx = _mm_add_ps(wx, q.wox), hy = _mm_add_ps(wy, q.woy), hz = _mm_add_ps(wz, q.woz);
+        const __m128 inverse = _mm_div_ps(_mm_set1_ps(1.0f), _mm_sqrt_ps(dot4(hx, hy, hz, hx, hy, hz)));
+        const __m128 cos_h = glsl_max(
+            dot4(q.nx, q.ny, q.nz, _mm_mul_ps(hx, inverse), _mm_mul_ps(hy, inverse), _mm_mul_ps(hz, inverse)), zero);
+        const __m128 spec = _mm_div_ps(
+            _mm_mul_ps(_mm_mul_ps(quad4::ggx_d<Kernel>(q, cos_h), quad4::smith_g1(cos_i, q.a2)), q.g1),
+            q.four_cos_o);
+        const __m128 lobe = _mm_and_ps(q.specular_lanes, _mm_cmpgt_ps(q.cos_o, zero));
+        r = quad4::v_select(lobe, _mm_add_ps(r, _mm_mul_ps(q.ks_r, spec)), r);
+        g = quad4::v_select(lobe, _mm_add_ps(g, _mm_mul_ps(q.ks_g, spec)), g);
+        b = quad4::v_select(lobe, _mm_add_ps(b, _mm_mul_ps(q.ks_b, spec)), b);
+    }
     alignas(16) float v[12][4];
-    _mm_store_ps(v[0], _mm_mul_ps(_mm_mul_ps(q.kd_r, c), factor));
-    _mm_store_ps(v[1], _mm_mul_ps(_mm_mul_ps(q.kd_g, c), factor));
-    _mm_store_ps(v[2], _mm_mul_ps(_mm_mul_ps(q.kd_b, c), factor));
+    _mm_store_ps(v[0], _mm_mul_ps(r, factor));
+    _mm_store_ps(v[1], _mm_mul_ps(g, factor));
+    _mm_store_ps(v[2], _mm_mul_ps(b, factor));
     if (q.disney != 0u) {
         __m128 r, g, b;
         quad4::disney_values<Kernel>(q, wx, wy, wz, cos_i, r, g, b);
@@ -487,8 +653,6 @@ bool quad_light_units(Kernel& kernel, const QuadLanes& q, const SurfacePoint* sp
         t_max[p] = v[6][p];
         if ((q.disney >> p & 1u) != 0u)
             unit[p] = glm::vec3(v[9][p], v[10][p], v[11][p]);
-        else if ((q.specular >> p & 1u) != 0u)
-            unit[p] = kernel.lc_brdf_cos(sp[p].mat, sp[p].n, wi[p], sp[p].wo, v[7][p]) * v[8][p];
         else
             unit[p] = glm::vec3(v[0][p], v[1][p], v[2][p]);
     }

@@ -107,7 +107,10 @@ public:
         lanes_ = quad_lanes(k_, sp, active);
         wide_ = lanes_.covered && cpu_has_avx2();
         if (wide_) quad8::widen(lanes_, lanes8_);
+        wide16_ = wide_ && cpu_has_avx512dq();
+        if (wide16_) quad16::widen(lanes8_, lanes16_);
 #endif
+        for (ChildErrors& c : ahead_) c.parent = kInvalidIndex;
         stats_ = stats;
         size_ = 0u;
         free_count_ = capacity_ + 1u;
@@ -309,6 +312,9 @@ private:
                         hit_max_cut_ = 1u;
                         return;
                     }
+#if defined(__SSE2__)
+                    if (wide16_) errors_ahead(i, w, words);
+#endif
                     refine_at(i);
                 }
         }
@@ -430,6 +436,62 @@ private:
         errors(b, errors_b);
     }
 
+    // The children's errors of a refinement, found ahead of it (errors_ahead).
+    struct ChildErrors {
+        uint parent;  // the refined node, kInvalidIndex where none
+        float kept[kQuadLanes], fresh[kQuadLanes];
+    };
+
+    // The children's errors of `parent`'s refinement from ahead_, where
+    // errors_ahead found them; true if so.
+    bool take_ahead(uint parent, float* errors_kept, float* errors_fresh) {
+        for (ChildErrors& c : ahead_) {
+            if (c.parent != parent) continue;
+            for (uint p = 0; p < kQuadLanes; ++p) errors_kept[p] = c.kept[p], errors_fresh[p] = c.fresh[p];
+            c.parent = kInvalidIndex;
+            return true;
+        }
+        return false;
+    }
+
+#if defined(__SSE2__)
+    // Before a pass refines place `at` (its mark in word `w` already
+    // taken): the children's errors of that refinement and of the pass's
+    // next one, in one evaluation of sixteen lanes (quad16), kept in ahead_
+    // for split. Their values do not depend on when they are computed (the
+    // points and the nodes do not change during a cut), so the cut is the
+    // one refined pair by pair; this halves the evaluations of a pass's
+    // bounds where AVX-512 has the lanes.
+    void errors_ahead(uint at, uint w, uint words) {
+        const uint parent = entries_[slot_[at]].node;
+        if (ahead_[0].parent == parent || ahead_[1].parent == parent) return;
+        uint next = kInvalidIndex;
+        for (uint v = w; v < words; ++v)
+            if (marks_[v] != 0u) {
+                next = 32u * v + uint(__builtin_ctz(marks_[v]));
+                break;
+            }
+        if (next == kInvalidIndex || Kernel::tightest_bound) return;
+        const uint parents[2] = {parent, entries_[slot_[next]].node};
+        const LightNode* nodes[4];
+        for (uint k = 0; k < 2u; ++k) {
+            const LightNode& node = k_.light_nodes[parents[k]];
+            const bool right_shares = (node.flags & kNodeRepFromRight) != 0u;
+            nodes[2u * k] = &k_.light_nodes[right_shares ? node.left + 1u : node.left];
+            nodes[2u * k + 1u] = &k_.light_nodes[right_shares ? node.left : node.left + 1u];
+        }
+        for (const LightNode* node : nodes)
+            if (!quad_bound_covers(*node)) return;
+        float errors[4][kQuadLanes];
+        quad16::quad_four_errors(k_, lanes16_, nodes, f_.min_distance2, errors);
+        for (uint k = 0; k < 2u; ++k) {
+            ahead_[k].parent = parents[k];
+            for (uint p = 0; p < kQuadLanes; ++p)
+                ahead_[k].kept[p] = errors[2u * k][p], ahead_[k].fresh[p] = errors[2u * k + 1u][p];
+        }
+    }
+#endif
+
     // What refine_top and refine_at share: the cluster in `kept_slot` is
     // replaced by its children. The child that keeps the parent's
     // representative keeps its units and the slot; the other one, in the
@@ -441,7 +503,8 @@ private:
     };
     Children split(uint kept_slot) {
         QuadEntry& kept = entries_[kept_slot];
-        const LightNode& node = k_.light_nodes[kept.node];
+        const uint parent = kept.node;
+        const LightNode& node = k_.light_nodes[parent];
         remove_estimate(kept, nullptr);
         const bool right_shares = (node.flags & kNodeRepFromRight) != 0u;
         const uint kept_index = right_shares ? node.left + 1u : node.left;
@@ -452,7 +515,7 @@ private:
         QuadEntry& fresh = entries_[fresh_slot];
         kept.node = kept_index;
         fresh.node = fresh_index;
-        child_errors(kept_node, fresh_node, kept.error, fresh.error);
+        if (!take_ahead(parent, kept.error, fresh.error)) child_errors(kept_node, fresh_node, kept.error, fresh.error);
         const bool fresh_leaf = (fresh_node.flags & kNodeLeaf) != 0u;
         // The new representative's shadow ray from each point, the four
         // traced together (lc_visible4: each ray tested on its own at every
@@ -463,7 +526,7 @@ private:
         vec3 units[kQuadLanes], wi[kQuadLanes];
         float t_max[kQuadLanes];
 #if defined(__SSE2__)
-        const bool lanes_done = quad_light_units(k_, lanes_, sp_, rep, f_.min_distance2, units, wi, t_max);
+        const bool lanes_done = quad_light_units(k_, lanes_, rep, f_.min_distance2, units, wi, t_max);
 #else
         const bool lanes_done = false;
 #endif
@@ -553,7 +616,10 @@ private:
     QuadLanes lanes_;
     quad8::QuadLanes lanes8_;  // lanes_ in both halves (child_errors)
     bool wide_ = false;        // lanes8_ is set and used
+    quad16::QuadLanes lanes16_;  // lanes_ in all four quarters (errors_ahead)
+    bool wide16_ = false;        // lanes16_ is set and used
 #endif
+    ChildErrors ahead_[2];  // errors_ahead
     ShadeStats* stats_ = nullptr;
     QuadColor fixed_;     // each point's final estimates: leaves and frozen clusters
     QuadColor heap_sum_;  // ... and the running sum of the heap's

@@ -51,8 +51,9 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
     k.materials = materials.data();  // lc_make_surface's; each point's own is set after it
     k.vpl_min_distance2 = 0.01f;
     int trials = 0, covered = 0, checked = 0, nonzero = 0, pairs = 0, cone_lit = 0, cone_dark = 0, disney_lit = 0;
-    gpu::LightNode previous{};
-    bool have_previous = false;
+    gpu::LightNode previous{}, earlier{};  // the last two covered clusters
+    bool have_previous = false, have_earlier = false;
+    int fours = 0;
     for (int trial = 0; trial < 40000; ++trial) {
         const glm::vec3 centre = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 4.0f;
         // Some boxes past the float range's middle, whose arithmetic gives
@@ -132,6 +133,30 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
                     << "trial " << trial << " lane " << p << " (pair, second): " << second[p] << " against " << scalar;
             }
             ++pairs;
+            // Four clusters at once (AVX-512, quad16::quad_four_errors, two
+            // refinements' children): this one, the last two covered ones
+            // and this one again, each quarter its scalar values bit for bit.
+            if (cpu::cpu_has_avx512dq() && have_earlier) {
+                cpu::quad16::QuadLanes wider;
+                cpu::quad16::widen(wide, wider);
+                const gpu::LightNode* four[4] = {&node, &previous, &earlier, &node};
+                float out[4][4];
+                cpu::quad16::quad_four_errors(k, wider, four, min_distance2, out);
+                for (unsigned c = 0; c < 4u; ++c)
+                    for (unsigned p = 0; p < 4u; ++p) {
+                        const float scalar = (active >> p & 1u) != 0u
+                                                 ? k.lc_cluster_error(sp[p], sp[p].mat, *four[c], min_distance2)
+                                                 : 0.0f;
+                        ASSERT_TRUE(out[c][p] == scalar || (std::isnan(out[c][p]) && std::isnan(scalar)))
+                            << "trial " << trial << " cluster " << c << " lane " << p << " (four): " << out[c][p]
+                            << " against " << scalar;
+                    }
+                ++fours;
+            }
+        }
+        if (have_previous) {
+            earlier = previous;
+            have_earlier = true;
         }
         previous = node;
         have_previous = true;
@@ -146,6 +171,9 @@ TEST(QuadCut, ErrorsAreTheScalarOnesBitForBit) {
     EXPECT_GT(disney_lit, checked / 10);  // Disney points with a bound above zero
     if (cpu::cpu_has_avx2()) {
         EXPECT_GT(pairs, covered / 2);
+    }
+    if (cpu::cpu_has_avx512dq()) {
+        EXPECT_GT(fours, covered / 2);
     }
 #endif
 }
@@ -234,7 +262,7 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
         float t_max[4];
 #if defined(__SSE2__)
         const bool took =
-            cpu::quad_light_units(k, cpu::quad_lanes(k, sp, active), sp, light, min_distance2, unit, wi, t_max);
+            cpu::quad_light_units(k, cpu::quad_lanes(k, sp, active), light, min_distance2, unit, wi, t_max);
 #else
         const bool took = false;
 #endif
