@@ -10,6 +10,7 @@
 #include "cpu_kernel.h"
 #include "scene/huge_pages.h"
 #include "shared/color.h"
+#include "run_on_threads.h"
 
 namespace lc {
 namespace {
@@ -173,10 +174,7 @@ UninitializedVector<gpu::Light> sample_area_lights(const TriangleEmission& emiss
                             gpu::lc_hash(seed ^ gpu::lc_hash(std::uint32_t(it->triangle))), lights.data() + it->first);
         }
     };
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(run, t);
-    run(0);
-    for (std::thread& th : pool) th.join();
+    run_on_threads(threads, run);
     return lights;
 }
 

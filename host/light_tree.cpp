@@ -31,6 +31,7 @@
 
 #include "light_bounds.h"
 #include "scene/huge_pages.h"
+#include "run_on_threads.h"
 
 namespace lc {
 namespace {
@@ -157,19 +158,10 @@ void parallel_for_ranges(std::size_t n, Fn fn) {
         fn(std::size_t(0), n, 0u);
         return;
     }
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < threads; ++t) {
-        auto [b, e] = thread_range(n, threads, t);
-        if (b < e) pool.emplace_back(fn, b, e, t);
-    }
-    try {
-        const auto [b, e] = thread_range(n, threads, 0u);
-        fn(b, e, 0u);
-    } catch (...) {
-        for (auto& th : pool) th.join();
-        throw;
-    }
-    for (auto& th : pool) th.join();
+    run_on_threads(threads, [&](unsigned t) {
+        const auto [b, e] = thread_range(n, threads, t);
+        if (b < e || t == 0u) fn(b, e, t);
+    });
 }
 
 // Runs fn(begin, end) over [0, n) on up to hardware_concurrency threads.
@@ -730,10 +722,7 @@ void flatten(Build& build, std::size_t leaf_count, std::span<const gpu::Light> i
             }
         }
     };
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(walk);
-    walk();
-    for (auto& th : pool) th.join();
+    run_on_threads(threads, [&](unsigned) { walk(); });
     // The clusters are written: their memory (144 bytes a light without
     // cones) goes back before the leaf-order lights' pages (48 bytes a light)
     // are first touched, so that the build's peak holds one or the other.

@@ -4,9 +4,9 @@
 
 #include <atomic>
 #include <cstdint>
-#include <exception>
-#include <thread>
 #include <vector>
+
+#include "run_on_threads.h"
 
 namespace lc {
 
@@ -16,25 +16,19 @@ inline constexpr std::uint32_t kTile = 8;
 // Runs work(tile, worker) for every tile index below tile_count, one thread
 // per element of `workers` (what each thread owns: its heap, its counters).
 // An exception in any worker (out of memory, say) stops the others at their
-// next tile and reaches the caller as itself, not as std::terminate.
+// next tile and reaches the caller as itself (run_on_threads), not as
+// std::terminate.
 template <typename Worker, typename Work>
 void for_each_tile(std::uint32_t tile_count, std::vector<Worker>& workers, Work work) {
     std::atomic<std::uint32_t> next_tile{0};
-    std::vector<std::exception_ptr> errors(workers.size());
-    auto worker = [&](std::size_t index) {
+    run_on_threads(unsigned(workers.size()), [&](unsigned index) {
         try {
             for (std::uint32_t tile; (tile = next_tile.fetch_add(1)) < tile_count;) work(tile, workers[index]);
         } catch (...) {
-            errors[index] = std::current_exception();
             next_tile.store(tile_count);
+            throw;
         }
-    };
-    std::vector<std::thread> pool;
-    for (std::size_t i = 1; i < workers.size(); ++i) pool.emplace_back(worker, i);
-    worker(0);
-    for (auto& th : pool) th.join();
-    for (const auto& e : errors)
-        if (e) std::rethrow_exception(e);
+    });
 }
 
 }  // namespace lc

@@ -8,6 +8,7 @@
 #include "cpu_kernel.h"
 #include "path_emitters.h"
 #include "shared/color.h"
+#include "run_on_threads.h"
 
 namespace lc {
 namespace {
@@ -206,24 +207,20 @@ VplSet trace_vpls(const Scene& scene, const Bvh& bvh, std::span<const gpu::Light
         const std::size_t round =
             std::min(max_paths - paths,
                      std::max<std::size_t>(1024, std::size_t(double(wanted - set.lights.size()) / rate * 1.05)));
-        std::vector<std::thread> pool;
-        for (unsigned t = 0; t < threads; ++t) {
-            pool.emplace_back([&, t] {
-                found[t].clear();
-                per_path[t].clear();
-                const std::size_t first = paths + round * t / threads, last = paths + round * (t + 1) / threads;
-                // Room for the VPLs the rate so far expects, and a tenth more.
-                found[t].reserve(std::size_t(double(last - first) * rate * 1.1) + 16);
-                per_path[t].reserve(last - first);
-                cpu::ShadeKernel kernel = k;
-                for (std::size_t p = first; p < last; ++p) {
-                    const std::size_t before = found[t].size();
-                    trace_path(kernel, source, seed, p, settings.max_bounces, found[t]);
-                    per_path[t].push_back(std::uint32_t(found[t].size() - before));
-                }
-            });
-        }
-        for (auto& th : pool) th.join();
+        run_on_threads(threads, [&](unsigned t) {
+            found[t].clear();
+            per_path[t].clear();
+            const std::size_t first = paths + round * t / threads, last = paths + round * (t + 1) / threads;
+            // Room for the VPLs the rate so far expects, and a tenth more.
+            found[t].reserve(std::size_t(double(last - first) * rate * 1.1) + 16);
+            per_path[t].reserve(last - first);
+            cpu::ShadeKernel kernel = k;
+            for (std::size_t p = first; p < last; ++p) {
+                const std::size_t before = found[t].size();
+                trace_path(kernel, source, seed, p, settings.max_bounces, found[t]);
+                per_path[t].push_back(std::uint32_t(found[t].size() - before));
+            }
+        });
         // Whole paths, in order, until the count is reached.
         for (unsigned t = 0; t < threads && set.lights.size() < wanted; ++t) {
             std::size_t at = 0;

@@ -19,6 +19,7 @@
 #include "light_records.h"
 #include "lightcuts/error.h"
 #include "lightcuts/scene.h"
+#include "run_on_threads.h"
 
 namespace lc {
 namespace loader {
@@ -205,10 +206,7 @@ void for_each_index(std::size_t n, Fn fn) {
     auto work = [&] {
         for (std::size_t i; (i = next.fetch_add(1)) < n;) fn(i);
     };
-    std::vector<std::thread> pool;
-    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
-    work();
-    for (std::thread& t : pool) t.join();
+    run_on_threads(unsigned(threads), [&](unsigned) { work(); });
 }
 
 // The file, but a header, is cut into chunks of about chunk_bytes at line

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "vk_check.h"
+#include "run_on_threads.h"
 
 namespace lc::vk {
 
@@ -167,13 +168,10 @@ void GpuResources::upload(const std::string& name, const void* data, VkDeviceSiz
         auto* to = static_cast<unsigned char*>(buffer.mapped()) + offset;
         const unsigned threads = bytes < (VkDeviceSize(64) << 20) ? 1u : std::max(1u, std::thread::hardware_concurrency());
         const VkDeviceSize share = (bytes + threads - 1) / threads;
-        std::vector<std::thread> pool;
-        for (unsigned t = 1; t < threads; ++t) {
+        run_on_threads(threads, [&](unsigned t) {
             const VkDeviceSize begin = std::min(bytes, t * share), end = std::min(bytes, begin + share);
-            pool.emplace_back([=] { std::memcpy(to + begin, from + begin, end - begin); });
-        }
-        std::memcpy(to, from, std::min(bytes, share));
-        for (std::thread& th : pool) th.join();
+            std::memcpy(to + begin, from + begin, end - begin);
+        });
         return;
     }
     Buffer staging(ctx_.device(), ctx_.memory(), bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
