@@ -197,6 +197,15 @@ bool pair_errors(Kernel& kernel, const SurfacePoint& sp, const gpu::Material& m,
 }
 
 #if defined(__SSE2__)
+// QuadLanes' vector fields (quad_bounds_body.h), for the copies of one
+// width's lanes into a wider one's (quad8::widen, quad16::widen).
+#define LC_QUAD_LANE_VECTORS(X)                                                                                     \
+    X(px) X(py) X(pz) X(nx) X(ny) X(nz) X(anx) X(any) X(anz) X(tx) X(ty) X(tz) X(atx) X(aty) X(atz) X(bx) X(by)   \
+    X(bz) X(abx) X(aby) X(abz) X(kd_r) X(kd_g) X(kd_b) X(ks_r) X(ks_g) X(ks_b) X(wox) X(woy) X(woz) X(cos_o)       \
+    X(wr_x) X(wr_y) X(wr_z) X(a2) X(g1) X(four_cos_o) X(active) X(specular_lanes) X(disney_lanes) X(sheen_lanes)   \
+    X(coat_lanes) X(one_minus_metallic) X(two_roughness) X(schlick_o) X(spec0_r) X(spec0_g) X(spec0_b) X(sheen_r) \
+    X(sheen_g) X(sheen_b) X(coat_weight) X(coat_a2) X(coat_a2_minus_1) X(coat_pi_log) X(coat_g1)
+
 // The quad evaluation with the four points in the four SSE lanes.
 namespace quad4 {
 using V = __m128;
@@ -354,40 +363,9 @@ inline V twice(__m128 v) { return _mm256_insertf128_ps(_mm256_castps128_ps256(v)
 
 // The quad's lanes in both halves.
 inline void widen(const quad4::QuadLanes& q, QuadLanes& w) {
-    const __m128 quad4::QuadLanes::*fields[] = {
-        &quad4::QuadLanes::px,   &quad4::QuadLanes::py,   &quad4::QuadLanes::pz,    &quad4::QuadLanes::nx,
-        &quad4::QuadLanes::ny,   &quad4::QuadLanes::nz,   &quad4::QuadLanes::anx,   &quad4::QuadLanes::any,
-        &quad4::QuadLanes::anz,  &quad4::QuadLanes::tx,   &quad4::QuadLanes::ty,    &quad4::QuadLanes::tz,
-        &quad4::QuadLanes::atx,  &quad4::QuadLanes::aty,  &quad4::QuadLanes::atz,   &quad4::QuadLanes::bx,
-        &quad4::QuadLanes::by,   &quad4::QuadLanes::bz,   &quad4::QuadLanes::abx,   &quad4::QuadLanes::aby,
-        &quad4::QuadLanes::abz,  &quad4::QuadLanes::kd_r, &quad4::QuadLanes::kd_g,  &quad4::QuadLanes::kd_b,
-        &quad4::QuadLanes::ks_r, &quad4::QuadLanes::ks_g, &quad4::QuadLanes::ks_b,  &quad4::QuadLanes::wox,
-        &quad4::QuadLanes::woy,  &quad4::QuadLanes::woz,  &quad4::QuadLanes::cos_o, &quad4::QuadLanes::wr_x,
-        &quad4::QuadLanes::wr_y, &quad4::QuadLanes::wr_z, &quad4::QuadLanes::a2,    &quad4::QuadLanes::g1,
-        &quad4::QuadLanes::four_cos_o, &quad4::QuadLanes::active, &quad4::QuadLanes::specular_lanes,
-        &quad4::QuadLanes::disney_lanes, &quad4::QuadLanes::sheen_lanes, &quad4::QuadLanes::coat_lanes,
-        &quad4::QuadLanes::one_minus_metallic, &quad4::QuadLanes::two_roughness, &quad4::QuadLanes::schlick_o,
-        &quad4::QuadLanes::spec0_r, &quad4::QuadLanes::spec0_g, &quad4::QuadLanes::spec0_b,
-        &quad4::QuadLanes::sheen_r, &quad4::QuadLanes::sheen_g, &quad4::QuadLanes::sheen_b,
-        &quad4::QuadLanes::coat_weight, &quad4::QuadLanes::coat_a2, &quad4::QuadLanes::coat_a2_minus_1,
-        &quad4::QuadLanes::coat_pi_log, &quad4::QuadLanes::coat_g1};
-    V QuadLanes::*wide[] = {
-        &QuadLanes::px,   &QuadLanes::py,   &QuadLanes::pz,    &QuadLanes::nx,   &QuadLanes::ny,
-        &QuadLanes::nz,   &QuadLanes::anx,  &QuadLanes::any,   &QuadLanes::anz,  &QuadLanes::tx,
-        &QuadLanes::ty,   &QuadLanes::tz,   &QuadLanes::atx,   &QuadLanes::aty,  &QuadLanes::atz,
-        &QuadLanes::bx,   &QuadLanes::by,   &QuadLanes::bz,    &QuadLanes::abx,  &QuadLanes::aby,
-        &QuadLanes::abz,  &QuadLanes::kd_r, &QuadLanes::kd_g,  &QuadLanes::kd_b, &QuadLanes::ks_r,
-        &QuadLanes::ks_g, &QuadLanes::ks_b, &QuadLanes::wox,   &QuadLanes::woy,  &QuadLanes::woz,
-        &QuadLanes::cos_o, &QuadLanes::wr_x, &QuadLanes::wr_y, &QuadLanes::wr_z, &QuadLanes::a2,
-        &QuadLanes::g1,   &QuadLanes::four_cos_o, &QuadLanes::active, &QuadLanes::specular_lanes,
-        &QuadLanes::disney_lanes, &QuadLanes::sheen_lanes, &QuadLanes::coat_lanes,
-        &QuadLanes::one_minus_metallic, &QuadLanes::two_roughness, &QuadLanes::schlick_o,
-        &QuadLanes::spec0_r, &QuadLanes::spec0_g, &QuadLanes::spec0_b,
-        &QuadLanes::sheen_r, &QuadLanes::sheen_g, &QuadLanes::sheen_b,
-        &QuadLanes::coat_weight, &QuadLanes::coat_a2, &QuadLanes::coat_a2_minus_1,
-        &QuadLanes::coat_pi_log, &QuadLanes::coat_g1};
-    static_assert(sizeof fields / sizeof fields[0] == sizeof wide / sizeof wide[0]);
-    for (std::size_t i = 0; i < sizeof wide / sizeof wide[0]; ++i) w.*wide[i] = twice(q.*fields[i]);
+#define LC_WIDEN(field) w.field = twice(q.field);
+    LC_QUAD_LANE_VECTORS(LC_WIDEN)
+#undef LC_WIDEN
     w.specular = q.specular;
     w.covered = q.covered;
     w.disney = q.disney;
@@ -465,40 +443,9 @@ inline V join(__m256 lo, __m256 hi) { return _mm512_insertf32x8(_mm512_castps256
 
 // The quad's lanes in all four quarters.
 inline void widen(const quad8::QuadLanes& q, QuadLanes& w) {
-    const __m256 quad8::QuadLanes::*fields[] = {
-        &quad8::QuadLanes::px,   &quad8::QuadLanes::py,   &quad8::QuadLanes::pz,    &quad8::QuadLanes::nx,
-        &quad8::QuadLanes::ny,   &quad8::QuadLanes::nz,   &quad8::QuadLanes::anx,   &quad8::QuadLanes::any,
-        &quad8::QuadLanes::anz,  &quad8::QuadLanes::tx,   &quad8::QuadLanes::ty,    &quad8::QuadLanes::tz,
-        &quad8::QuadLanes::atx,  &quad8::QuadLanes::aty,  &quad8::QuadLanes::atz,   &quad8::QuadLanes::bx,
-        &quad8::QuadLanes::by,   &quad8::QuadLanes::bz,   &quad8::QuadLanes::abx,   &quad8::QuadLanes::aby,
-        &quad8::QuadLanes::abz,  &quad8::QuadLanes::kd_r, &quad8::QuadLanes::kd_g,  &quad8::QuadLanes::kd_b,
-        &quad8::QuadLanes::ks_r, &quad8::QuadLanes::ks_g, &quad8::QuadLanes::ks_b,  &quad8::QuadLanes::wox,
-        &quad8::QuadLanes::woy,  &quad8::QuadLanes::woz,  &quad8::QuadLanes::cos_o, &quad8::QuadLanes::wr_x,
-        &quad8::QuadLanes::wr_y, &quad8::QuadLanes::wr_z, &quad8::QuadLanes::a2,    &quad8::QuadLanes::g1,
-        &quad8::QuadLanes::four_cos_o, &quad8::QuadLanes::active, &quad8::QuadLanes::specular_lanes,
-        &quad8::QuadLanes::disney_lanes, &quad8::QuadLanes::sheen_lanes, &quad8::QuadLanes::coat_lanes,
-        &quad8::QuadLanes::one_minus_metallic, &quad8::QuadLanes::two_roughness, &quad8::QuadLanes::schlick_o,
-        &quad8::QuadLanes::spec0_r, &quad8::QuadLanes::spec0_g, &quad8::QuadLanes::spec0_b,
-        &quad8::QuadLanes::sheen_r, &quad8::QuadLanes::sheen_g, &quad8::QuadLanes::sheen_b,
-        &quad8::QuadLanes::coat_weight, &quad8::QuadLanes::coat_a2, &quad8::QuadLanes::coat_a2_minus_1,
-        &quad8::QuadLanes::coat_pi_log, &quad8::QuadLanes::coat_g1};
-    V QuadLanes::*wide[] = {
-        &QuadLanes::px,   &QuadLanes::py,   &QuadLanes::pz,    &QuadLanes::nx,   &QuadLanes::ny,
-        &QuadLanes::nz,   &QuadLanes::anx,  &QuadLanes::any,   &QuadLanes::anz,  &QuadLanes::tx,
-        &QuadLanes::ty,   &QuadLanes::tz,   &QuadLanes::atx,   &QuadLanes::aty,  &QuadLanes::atz,
-        &QuadLanes::bx,   &QuadLanes::by,   &QuadLanes::bz,    &QuadLanes::abx,  &QuadLanes::aby,
-        &QuadLanes::abz,  &QuadLanes::kd_r, &QuadLanes::kd_g,  &QuadLanes::kd_b, &QuadLanes::ks_r,
-        &QuadLanes::ks_g, &QuadLanes::ks_b, &QuadLanes::wox,   &QuadLanes::woy,  &QuadLanes::woz,
-        &QuadLanes::cos_o, &QuadLanes::wr_x, &QuadLanes::wr_y, &QuadLanes::wr_z, &QuadLanes::a2,
-        &QuadLanes::g1,   &QuadLanes::four_cos_o, &QuadLanes::active, &QuadLanes::specular_lanes,
-        &QuadLanes::disney_lanes, &QuadLanes::sheen_lanes, &QuadLanes::coat_lanes,
-        &QuadLanes::one_minus_metallic, &QuadLanes::two_roughness, &QuadLanes::schlick_o,
-        &QuadLanes::spec0_r, &QuadLanes::spec0_g, &QuadLanes::spec0_b,
-        &QuadLanes::sheen_r, &QuadLanes::sheen_g, &QuadLanes::sheen_b,
-        &QuadLanes::coat_weight, &QuadLanes::coat_a2, &QuadLanes::coat_a2_minus_1,
-        &QuadLanes::coat_pi_log, &QuadLanes::coat_g1};
-    static_assert(sizeof fields / sizeof fields[0] == sizeof wide / sizeof wide[0]);
-    for (std::size_t i = 0; i < sizeof wide / sizeof wide[0]; ++i) w.*wide[i] = join(q.*fields[i], q.*fields[i]);
+#define LC_WIDEN(field) w.field = join(q.field, q.field);
+    LC_QUAD_LANE_VECTORS(LC_WIDEN)
+#undef LC_WIDEN
     w.specular = q.specular;
     w.covered = q.covered;
     w.disney = q.disney;
