@@ -20,11 +20,14 @@
 // quad_bounds_body.h; a change to lc_emission_bound, lc_ggx_bound or
 // lc_disney_bound must be made there too),
 // two clusters' bounds at once where the CPU has AVX2
-// (quad8::quad_pair_errors), and a representative's contribution
-// (quad_light_units), bit for bit the scalar functions'
+// (quad8::quad_pair_errors) and four where it has AVX-512
+// (quad16::quad_four_errors), and a representative's contribution
+// (quad_light_units; two at once, quad8::quad_light_units_pair; the code in
+// quad_bounds_body.h, light_values), bit for bit the scalar functions'
 // (tests/test_quad_cut.cpp).
 #pragma once
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -103,6 +106,12 @@ inline bool pair_bound_covers(const gpu::LightNode& node) {
 inline bool quad_bound_covers(const gpu::LightNode& node) {
     const std::uint32_t type = (node.flags >> gpu::kNodeTypeShift) & gpu::kNodeTypeMask;
     return (node.flags & gpu::kNodeLeaf) == 0u && type != gpu::kLightDirectional;
+}
+
+// Whether quad_light_units covers this light: not a directional one.
+inline bool quad_units_cover(const gpu::Light& light) {
+    const std::uint32_t type = light.type & gpu::kLightTypeMask;
+    return type != gpu::kLightDirectional && type <= gpu::kLightVpl;
 }
 
 // lc_cluster_error of `left` and `right` into `errors`, or false where the
@@ -382,6 +391,30 @@ void quad_pair_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode& 
     _mm_storeu_ps(errors_a, _mm256_castps256_ps128(e));
     _mm_storeu_ps(errors_b, _mm256_extractf128_ps(e, 1));
 }
+// quad_light_units of `a` and `b` at once, in the eight lanes of AVX2, into
+// unit[0], wi[0], t_max[0] and unit[1], wi[1], t_max[1]; false (nothing
+// written) where quad_light_units does not cover both.
+template <class Kernel>
+bool quad_light_units_pair(Kernel& kernel, const QuadLanes& q, const gpu::Light& a, const gpu::Light& b,
+                           float min_distance2, glm::vec3 unit[2][4], glm::vec3 wi[2][4], float t_max[2][4]) {
+    if (!q.covered || !quad_units_cover(a) || !quad_units_cover(b)) return false;
+    alignas(32) float v[7][8];
+    V r, g, bl, wx, wy, wz, length;
+    const unsigned lit = unsigned(
+        _mm256_movemask_ps(light_values<Kernel>(q, light_lanes(kernel, a, b, min_distance2), r, g, bl, wx, wy, wz, length)));
+    const V rows[7] = {r, g, bl, wx, wy, wz, length};
+    for (unsigned k = 0; k < 7u; ++k) _mm256_store_ps(v[k], rows[k]);
+    for (unsigned h = 0; h < 2u; ++h)
+        for (unsigned p = 0; p < 4u; ++p) {
+            const unsigned lane = 4u * h + p;
+            unit[h][p] = glm::vec3(0.0f);
+            if ((lit >> lane & 1u) == 0u) continue;
+            unit[h][p] = glm::vec3(v[0][lane], v[1][lane], v[2][lane]);
+            wi[h][p] = glm::vec3(v[3][lane], v[4][lane], v[5][lane]);
+            t_max[h][p] = v[6][lane];
+        }
+    return true;
+}
 }  // namespace quad8
 #if defined(__clang__)
 #pragma clang attribute pop
@@ -515,93 +548,25 @@ void quad_four_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode* 
 // (tests/test_quad_cut.cpp). False where this does not cover the case: a
 // directional light, or the points' lanes not covered (QuadLanes). The
 // BRDF is evaluated in the lanes too, the GGX lobe's and the Disney BRDF's
-// (quad4::disney_values). A change to lc_light_unit, lc_brdf_cos or
-// lc_disney_brdf_cos (shaders/shared/shading.h) must be made here too; the
-// test fails until it is.
+// (quad_bounds_body.h, light_values). A change to lc_light_unit,
+// lc_brdf_cos or lc_disney_brdf_cos (shaders/shared/shading.h) must be made
+// there too; the test fails until it is.
 template <class Kernel>
 bool quad_light_units(Kernel& kernel, const QuadLanes& q, const gpu::Light& light, float min_distance2,
                       glm::vec3 unit[4], glm::vec3 wi[4], float t_max[4]) {
-    const std::uint32_t type = light.type & gpu::kLightTypeMask;
-    if (!q.covered || type == gpu::kLightDirectional || type > gpu::kLightVpl) return false;
-    const __m128 zero = _mm_setzero_ps();
-    const __m128 tx = _mm_sub_ps(_mm_set1_ps(light.x), q.px), ty = _mm_sub_ps(_mm_set1_ps(light.y), q.py),
-                 tz = _mm_sub_ps(_mm_set1_ps(light.z), q.pz);
-    const __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(tx, tx), _mm_mul_ps(ty, ty)), _mm_mul_ps(tz, tz));
-    const __m128 d = _mm_sqrt_ps(d2);
-    const __m128 wx = _mm_div_ps(tx, d), wy = _mm_div_ps(ty, d), wz = _mm_div_ps(tz, d);
-    const __m128 length = _mm_mul_ps(d, _mm_set1_ps(1.0f - Kernel::kShadowEndRelative));
-    __m128 factor =
-        _mm_div_ps(_mm_set1_ps(1.0f), glsl_max(d2, _mm_set1_ps(kernel.lc_falloff_clamp2(min_distance2, type))));
-    if (type != gpu::kLightPoint) {
-        // The emission towards each point: -(axis . wi), then the spot's
-        // falloff (lc_spot_falloff) or the cosine emitter's cosine.
-        const __m128 cos_axis = _mm_mul_ps(dot_lanes(glm::vec3(light.axis_x, light.axis_y, light.axis_z), wx, wy, wz),
-                                           _mm_set1_ps(-1.0f));
-        __m128 emission;
-        if (type == gpu::kLightSpot) {
-            const float width = std::max(1e-3f, light.cos_inner - light.cos_outer);
-            const __m128 one = _mm_set1_ps(1.0f);
-            const __m128 s = glsl_min(
-                glsl_max(_mm_div_ps(_mm_sub_ps(glsl_min(cos_axis, one), _mm_set1_ps(light.cos_outer)),
-                                    _mm_set1_ps(width)),
-                         zero),
-                one);
-            emission = _mm_mul_ps(s, s);
-        } else {
-            emission = (light.type & gpu::kLightTwoSided) != 0u ? abs_lanes(cos_axis) : glsl_max(cos_axis, zero);
-        }
-        factor = _mm_mul_ps(factor, emission);
-    }
-    const __m128 cos_i = dot4(q.nx, q.ny, q.nz, wx, wy, wz);
-    // lc_light_unit's early returns: no direction (d = 0), the light behind
-    // the surface, no emission towards it.
-    const __m128 lit = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(d, zero), _mm_cmpnle_ps(cos_i, zero)),
-                                  _mm_and_ps(_mm_cmpgt_ps(factor, zero), q.active));
-    const __m128 c = _mm_div_ps(cos_i, _mm_set1_ps(Kernel::kPi));
-    __m128 r = _mm_mul_ps(q.kd_r, c), g = _mm_mul_ps(q.kd_g, c), b = _mm_mul_ps(q.kd_b, c);
-    if (Kernel::kEnableGgx && q.specular != 0u) {
-        // lc_brdf_cos's GGX lobe where cos_o > 0: h = normalize(wi + wo)
-        // (glm's: v * (1 / sqrt(dot(v, v)))), then D G1(cos_i) G1(cos_o) /
-        // (4 cos_o), the point's terms from QuadLanes (set_ggx_terms).
-        const __m128 hx = _mm_add_ps(wx, q.wox), hy = _mm_add_ps(wy, q.woy), hz = _mm_add_ps(wz, q.woz);
-        const __m128 inverse = _mm_div_ps(_mm_set1_ps(1.0f), _mm_sqrt_ps(dot4(hx, hy, hz, hx, hy, hz)));
-        const __m128 cos_h = glsl_max(
-            dot4(q.nx, q.ny, q.nz, _mm_mul_ps(hx, inverse), _mm_mul_ps(hy, inverse), _mm_mul_ps(hz, inverse)), zero);
-        const __m128 spec = _mm_div_ps(
-            _mm_mul_ps(_mm_mul_ps(quad4::ggx_d<Kernel>(q, cos_h), quad4::smith_g1(cos_i, q.a2)), q.g1),
-            q.four_cos_o);
-        const __m128 lobe = _mm_and_ps(q.specular_lanes, _mm_cmpgt_ps(q.cos_o, zero));
-        r = quad4::v_select(lobe, _mm_add_ps(r, _mm_mul_ps(q.ks_r, spec)), r);
-        g = quad4::v_select(lobe, _mm_add_ps(g, _mm_mul_ps(q.ks_g, spec)), g);
-        b = quad4::v_select(lobe, _mm_add_ps(b, _mm_mul_ps(q.ks_b, spec)), b);
-    }
-    alignas(16) float v[12][4];
-    _mm_store_ps(v[0], _mm_mul_ps(r, factor));
-    _mm_store_ps(v[1], _mm_mul_ps(g, factor));
-    _mm_store_ps(v[2], _mm_mul_ps(b, factor));
-    if (q.disney != 0u) {
-        __m128 r, g, b;
-        quad4::disney_values<Kernel>(q, wx, wy, wz, cos_i, r, g, b);
-        _mm_store_ps(v[9], _mm_mul_ps(r, factor));
-        _mm_store_ps(v[10], _mm_mul_ps(g, factor));
-        _mm_store_ps(v[11], _mm_mul_ps(b, factor));
-    }
-    _mm_store_ps(v[3], wx);
-    _mm_store_ps(v[4], wy);
-    _mm_store_ps(v[5], wz);
-    _mm_store_ps(v[6], length);
-    _mm_store_ps(v[7], cos_i);
-    _mm_store_ps(v[8], factor);
-    const unsigned mask = unsigned(_mm_movemask_ps(lit));
+    if (!q.covered || !quad_units_cover(light)) return false;
+    alignas(16) float v[7][4];
+    __m128 r, g, b, wx, wy, wz, length;
+    const unsigned lit = unsigned(_mm_movemask_ps(quad4::light_values<Kernel>(
+        q, quad4::light_lanes(kernel, light, light, min_distance2), r, g, b, wx, wy, wz, length)));
+    const __m128 rows[7] = {r, g, b, wx, wy, wz, length};
+    for (unsigned k = 0; k < 7u; ++k) _mm_store_ps(v[k], rows[k]);
     for (unsigned p = 0; p < 4u; ++p) {
         unit[p] = glm::vec3(0.0f);
-        if ((mask >> p & 1u) == 0u) continue;
+        if ((lit >> p & 1u) == 0u) continue;
+        unit[p] = glm::vec3(v[0][p], v[1][p], v[2][p]);
         wi[p] = glm::vec3(v[3][p], v[4][p], v[5][p]);
         t_max[p] = v[6][p];
-        if ((q.disney >> p & 1u) != 0u)
-            unit[p] = glm::vec3(v[9][p], v[10][p], v[11][p]);
-        else
-            unit[p] = glm::vec3(v[0][p], v[1][p], v[2][p]);
     }
     return true;
 }

@@ -1,15 +1,18 @@
-// The quad bound evaluation of host/pair_bound.h, written once over a
-// vector of float lanes: pair_bound.h includes this file twice, in
-// namespace quad4 (SSE: the four points of a quad in the lanes) and, built
-// for AVX2, in namespace quad8 (two clusters at the four points, the first
-// in lanes 0-3, the second in lanes 4-7). The including namespace provides
+// The quad evaluations of host/pair_bound.h (a cluster's bound, a light's
+// unit contribution), written once over a vector of float lanes:
+// pair_bound.h includes this file in namespace quad4 (SSE: the four points
+// of a quad in the lanes), built for AVX2 in namespace quad8 (two clusters
+// or lights at the four points, the first in lanes 0-3, the second in lanes
+// 4-7) and built for AVX-512 in namespace quad16 (four clusters, each in a
+// quarter; only cluster_errors is used there). The including namespace provides
 // the vector type V and its operations v_set1, v_zero, v_add, v_sub, v_mul,
 // v_div, v_sqrt, v_and, v_andnot, v_or, v_cmpgt, v_cmpge, v_cmpnle,
 // v_abs, v_min and v_max (GLSL's min and max, see glsl_min), v_movemask,
 // and v_set2(a, b): the first cluster's value a and the second's b.
 // Every value is computed with the same operations in the same order as
-// the scalar lc_cluster_bound, lc_ggx_bound, lc_disney_bound and
-// lc_emission_bound (shaders/shared), so the results are theirs bit for bit
+// the scalar lc_cluster_bound, lc_ggx_bound, lc_disney_bound,
+// lc_emission_bound, lc_light_unit, lc_brdf_cos and lc_disney_brdf_cos
+// (shaders/shared), so the results are theirs bit for bit
 // (tests/test_quad_cut.cpp). Those bounds form no angles (no acos, asin or
 // cos) for this: sqrt, like the rest, is rounded the same way in every lane.
 // No include guard: included once per vector width.
@@ -433,4 +436,95 @@ LC_ALWAYS_INLINE inline bool cluster_errors(const QuadLanes& q, const QuadNodes&
     const V error = v_add(v_add(v_mul(v_set1(0.2126f), r), v_mul(v_set1(0.7152f), g)), v_mul(v_set1(0.0722f), b));
     errors = v_and(error, counted);
     return true;
+}
+
+// Lights lane by lane for light_values, as v_set2 lays them out: their
+// positions, falloff clamps and, where some light is not a point light,
+// their emission (lc_light_unit's spot falloff or cosine).
+struct LightLanes {
+    V x, y, z, clamp;
+    bool any_emission = false;  // the fields below are set
+    V point;                    // all ones where the light emits the same everywhere
+    V axis_x, axis_y, axis_z;
+    V spot, two_sided;  // all ones where the light is a spot, a two-sided cosine emitter
+    V cos_outer, width;  // a spot's: cos_outer and max(1e-3, cos_inner - cos_outer)
+};
+
+// The lights `a` and `b`, each a point light, spot, cosine emitter or VPL.
+template <class Kernel>
+LC_ALWAYS_INLINE inline LightLanes light_lanes(Kernel& kernel, const gpu::Light& a, const gpu::Light& b,
+                                               float min_distance2) {
+    const std::uint32_t type_a = a.type & gpu::kLightTypeMask, type_b = b.type & gpu::kLightTypeMask;
+    LightLanes l;
+    l.x = v_set2(a.x, b.x);
+    l.y = v_set2(a.y, b.y);
+    l.z = v_set2(a.z, b.z);
+    l.clamp = v_set2(kernel.lc_falloff_clamp2(min_distance2, type_a), kernel.lc_falloff_clamp2(min_distance2, type_b));
+    l.any_emission = type_a != gpu::kLightPoint || type_b != gpu::kLightPoint;
+    if (!l.any_emission) return l;
+    const auto all = [](bool on) { return on ? std::bit_cast<float>(~0u) : 0.0f; };
+    l.point = v_set2(all(type_a == gpu::kLightPoint), all(type_b == gpu::kLightPoint));
+    l.axis_x = v_set2(a.axis_x, b.axis_x);
+    l.axis_y = v_set2(a.axis_y, b.axis_y);
+    l.axis_z = v_set2(a.axis_z, b.axis_z);
+    l.spot = v_set2(all(type_a == gpu::kLightSpot), all(type_b == gpu::kLightSpot));
+    l.two_sided = v_set2(all((a.type & gpu::kLightTwoSided) != 0u), all((b.type & gpu::kLightTwoSided) != 0u));
+    l.cos_outer = v_set2(a.cos_outer, b.cos_outer);
+    l.width = v_set2(std::max(1e-3f, a.cos_inner - a.cos_outer), std::max(1e-3f, b.cos_inner - b.cos_outer));
+    return l;
+}
+
+// lc_light_unit of each lane's light at its point, with the operations of
+// lc_light_unit, lc_spot_falloff, lc_brdf_cos and lc_disney_brdf_cos in
+// their order: the unit (the BRDF times the cosine and the falloff) into
+// r, g, b, the direction to the light into wi and the shadow ray's length
+// into length; the lanes where the light reaches the point (lc_light_unit's
+// early returns not taken) are all ones in the result.
+template <class Kernel>
+LC_ALWAYS_INLINE inline V light_values(const QuadLanes& q, const LightLanes& l, V& r, V& g, V& b, V& wi_x, V& wi_y,
+                                       V& wi_z, V& length) {
+    const V zero = v_zero(), one = v_set1(1.0f);
+    const V tx = v_sub(l.x, q.px), ty = v_sub(l.y, q.py), tz = v_sub(l.z, q.pz);
+    const V d2 = dot4(tx, ty, tz, tx, ty, tz);
+    const V d = v_sqrt(d2);
+    wi_x = v_div(tx, d), wi_y = v_div(ty, d), wi_z = v_div(tz, d);
+    length = v_mul(d, v_set1(1.0f - Kernel::kShadowEndRelative));
+    V factor = v_div(one, v_max(d2, l.clamp));
+    if (l.any_emission) {
+        // The emission towards each point: -(axis . wi), then the spot's
+        // falloff (lc_spot_falloff) or the cosine emitter's cosine.
+        const V cos_axis = v_mul(dot4(l.axis_x, l.axis_y, l.axis_z, wi_x, wi_y, wi_z), v_set1(-1.0f));
+        const V s = v_min(v_max(v_div(v_sub(v_min(cos_axis, one), l.cos_outer), l.width), zero), one);
+        const V emission =
+            v_select(l.spot, v_mul(s, s), v_select(l.two_sided, v_abs(cos_axis), v_max(cos_axis, zero)));
+        factor = v_select(l.point, factor, v_mul(factor, emission));
+    }
+    const V cos_i = dot4(q.nx, q.ny, q.nz, wi_x, wi_y, wi_z);
+    // lc_light_unit's early returns: no direction (d = 0), the light behind
+    // the surface, no emission towards it.
+    const V lit = v_and(v_and(v_cmpgt(d, zero), v_cmpnle(cos_i, zero)), v_and(v_cmpgt(factor, zero), q.active));
+    const V c = v_div(cos_i, v_set1(Kernel::kPi));
+    r = v_mul(q.kd_r, c), g = v_mul(q.kd_g, c), b = v_mul(q.kd_b, c);
+    if (Kernel::kEnableGgx && q.specular != 0u) {
+        // lc_brdf_cos's GGX lobe where cos_o > 0: h = normalize(wi + wo)
+        // (glm's: v * (1 / sqrt(dot(v, v)))), then D G1(cos_i) G1(cos_o) /
+        // (4 cos_o), the point's terms from set_ggx_terms.
+        const V hx = v_add(wi_x, q.wox), hy = v_add(wi_y, q.woy), hz = v_add(wi_z, q.woz);
+        const V inverse = v_div(one, v_sqrt(dot4(hx, hy, hz, hx, hy, hz)));
+        const V cos_h = v_max(dot4(q.nx, q.ny, q.nz, v_mul(hx, inverse), v_mul(hy, inverse), v_mul(hz, inverse)), zero);
+        const V spec = v_div(v_mul(v_mul(ggx_d<Kernel>(q, cos_h), smith_g1(cos_i, q.a2)), q.g1), q.four_cos_o);
+        const V lobe = v_and(q.specular_lanes, v_cmpgt(q.cos_o, zero));
+        r = v_select(lobe, v_add(r, v_mul(q.ks_r, spec)), r);
+        g = v_select(lobe, v_add(g, v_mul(q.ks_g, spec)), g);
+        b = v_select(lobe, v_add(b, v_mul(q.ks_b, spec)), b);
+    }
+    if (q.disney != 0u) {
+        V dr, dg, db;
+        disney_values<Kernel>(q, wi_x, wi_y, wi_z, cos_i, dr, dg, db);
+        r = v_select(q.disney_lanes, dr, r);
+        g = v_select(q.disney_lanes, dg, g);
+        b = v_select(q.disney_lanes, db, b);
+    }
+    r = v_mul(r, factor), g = v_mul(g, factor), b = v_mul(b, factor);
+    return lit;
 }

@@ -440,28 +440,32 @@ private:
     struct ChildErrors {
         uint parent;  // the refined node, kInvalidIndex where none
         float kept[kQuadLanes], fresh[kQuadLanes];
+        bool has_units;  // the fresh child's representative's units, as quad_light_units gives them:
+        vec3 units[kQuadLanes], wi[kQuadLanes];
+        float t_max[kQuadLanes];
     };
 
     // The children's errors of `parent`'s refinement from ahead_, where
     // errors_ahead found them; true if so.
-    bool take_ahead(uint parent, float* errors_kept, float* errors_fresh) {
+    ChildErrors* take_ahead(uint parent, float* errors_kept, float* errors_fresh) {
         for (ChildErrors& c : ahead_) {
             if (c.parent != parent) continue;
             for (uint p = 0; p < kQuadLanes; ++p) errors_kept[p] = c.kept[p], errors_fresh[p] = c.fresh[p];
             c.parent = kInvalidIndex;
-            return true;
+            return &c;
         }
-        return false;
+        return nullptr;
     }
 
 #if defined(__SSE2__)
     // Before a pass refines place `at` (its mark in word `w` already
     // taken): the children's errors of that refinement and of the pass's
-    // next one, in one evaluation of sixteen lanes (quad16), kept in ahead_
-    // for split. Their values do not depend on when they are computed (the
-    // points and the nodes do not change during a cut), so the cut is the
-    // one refined pair by pair; this halves the evaluations of a pass's
-    // bounds where AVX-512 has the lanes.
+    // next one, in one evaluation of sixteen lanes (quad16), and their new
+    // representatives' units in one of eight (quad8), kept in ahead_ for
+    // split. Their values do not depend on when they are computed (the
+    // points, nodes and lights do not change during a cut), so the cut is
+    // the one refined pair by pair; this halves the evaluations of a pass's
+    // bounds and units where AVX-512 has the lanes.
     void errors_ahead(uint at, uint w, uint words) {
         const uint parent = entries_[slot_[at]].node;
         if (ahead_[0].parent == parent || ahead_[1].parent == parent) return;
@@ -484,10 +488,23 @@ private:
             if (!quad_bound_covers(*node)) return;
         float errors[4][kQuadLanes];
         quad16::quad_four_errors(k_, lanes16_, nodes, f_.min_distance2, errors);
+        // And both new representatives' units, in the eight lanes of AVX2.
+        vec3 units[2][kQuadLanes], wi[2][kQuadLanes];
+        float t_max[2][kQuadLanes];
+        const bool has_units = quad8::quad_light_units_pair(k_, lanes8_, k_.lights[nodes[1]->rep_light],
+                                                            k_.lights[nodes[3]->rep_light], f_.min_distance2,
+                                                            units, wi, t_max);
         for (uint k = 0; k < 2u; ++k) {
-            ahead_[k].parent = parents[k];
-            for (uint p = 0; p < kQuadLanes; ++p)
-                ahead_[k].kept[p] = errors[2u * k][p], ahead_[k].fresh[p] = errors[2u * k + 1u][p];
+            ChildErrors& c = ahead_[k];
+            c.parent = parents[k];
+            c.has_units = has_units;
+            for (uint p = 0; p < kQuadLanes; ++p) {
+                c.kept[p] = errors[2u * k][p], c.fresh[p] = errors[2u * k + 1u][p];
+                if (!has_units) continue;
+                c.units[p] = units[k][p];
+                if (units[k][p] == vec3(0.0f)) continue;  // wi and t_max not written
+                c.wi[p] = wi[k][p], c.t_max[p] = t_max[k][p];
+            }
         }
     }
 #endif
@@ -515,7 +532,8 @@ private:
         QuadEntry& fresh = entries_[fresh_slot];
         kept.node = kept_index;
         fresh.node = fresh_index;
-        if (!take_ahead(parent, kept.error, fresh.error)) child_errors(kept_node, fresh_node, kept.error, fresh.error);
+        const ChildErrors* ahead = take_ahead(parent, kept.error, fresh.error);
+        if (ahead == nullptr) child_errors(kept_node, fresh_node, kept.error, fresh.error);
         const bool fresh_leaf = (fresh_node.flags & kNodeLeaf) != 0u;
         // The new representative's shadow ray from each point, the four
         // traced together (lc_visible4: each ray tested on its own at every
@@ -525,10 +543,16 @@ private:
         const Light& rep = k_.lights[fresh_node.rep_light];
         vec3 units[kQuadLanes], wi[kQuadLanes];
         float t_max[kQuadLanes];
+        bool lanes_done = false;
+        if (ahead != nullptr && ahead->has_units) {
+            for (uint p = 0; p < kQuadLanes; ++p) {
+                units[p] = ahead->units[p];
+                if (units[p] != vec3(0.0f)) wi[p] = ahead->wi[p], t_max[p] = ahead->t_max[p];
+            }
+            lanes_done = true;
+        }
 #if defined(__SSE2__)
-        const bool lanes_done = quad_light_units(k_, lanes_, rep, f_.min_distance2, units, wi, t_max);
-#else
-        const bool lanes_done = false;
+        if (!lanes_done) lanes_done = quad_light_units(k_, lanes_, rep, f_.min_distance2, units, wi, t_max);
 #endif
         RayPacket4 rays;
         for (uint p = 0; p < kQuadLanes; ++p) {

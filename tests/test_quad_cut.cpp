@@ -217,7 +217,9 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
     const std::vector<gpu::Material> materials = {test::lambert(glm::vec3(0.5f))};
     Kernel k;
     k.materials = materials.data();
-    int covered = 0, lanes = 0, lit = 0, trials = 0, lit_cones = 0, lit_disney = 0;
+    int covered = 0, lanes = 0, lit = 0, trials = 0, lit_cones = 0, lit_disney = 0, pairs = 0, pairs_lit = 0;
+    gpu::Light previous{};  // the last covered light
+    bool have_previous = false;
     for (int trial = 0; trial < 40000; ++trial) {
         const glm::vec3 at = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 4.0f;
         // Now and then a spot whose outer cosine rounds to 1, with points on
@@ -261,8 +263,8 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
         glm::vec3 unit[4], wi[4];
         float t_max[4];
 #if defined(__SSE2__)
-        const bool took =
-            cpu::quad_light_units(k, cpu::quad_lanes(k, sp, active), light, min_distance2, unit, wi, t_max);
+        const cpu::QuadLanes quad = cpu::quad_lanes(k, sp, active);
+        const bool took = cpu::quad_light_units(k, quad, light, min_distance2, unit, wi, t_max);
 #else
         const bool took = false;
 #endif
@@ -286,12 +288,44 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
             ASSERT_EQ(wi[p], scalar_wi) << "trial " << trial << " lane " << p;
             ASSERT_EQ(t_max[p], scalar_t_max) << "trial " << trial << " lane " << p;
         }
+#if defined(__SSE2__)
+        // This light and the last covered one at once (AVX2,
+        // quad_light_units_pair), each half the scalar values bit for bit.
+        if (cpu::cpu_has_avx2() && have_previous) {
+            cpu::quad8::QuadLanes wide;
+            cpu::quad8::widen(quad, wide);
+            glm::vec3 units2[2][4], wi2[2][4];
+            float t_max2[2][4];
+            ASSERT_TRUE(cpu::quad8::quad_light_units_pair(k, wide, light, previous, min_distance2, units2, wi2, t_max2));
+            const gpu::Light* both[2] = {&light, &previous};
+            for (unsigned h = 0; h < 2u; ++h)
+                for (unsigned p = 0; p < 4u; ++p) {
+                    glm::vec3 scalar_wi;
+                    float scalar_t_max;
+                    const glm::vec3 scalar = (active >> p & 1u) != 0u
+                                                 ? k.lc_light_unit(sp[p], *both[h], min_distance2, scalar_wi, scalar_t_max)
+                                                 : glm::vec3(0.0f);
+                    ASSERT_EQ(units2[h][p], scalar) << "trial " << trial << " light " << h << " lane " << p << " (pair)";
+                    if (!(scalar.x + scalar.y + scalar.z > 0.0f)) continue;
+                    ++pairs_lit;
+                    ASSERT_EQ(wi2[h][p], scalar_wi) << "trial " << trial << " light " << h << " lane " << p << " (pair)";
+                    ASSERT_EQ(t_max2[h][p], scalar_t_max) << "trial " << trial << " light " << h << " lane " << p;
+                }
+            ++pairs;
+        }
+        previous = light;
+        have_previous = true;
+#endif
     }
 #if defined(__SSE2__)
     EXPECT_GT(covered, trials / 2);
     EXPECT_GT(lit, lanes / 5);
     EXPECT_GT(lit_cones, lit / 5);  // spots, cosine emitters and VPLs that light their points
     EXPECT_GT(lit_disney, lit / 4);  // points with the Disney BRDF that a light reaches
+    if (cpu::cpu_has_avx2()) {
+        EXPECT_GT(pairs, covered / 2);
+        EXPECT_GT(pairs_lit, lit / 2);
+    }
 #endif
 }
 
