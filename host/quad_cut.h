@@ -110,7 +110,7 @@ public:
         wide16_ = wide_ && cpu_has_avx512dq();
         if (wide16_) quad16::widen(lanes8_, lanes16_);
 #endif
-        for (ChildErrors& c : ahead_) c.parent = kInvalidIndex;
+        for (Ahead& c : ahead_) c.parent = kInvalidIndex;
         stats_ = stats;
         size_ = 0u;
         free_count_ = capacity_ + 1u;
@@ -313,7 +313,7 @@ private:
                         return;
                     }
 #if defined(__SSE2__)
-                    if (wide16_) errors_ahead(i, w, words);
+                    if (wide16_) look_ahead(i, w, words);
 #endif
                     refine_at(i);
                 }
@@ -436,19 +436,22 @@ private:
         errors(b, errors_b);
     }
 
-    // The children's errors of a refinement, found ahead of it (errors_ahead).
-    struct ChildErrors {
+    // What split needs of a refinement, found ahead of it (look_ahead): the
+    // children's errors and, where has_units, the new representative's
+    // units, directions and ray lengths as quad_light_units gives them.
+    struct Ahead {
         uint parent;  // the refined node, kInvalidIndex where none
         float kept[kQuadLanes], fresh[kQuadLanes];
-        bool has_units;  // the fresh child's representative's units, as quad_light_units gives them:
+        bool has_units;
         vec3 units[kQuadLanes], wi[kQuadLanes];
         float t_max[kQuadLanes];
     };
 
-    // The children's errors of `parent`'s refinement from ahead_, where
-    // errors_ahead found them; true if so.
-    ChildErrors* take_ahead(uint parent, float* errors_kept, float* errors_fresh) {
-        for (ChildErrors& c : ahead_) {
+    // The children's errors of `parent`'s refinement into errors_kept and
+    // errors_fresh, and the rest of what look_ahead found for it; nullptr
+    // (nothing written) where it found nothing.
+    const Ahead* take_ahead(uint parent, float* errors_kept, float* errors_fresh) {
+        for (Ahead& c : ahead_) {
             if (c.parent != parent) continue;
             for (uint p = 0; p < kQuadLanes; ++p) errors_kept[p] = c.kept[p], errors_fresh[p] = c.fresh[p];
             c.parent = kInvalidIndex;
@@ -466,7 +469,7 @@ private:
     // points, nodes and lights do not change during a cut), so the cut is
     // the one refined pair by pair; this halves the evaluations of a pass's
     // bounds and units where AVX-512 has the lanes.
-    void errors_ahead(uint at, uint w, uint words) {
+    void look_ahead(uint at, uint w, uint words) {
         const uint parent = entries_[slot_[at]].node;
         if (ahead_[0].parent == parent || ahead_[1].parent == parent) return;
         uint next = kInvalidIndex;
@@ -495,7 +498,7 @@ private:
                                                             k_.lights[nodes[3]->rep_light], f_.min_distance2,
                                                             units, wi, t_max);
         for (uint k = 0; k < 2u; ++k) {
-            ChildErrors& c = ahead_[k];
+            Ahead& c = ahead_[k];
             c.parent = parents[k];
             c.has_units = has_units;
             for (uint p = 0; p < kQuadLanes; ++p) {
@@ -532,7 +535,7 @@ private:
         QuadEntry& fresh = entries_[fresh_slot];
         kept.node = kept_index;
         fresh.node = fresh_index;
-        const ChildErrors* ahead = take_ahead(parent, kept.error, fresh.error);
+        const Ahead* ahead = take_ahead(parent, kept.error, fresh.error);
         if (ahead == nullptr) child_errors(kept_node, fresh_node, kept.error, fresh.error);
         const bool fresh_leaf = (fresh_node.flags & kNodeLeaf) != 0u;
         // The new representative's shadow ray from each point, the four
@@ -640,10 +643,10 @@ private:
     QuadLanes lanes_;
     quad8::QuadLanes lanes8_;  // lanes_ in both halves (child_errors)
     bool wide_ = false;        // lanes8_ is set and used
-    quad16::QuadLanes lanes16_;  // lanes_ in all four quarters (errors_ahead)
+    quad16::QuadLanes lanes16_;  // lanes_ in all four quarters (look_ahead)
     bool wide16_ = false;        // lanes16_ is set and used
 #endif
-    ChildErrors ahead_[2];  // errors_ahead
+    Ahead ahead_[2];  // look_ahead
     ShadeStats* stats_ = nullptr;
     QuadColor fixed_;     // each point's final estimates: leaves and frozen clusters
     QuadColor heap_sum_;  // ... and the running sum of the heap's
