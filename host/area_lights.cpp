@@ -8,9 +8,9 @@
 #include <glm/glm.hpp>
 
 #include "cpu_kernel.h"
+#include "run_on_threads.h"
 #include "scene/huge_pages.h"
 #include "shared/color.h"
-#include "run_on_threads.h"
 
 namespace lc {
 namespace {

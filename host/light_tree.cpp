@@ -30,8 +30,8 @@
 #include <glm/glm.hpp>
 
 #include "light_bounds.h"
-#include "scene/huge_pages.h"
 #include "run_on_threads.h"
+#include "scene/huge_pages.h"
 
 namespace lc {
 namespace {

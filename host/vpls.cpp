@@ -7,8 +7,8 @@
 
 #include "cpu_kernel.h"
 #include "path_emitters.h"
-#include "shared/color.h"
 #include "run_on_threads.h"
+#include "shared/color.h"
 
 namespace lc {
 namespace {

@@ -8,8 +8,8 @@
 #include <thread>
 #include <vector>
 
-#include "vk_check.h"
 #include "run_on_threads.h"
+#include "vk_check.h"
 
 namespace lc::vk {
 
