@@ -241,11 +241,36 @@ private:
     // over the points, at most FLT_MAX. A NaN bound is passed over, as
     // Walter's test never refines it.
     float key_of(const QuadEntry& e) const {
+#if defined(__SSE2__)
+        __m128 m = key_terms(e);
+        m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
+        m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+        return std::min(_mm_cvtss_f32(m), FLT_MAX);
+#else
         float key = 0.0f;
         for (uint p = 0; p < kQuadLanes; ++p)
             if (e.error[p] > 0.0f) key = std::max(key, e.error[p] * weight_[p]);
         return std::min(key, FLT_MAX);
+#endif
     }
+    // key_of(e) > relative_error: whether some point's ratio is above it.
+    bool above(const QuadEntry& e) const {
+#if defined(__SSE2__)
+        return _mm_movemask_ps(_mm_cmpgt_ps(key_terms(e), _mm_set1_ps(f_.relative_error))) != 0;
+#else
+        return key_of(e) > f_.relative_error;
+#endif
+    }
+#if defined(__SSE2__)
+    // key_of's ratios at the four points: each bound times its point's
+    // weight, zero where the bound is not above zero (NaN included). The
+    // products are the scalar ones, and a maximum or a comparison of them
+    // is exact, so key_of and above are bit for bit the loop's.
+    __m128 key_terms(const QuadEntry& e) const {
+        const __m128 error = _mm_loadu_ps(e.error);
+        return _mm_and_ps(_mm_mul_ps(error, _mm_loadu_ps(weight_)), _mm_cmpgt_ps(error, _mm_setzero_ps()));
+    }
+#endif
 
     void remove_estimate(const QuadEntry& e, QuadColor* into) {
         const vec3 intensity = k_.lc_node_intensity(k_.light_nodes[e.node]);
@@ -299,9 +324,9 @@ private:
             bool any = false;
             for (uint w = 0; w < words; ++w) marks_[w] = 0u;
             for (uint i = 0; i < size_; ++i) {
-                const bool above = key_of(entries_[slot_[i]]) > f_.relative_error;
-                marks_[i >> 5] |= uint(above) << (i & 31u);
-                any |= above;
+                const bool mark = above(entries_[slot_[i]]);
+                marks_[i >> 5] |= uint(mark) << (i & 31u);
+                any |= mark;
             }
             if (!any) return;
             for (uint w = 0; w < words && !heap_mode_; ++w)
