@@ -223,7 +223,7 @@ int run(int argc, char** argv) {
                 lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
                 std::size_t h = 0;
                 for (std::size_t i = b; i < e; ++i)
-                    h += trace(tk, p.bvh.wide8_nodes.data(), p.bvh.wide_leaves.data(), r[i].org, r[i].dir,
+                    h += trace(tk, p.bvh.wide8_nodes.data(), p.bvh.wide8_leaves.data(), r[i].org, r[i].dir,
                                r[i].t_max)
                              ? 1
                              : 0;
@@ -285,9 +285,9 @@ int run(int argc, char** argv) {
         if (lc::cpu::cpu_has_avx2())
             packets("software 8-wide BVH, packets of 4", [&](lc::cpu::TraceKernel& tk, const lc::cpu::RayPacket4& packet) {
                 return lc::cpu::cpu_has_avx512vl()
-                           ? lc::cpu::trace_any_wide8x4_avx512(tk, p.bvh.wide8_nodes.data(), p.bvh.wide_leaves.data(),
+                           ? lc::cpu::trace_any_wide8x4_avx512(tk, p.bvh.wide8_nodes.data(), p.bvh.wide8_leaves.data(),
                                                                 packet)
-                           : lc::cpu::trace_any_wide8x4_avx2(tk, p.bvh.wide8_nodes.data(), p.bvh.wide_leaves.data(),
+                           : lc::cpu::trace_any_wide8x4_avx2(tk, p.bvh.wide8_nodes.data(), p.bvh.wide8_leaves.data(),
                                                               packet);
             });
 #endif

@@ -8,7 +8,6 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
-#include <unordered_map>
 
 #include <glm/glm.hpp>
 
@@ -215,12 +214,12 @@ float half_area(const BvhNode& n) {
     return dx * dy + dy * dz + dz * dx;
 }
 
-// The wide leaf of binary leaf `leaf`.
-WideLeaf wide_leaf(const BvhNode& leaf, const std::vector<gpu::Triangle>& triangles) {
+// The wide leaf of the `count` (at most four) triangles from `first` on.
+WideLeaf wide_leaf(std::uint32_t first, std::uint32_t count, const std::vector<gpu::Triangle>& triangles) {
     WideLeaf w{};
-    w.first = leaf.first_or_left;
-    for (std::uint32_t lane = 0; lane < leaf.tri_count; ++lane) {
-        const gpu::Triangle& t = triangles[leaf.first_or_left + lane];
+    w.first = first;
+    for (std::uint32_t lane = 0; lane < count; ++lane) {
+        const gpu::Triangle& t = triangles[first + lane];
         const float v0[3] = {t.v0_x, t.v0_y, t.v0_z}, v1[3] = {t.v1_x, t.v1_y, t.v1_z},
                     v2[3] = {t.v2_x, t.v2_y, t.v2_z};
         for (int axis = 0; axis < 3; ++axis) {
@@ -245,28 +244,99 @@ Node empty_wide_node() {
     return w;
 }
 
-// Puts binary node `c` in slot s of w: its box and count, and for a leaf
-// the index of its wide leaf, which `leaf_index(c)` gives (an inner
-// child's index comes later).
+// Which binary nodes a wide tree takes as leaves: leaf_size[i] triangles
+// from first[i] on where node i is one (nonzero), 0 where it is inner.
+struct LeafView {
+    std::vector<std::uint32_t> leaf_size, first;
+};
+
+// The binary tree's own leaves (the 4-wide tree, which the kernels read).
+LeafView binary_leaves(const std::vector<BvhNode>& nodes) {
+    LeafView v;
+    v.leaf_size.resize(nodes.size());
+    v.first.resize(nodes.size());
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        v.leaf_size[i] = nodes[i].tri_count;
+        v.first[i] = nodes[i].first_or_left;
+    }
+    return v;
+}
+
+// The 8-wide tree's leaves: the binary leaves, and the subtrees of at most
+// kMaxLeaf triangles that are cheaper to test whole on the CPU's walk. The
+// binary tree is built for the kernels, which test a leaf one triangle per
+// trip of their loop, so that a node's boxes cost about one triangle
+// (kTraversalCost); the 8-wide walk tests a leaf's up to four triangles in
+// one SSE test, so there a split must save more to pay. A subtree is kept
+// whole where the builder's own leaf test prefers that at twice the
+// traversal cost (kWide8TraversalCost), and where its box is at most three
+// times as thick (its smallest extent) as the thickest of its leaves'
+// boxes (kWide8Thickening). Shadow rays leave surfaces: a box around two
+// surfaces that meet at a corner is entered by the rays leaving either one,
+// which their two flat boxes let pass. Without that second test the walk on
+// the gallery (walls, floor and plinths, 152 triangles) tested 14 times as
+// many leaves and its render took 6 to 8% longer; with it the room, the
+// bunny and the other shipped scenes render 0 to 4% faster, brute force
+// 2% (docs/results/speed.md, twenty-fourth session). A subtree's triangles
+// are contiguous (the build is depth first), so it is one leaf.
+constexpr double kWide8TraversalCost = 2.0;
+constexpr double kWide8Thickening = 3.0;
+
+LeafView wide8_leaves(const std::vector<BvhNode>& nodes) {
+    auto extents = [](const BvhNode& b) {
+        return glm::dvec3(double(b.max_x) - b.min_x, double(b.max_y) - b.min_y, double(b.max_z) - b.min_z);
+    };
+    auto area = [](glm::dvec3 d) { return d.x * d.y + d.y * d.z + d.z * d.x; };
+    auto thickness = [](glm::dvec3 d) { return std::min(d.x, std::min(d.y, d.z)); };
+    LeafView v = binary_leaves(nodes);
+    std::vector<std::uint32_t> under(nodes.size());  // the triangles under each node
+    std::vector<double> thickest(nodes.size());      // the thickest leaf box under each node
+    // Children come after their parent, so a reverse sweep sees them first.
+    for (std::size_t i = nodes.size(); i-- > 0;) {
+        const BvhNode& n = nodes[i];
+        if (n.tri_count > 0 || n.first_or_left == 0) {  // a leaf, or the root of an empty tree
+            under[i] = n.tri_count;
+            thickest[i] = thickness(extents(n));
+            continue;
+        }
+        const std::uint32_t l = n.first_or_left, r = l + 1u;
+        under[i] = under[l] + under[r];
+        v.first[i] = v.first[l];
+        thickest[i] = std::max(thickest[l], thickest[r]);
+        if (under[i] > kMaxLeaf) continue;
+        // As in build: a split that is not cheaper than the leaf is not made.
+        const glm::dvec3 d = extents(n);
+        const double children = under[l] * area(extents(nodes[l])) + under[r] * area(extents(nodes[r]));
+        const double split_cost = kIntersectCost * children + kWide8TraversalCost * area(d);
+        const bool cheaper_whole = !(split_cost < kIntersectCost * under[i] * area(d));
+        if (cheaper_whole && thickness(d) <= kWide8Thickening * thickest[i]) v.leaf_size[i] = under[i];
+    }
+    return v;
+}
+
+// Puts binary node `c` (index i) in slot s of w: its box and, where `view`
+// takes it as a leaf, its count and the index of its wide leaf, which
+// `leaf_index(i)` gives (an inner child's index comes later).
 template <class Node, class LeafIndex>
-void fill_slot(Node& w, std::uint32_t s, const BvhNode& c, LeafIndex& leaf_index) {
+void fill_slot(Node& w, std::uint32_t s, const BvhNode& c, std::uint32_t i, const LeafView& view,
+               LeafIndex& leaf_index) {
     w.lo_x[s] = c.min_x, w.lo_y[s] = c.min_y, w.lo_z[s] = c.min_z;
     w.hi_x[s] = c.max_x, w.hi_y[s] = c.max_y, w.hi_z[s] = c.max_z;
-    w.count[s] = std::int32_t(c.tri_count);
-    if (c.tri_count > 0) w.child[s] = leaf_index(c);
+    w.count[s] = std::int32_t(view.leaf_size[i]);
+    if (view.leaf_size[i] > 0) w.child[s] = leaf_index(i);
 }
 
 // Writes the wide node for the children of binary node `inner` at
 // wide[index], and its inner children's wide nodes after it (depth first).
 template <class Node, class LeafIndex>
-void collapse(const std::vector<BvhNode>& nodes, std::uint32_t inner, std::uint32_t index, std::vector<Node>& wide,
-              LeafIndex& leaf_index) {
+void collapse(const std::vector<BvhNode>& nodes, const LeafView& view, std::uint32_t inner, std::uint32_t index,
+              std::vector<Node>& wide, LeafIndex& leaf_index) {
     std::array<std::uint32_t, kSlots<Node>> slots{nodes[inner].first_or_left, nodes[inner].first_or_left + 1u};
     std::uint32_t used = 2;
     while (used < kSlots<Node>) {
         int widest = -1;
         for (std::uint32_t s = 0; s < used; ++s)
-            if (nodes[slots[s]].tri_count == 0 &&
+            if (view.leaf_size[slots[s]] == 0 &&
                 (widest < 0 || half_area(nodes[slots[s]]) > half_area(nodes[slots[std::size_t(widest)]])))
                 widest = int(s);
         if (widest < 0) break;
@@ -275,39 +345,44 @@ void collapse(const std::vector<BvhNode>& nodes, std::uint32_t inner, std::uint3
         slots[used++] = left + 1u;
     }
     Node w = empty_wide_node<Node>();
-    for (std::uint32_t s = 0; s < used; ++s) fill_slot(w, s, nodes[slots[s]], leaf_index);
+    for (std::uint32_t s = 0; s < used; ++s) fill_slot(w, s, nodes[slots[s]], slots[s], view, leaf_index);
     wide[index] = w;
     for (std::uint32_t s = 0; s < used; ++s) {
         if (w.count[s] != 0) continue;
         const auto child = std::uint32_t(wide.size());
         wide.emplace_back();
         wide[index].child[s] = child;
-        collapse(nodes, slots[s], child, wide, leaf_index);
+        collapse(nodes, view, slots[s], child, wide, leaf_index);
     }
 }
 
-template <class Node, class LeafIndex>
-void collapse_tree(const std::vector<BvhNode>& nodes, std::vector<Node>& wide_nodes, LeafIndex leaf_index) {
+// The wide tree of `nodes` with `view`'s leaves, each made a WideLeaf of
+// `triangles` into `leaves`.
+template <class Node>
+void collapse_tree(const std::vector<BvhNode>& nodes, const LeafView& view,
+                   const std::vector<gpu::Triangle>& triangles, std::vector<Node>& wide_nodes,
+                   std::vector<WideLeaf>& leaves) {
+    leaves.clear();
+    auto leaf_index = [&](std::uint32_t i) {
+        leaves.push_back(wide_leaf(view.first[i], view.leaf_size[i], triangles));
+        return std::uint32_t(leaves.size() - 1);
+    };
     wide_nodes.assign(1, empty_wide_node<Node>());
     if (nodes.empty()) return;
     const BvhNode& r = nodes[0];
     if (r.tri_count == 0 && r.first_or_left == 0) return;  // no triangles (build_bvh's far root)
-    if (r.tri_count > 0) {
-        fill_slot(wide_nodes[0], 0, r, leaf_index);  // a root leaf: one slot holding it
+    if (view.leaf_size[0] > 0) {
+        fill_slot(wide_nodes[0], 0, r, 0, view, leaf_index);  // a root leaf: one slot holding it
         return;
     }
-    collapse(nodes, 0, 0, wide_nodes, leaf_index);
+    collapse(nodes, view, 0, 0, wide_nodes, leaf_index);
 }
 
 }  // namespace
 
 void collapse_bvh(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
                   std::vector<WideBvhNode>& wide_nodes, std::vector<WideLeaf>& wide_leaves) {
-    wide_leaves.clear();
-    collapse_tree(nodes, wide_nodes, [&](const BvhNode& leaf) {
-        wide_leaves.push_back(wide_leaf(leaf, triangles));
-        return std::uint32_t(wide_leaves.size() - 1);
-    });
+    collapse_tree(nodes, binary_leaves(nodes), triangles, wide_nodes, wide_leaves);
 }
 
 namespace {
@@ -386,13 +461,9 @@ std::vector<gpu::Bvh4Node> bvh4_nodes(const std::vector<WideBvhNode>& wide_nodes
     return out;
 }
 
-void collapse_bvh8(const std::vector<BvhNode>& nodes, const std::vector<WideLeaf>& wide_leaves,
-                   std::vector<WideBvhNode8>& wide_nodes) {
-    // The binary leaves' triangle ranges are disjoint, so a leaf's first
-    // triangle names its wide leaf.
-    std::unordered_map<std::uint32_t, std::uint32_t> leaf_of_first;
-    for (std::uint32_t i = 0; i < wide_leaves.size(); ++i) leaf_of_first[wide_leaves[i].first] = i;
-    collapse_tree(nodes, wide_nodes, [&](const BvhNode& leaf) { return leaf_of_first.at(leaf.first_or_left); });
+void collapse_bvh8(const std::vector<BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
+                   std::vector<WideBvhNode8>& wide_nodes, std::vector<WideLeaf>& wide_leaves) {
+    collapse_tree(nodes, wide8_leaves(nodes), triangles, wide_nodes, wide_leaves);
 }
 
 Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNormals>& normals,
@@ -419,7 +490,7 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
         constexpr float far = std::numeric_limits<float>::max();
         bvh.nodes.push_back(BvhNode{far, far, far, 0u, far, far, far, 0u});
         collapse_bvh(bvh.nodes, triangles, bvh.wide_nodes, bvh.wide_leaves);
-        collapse_bvh8(bvh.nodes, bvh.wide_leaves, bvh.wide8_nodes);
+        collapse_bvh8(bvh.nodes, triangles, bvh.wide8_nodes, bvh.wide8_leaves);
         bvh.kernel_nodes = bvh4_nodes(bvh.wide_nodes, bvh.wide_leaves);
         bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return bvh;
@@ -460,7 +531,7 @@ Bvh build_bvh(std::vector<gpu::Triangle>& triangles, std::vector<gpu::TriangleNo
     }
 
     collapse_bvh(bvh.nodes, triangles, bvh.wide_nodes, bvh.wide_leaves);
-    collapse_bvh8(bvh.nodes, bvh.wide_leaves, bvh.wide8_nodes);
+    collapse_bvh8(bvh.nodes, triangles, bvh.wide8_nodes, bvh.wide8_leaves);
     bvh.kernel_nodes = bvh4_nodes(bvh.wide_nodes, bvh.wide_leaves);
     bvh.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return bvh;

@@ -185,7 +185,8 @@ struct BasicShadeKernel {
     const BvhNode* bvh_nodes = nullptr;
     const WideBvhNode* wide_nodes = nullptr;  // the same tree 4 wide, for shadow rays (none: bvh_nodes)
     const WideLeaf* wide_leaves = nullptr;    // its leaves' triangles
-    const WideBvhNode8* wide8_nodes = nullptr;  // the same tree 8 wide (its leaves: wide_leaves), where the CPU has AVX2
+    const WideBvhNode8* wide8_nodes = nullptr;  // the same tree 8 wide, where the CPU has AVX2
+    const WideLeaf* wide8_leaves = nullptr;     // ... and its leaves
     const Triangle* triangles = nullptr;
     const TriangleNormals* normals = nullptr;
     const TriangleUvs* uvs = nullptr;
@@ -394,7 +395,7 @@ struct BasicShadeKernel {
     // 8-wide 1.1 to 1.3 times the 4-wide's on lightcuts' rays; bench/embree_rays).
     bool lc_trace_shadow(vec3 org, vec3 dir, float t_max) {
 #if defined(LC_WIDE8_TRACE)
-        if (wide8_nodes != nullptr) return trace_any_wide8(*this, wide8_nodes, wide_leaves, org, dir, t_max);
+        if (wide8_nodes != nullptr) return trace_any_wide8(*this, wide8_nodes, wide8_leaves, org, dir, t_max);
 #endif
         return wide_nodes != nullptr ? trace_any_wide(*this, wide_nodes, wide_leaves, org, dir, t_max)
                                      : lc_trace_any(org, dir, t_max);
@@ -411,8 +412,8 @@ struct BasicShadeKernel {
         if (!kEnableShadows) return valid;
 #if defined(LC_WIDE8_TRACE)
         if (!kRecordRays && wide8_nodes != nullptr)
-            return valid & ~(cpu_has_avx512vl() ? trace_any_wide8x4_avx512(*this, wide8_nodes, wide_leaves, packet)
-                                                : trace_any_wide8x4_avx2(*this, wide8_nodes, wide_leaves, packet));
+            return valid & ~(cpu_has_avx512vl() ? trace_any_wide8x4_avx512(*this, wide8_nodes, wide8_leaves, packet)
+                                                : trace_any_wide8x4_avx2(*this, wide8_nodes, wide8_leaves, packet));
 #endif
         if (!kRecordRays && wide_nodes != nullptr) return valid & ~trace_any_wide4(*this, wide_nodes, wide_leaves, packet);
         unsigned visible = 0u;
@@ -436,7 +437,10 @@ BasicShadeKernel<kRecordRays> make_shade_kernel(const PreparedScene& p, CutHeap*
     k.bvh_nodes = p.bvh.nodes.data();
     k.wide_nodes = p.bvh.wide_nodes.empty() ? nullptr : p.bvh.wide_nodes.data();
     k.wide_leaves = p.bvh.wide_leaves.data();
-    if (cpu_has_avx2() && !p.bvh.wide8_nodes.empty()) k.wide8_nodes = p.bvh.wide8_nodes.data();
+    if (cpu_has_avx2() && !p.bvh.wide8_nodes.empty()) {
+        k.wide8_nodes = p.bvh.wide8_nodes.data();
+        k.wide8_leaves = p.bvh.wide8_leaves.data();
+    }
     k.triangles = p.scene.triangles.data();
     k.normals = p.scene.normals.data();
     k.uvs = p.scene.uvs.data();

@@ -6,6 +6,12 @@
 // by lane with the same operations in the same order, so the answer is the
 // binary traversal's: a triangle is tested here whenever it is there (each
 // of its boxes passes the same test), and each test gives the same result.
+// (The 8-wide tree also tests some triangles together that the binary tree
+// keeps apart, in leaves of their own (collapse_bvh8). A triangle the ray
+// hits lies inside its own boxes, and lc_hit_box widens the far distance
+// so that rounding does not make a ray miss a box around its hit point:
+// the extra tests find nothing the binary walk does not. The Bvh tests
+// check every walk against brute force.)
 // A change to lc_hit_box or lc_intersect_sheared (shaders/shared/trace.h)
 // must be made here too; the Bvh tests compare the two traversals.
 #pragma once

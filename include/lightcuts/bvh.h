@@ -24,7 +24,7 @@ struct alignas(16) WideBvhNode {
 // The same tree 8 wide, for CPUs with AVX2 (host/wide_trace.h,
 // trace_any_wide8): up to eight children's boxes per node, tested in one
 // 256-bit slab test. Fewer levels than the 4-wide tree, so a ray visits
-// fewer nodes. Made by collapse_bvh8; its leaves are the 4-wide tree's.
+// fewer nodes. Made by collapse_bvh8, with leaves of its own (Bvh::wide8_leaves).
 struct alignas(32) WideBvhNode8 {
     float lo_x[8], lo_y[8], lo_z[8];
     float hi_x[8], hi_y[8], hi_z[8];
@@ -45,7 +45,8 @@ struct Bvh {
     std::vector<gpu::BvhNode> nodes;      // root at 0 (a single empty leaf if no triangles)
     std::vector<WideBvhNode> wide_nodes;  // root at 0 (all slots empty if no triangles)
     std::vector<WideLeaf> wide_leaves;    // one per leaf of wide_nodes
-    std::vector<WideBvhNode8> wide8_nodes;  // root at 0 (all slots empty if no triangles); leaves in wide_leaves
+    std::vector<WideBvhNode8> wide8_nodes;  // root at 0 (all slots empty if no triangles)
+    std::vector<WideLeaf> wide8_leaves;     // one per leaf of wide8_nodes
     std::vector<gpu::Bvh4Node> kernel_nodes;  // wide_nodes as the Vulkan kernels read them (bvh4_nodes)
     double build_seconds = 0.0;
 };
@@ -56,10 +57,12 @@ struct Bvh {
 // four.
 void collapse_bvh(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
                   std::vector<WideBvhNode>& wide_nodes, std::vector<WideLeaf>& wide_leaves);
-// The same with up to eight children per node, over the wide leaves
-// collapse_bvh made of the same binary tree.
-void collapse_bvh8(const std::vector<gpu::BvhNode>& nodes, const std::vector<WideLeaf>& wide_leaves,
-                   std::vector<WideBvhNode8>& wide_nodes);
+// The same with up to eight children per node, for the CPU's shadow rays:
+// its leaves are the binary leaves and the small subtrees (at most four
+// triangles) that a leaf test costs less than splitting on the 8-wide walk
+// (bvh_build.cpp, wide8_leaves).
+void collapse_bvh8(const std::vector<gpu::BvhNode>& nodes, const std::vector<gpu::Triangle>& triangles,
+                   std::vector<WideBvhNode8>& wide_nodes, std::vector<WideLeaf>& wide_leaves);
 
 // The 4-wide tree as the Vulkan kernels' shadow rays read it: wide_nodes
 // with each leaf slot naming the leaf's first triangle (WideLeaf::first)
