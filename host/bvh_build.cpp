@@ -274,12 +274,11 @@ LeafView binary_leaves(const std::vector<BvhNode>& nodes) {
 // boxes (kWide8Thickening). Shadow rays leave surfaces: a box around two
 // surfaces that meet at a corner is entered by the rays leaving either one,
 // which their two flat boxes let pass. Without that second test the walk on
-// the gallery (a hall of 152 triangles) tested 14 times as
-// many leaves and its render took 6 to 8% longer; with it Lightcuts renders
-// the room 4% faster, the bunny 10%, the other shipped scenes 0 to 6%, and
-// brute force the room 7% (docs/results/speed.md, twenty-fourth session).
-// A subtree's triangles are contiguous (the build is depth first), so it is
-// one leaf.
+// the gallery (a hall of 152 triangles) tested 14 times as many leaves and
+// its render took 6 to 8% longer; with it Lightcuts renders the room 4%
+// faster, the bunny 10%, the other shipped scenes 0 to 6%, and brute force
+// the room 7% (docs/results/speed.md, twenty-fourth session). A subtree's
+// triangles are contiguous (the build is depth first), so it is one leaf.
 constexpr double kWide8TraversalCost = 2.0;
 constexpr double kWide8Thickening = 3.0;
 
