@@ -255,16 +255,16 @@ int run(int argc, char** argv) {
         for (std::uint64_t n : trips) trip_total += n;
         std::printf("    %.2f trips round the kernels' loop per ray\n", double(trip_total) / double(r.size()));
 
-        // Consecutive rays four at a time, `trace(kernel, packet)` giving the
-        // blocked ones.
-        auto packets = [&](const char* what, auto trace) {
+        // Consecutive rays R at a time (a packet of R = 4 or 8),
+        // `trace(kernel, packet)` giving the blocked ones.
+        auto packets = [&]<unsigned R>(const char* what, auto trace) {
             std::fill(hits.begin(), hits.end(), 0);
             s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
                 lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
                 std::size_t h = 0;
-                for (std::size_t i = b; i < e; i += 4) {
-                    lc::cpu::RayPacket4 packet;
-                    for (std::size_t j = 0; j < 4 && i + j < e; ++j) {
+                for (std::size_t i = b; i < e; i += R) {
+                    lc::cpu::RayPacket<R> packet;
+                    for (std::size_t j = 0; j < R && i + j < e; ++j) {
                         packet.org[j] = r[i + j].org, packet.dir[j] = r[i + j].dir, packet.t_max[j] = r[i + j].t_max;
                         packet.valid |= 1u << j;
                     }
@@ -274,22 +274,30 @@ int run(int argc, char** argv) {
             });
             report(what, r.size(), s, total(), reference);
         };
-        packets("software 4-wide BVH, packets of 4", [&](lc::cpu::TraceKernel& tk, const lc::cpu::RayPacket4& packet) {
+        packets.template operator()<4>("software 4-wide BVH, packets of 4",
+                                       [&](lc::cpu::TraceKernel& tk, const lc::cpu::RayPacket4& packet) {
             return lc::cpu::trace_any_wide4(tk, p.bvh.wide_nodes.data(), p.bvh.wide_leaves.data(), packet);
         });
 #if defined(LC_WIDE8_TRACE)
-        // Four consecutive rays down the 8-wide tree together, each tested
-        // on its own (trace_any_wide8x4): the renderer's packets, brute
-        // force's four lights from one point and a quad's four points to
-        // one light (the latter are not in these ray lists).
-        if (lc::cpu::cpu_has_avx2())
-            packets("software 8-wide BVH, packets of 4", [&](lc::cpu::TraceKernel& tk, const lc::cpu::RayPacket4& packet) {
-                return lc::cpu::cpu_has_avx512vl()
-                           ? lc::cpu::trace_any_wide8x4_avx512(tk, p.bvh.wide8_nodes.data(), p.bvh.wide8_leaves.data(),
-                                                                packet)
-                           : lc::cpu::trace_any_wide8x4_avx2(tk, p.bvh.wide8_nodes.data(), p.bvh.wide8_leaves.data(),
-                                                              packet);
+        // Four and eight consecutive rays down the 8-wide tree together,
+        // each tested on its own (trace_any_wide8x4, trace_any_wide8x8): the
+        // renderer's packets, brute force's eight lights from one point and
+        // a quad's four or an octet's eight points to one light (the latter
+        // are not in these ray lists).
+        const lc::WideBvhNode8* nodes8 = p.bvh.wide8_nodes.data();
+        const lc::WideLeaf* leaves8 = p.bvh.wide8_leaves.data();
+        if (lc::cpu::cpu_has_avx2()) {
+            packets.template operator()<4>("software 8-wide BVH, packets of 4",
+                                           [&](lc::cpu::TraceKernel& tk, const lc::cpu::RayPacket4& packet) {
+                return lc::cpu::cpu_has_avx512vl() ? lc::cpu::trace_any_wide8x4_avx512(tk, nodes8, leaves8, packet)
+                                                   : lc::cpu::trace_any_wide8x4_avx2(tk, nodes8, leaves8, packet);
             });
+            packets.template operator()<8>("software 8-wide BVH, packets of 8",
+                                           [&](lc::cpu::TraceKernel& tk, const lc::cpu::RayPacket8& packet) {
+                return lc::cpu::cpu_has_avx512vl() ? lc::cpu::trace_any_wide8x8_avx512(tk, nodes8, leaves8, packet)
+                                                   : lc::cpu::trace_any_wide8x8_avx2(tk, nodes8, leaves8, packet);
+            });
+        }
 #endif
 
         std::fill(hits.begin(), hits.end(), 0);

@@ -11,20 +11,22 @@
    of shadow rays) and the speedup, from the medians of brute force's
    renders (--brute-runs, 3 by default) and lightcuts', taken in turn so
    that the machine's drift reaches both; at the defaults (the CPU's cuts shared
-   by 2x2 quads of pixels) and with a cut per pixel (cut_sharing "pixel", as
+   by 4x2 octets of pixels) and with a cut per pixel (cut_sharing "pixel", as
    the Vulkan kernels cut).
 2. The K table: every shipped scene rendered with lightcuts on the CPU with a
    cut per pixel and a cut heap of K slots for each K of --heaps and with a
    heap as large as the tree needs (nothing frozen), then at the defaults
-   (quads, K = 64 slots per pixel pooled by each quad), against brute force:
+   (octets, K = 64 slots per pixel pooled by each octet) and with cuts
+   shared by 2x2 quads, against brute force:
    relative RMSE, pixels above 2%, mean cut, shadow rays per pixel, the
    share of samples that froze clusters, and the time.
 3. The Vulkan path (lavapipe) on the room with 10^4 lights at the same size
    for each K that fits its shared memory, with the CPU path cutting each
    pixel alone (the same image) in the same run, and the CPU at its
    defaults: the Vulkan/CPU time ratios, and the samples whose heap waited
-   in global memory between dispatches; and the CPU's own cuts, shared by
-   quads, on both (cut_sharing "quad", shaders/quadcuts.comp).
+   in global memory between dispatches; and cuts shared by
+   quads, on both (cut_sharing "quad", shaders/quadcuts.comp); the kernels
+   have no octets.
 
 Writes DIR/speed.md and DIR/speed.json (default out/speed). Nothing here
 passes or fails. --quick: 32x32, two scenes (CI's bench label runs it);
@@ -109,7 +111,7 @@ def main():
 
     # 1 and 2: brute force per scene (the rooms: --brute-runs times), lightcuts per heap size.
     lines += ["## Lightcuts against brute force (defaults: error 0.02, max cut 1000, cut_heap 64, cuts shared "
-              "by quads)", "",
+              "by octets)", "",
               "brute s: the median of brute force's renders, the first before the K table (its image is the "
               "reference) and the others after it, each in brackets. lightcuts s: the median of the renders at "
               "the defaults before brute force, at the end of the K table and after it, taking turns with brute "
@@ -119,8 +121,10 @@ def main():
               "| ratio | speedup | pixel s | pixel rays/px | pixel speedup |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     table = ["## The cut heap: K slots against a heap as large as the tree needs", "",
-             "Rows `pixel`: a cut per pixel, K slots per pixel (the Vulkan kernels' heap). Row `quad`: the "
-             "defaults, a cut per 2x2 quad with its pixels' 4 x 64 slots pooled.", "",
+             "Rows `pixel`: a cut per pixel, K slots per pixel (the Vulkan kernels' heap). Row `quad`: a cut "
+             "per 2x2 quad with its pixels' 4 x 64 slots pooled. Row `octet`: the defaults, a cut per 4x2 "
+             "octet with its pixels' 8 x 64 slots pooled (a tile's blocks after an octet whose cut reached "
+             "max_cut cut as quads).", "",
              "| scene | cuts | K | relative RMSE | above 2% | mean cut | rays/px | samples that froze | time s |",
              "|---|---|---|---|---|---|---|---|---|"]
     for scene in [] if a.vulkan_only else scenes:
@@ -141,7 +145,7 @@ def main():
         ref, bstats = render(a.out, scene, name + "_brute", size, "brute")
         pixels = size * size
         pixel = None
-        for sharing, k in [("pixel", k) for k in heaps + [UNBOUNDED]] + [("quad", None)]:
+        for sharing, k in [("pixel", k) for k in heaps + [UNBOUNDED]] + [("quad", None), ("octet", None)]:
             print(f"{scene}: lightcuts, {sharing}, cut_heap {k or 'default'}", file=sys.stderr)
             img, s = render(a.out, scene, f"{name}_{sharing}_k{k or 'default'}", size, "lightcuts", cut_heap=k,
                             sharing=sharing)
@@ -158,7 +162,7 @@ def main():
                          f"{row['seconds']:.3f} |")
             if sharing == "pixel" and k == 64:
                 pixel = s
-            if sharing == "quad" and room:
+            if sharing == "octet" and room:
                 lightcuts_times.append(s["seconds"]["render"])
         if not room:
             continue
@@ -199,7 +203,7 @@ def main():
                       "timestamps of the camera-ray and shading kernels. Each K rendered once at 8x8 first, so that "
                       "its kernels are in Mesa's shader cache.", "",
                       "CPU s: the CPU path with a cut per pixel, the image the Vulkan kernels make; CPU default s: "
-                      "at the CPU's defaults (cuts shared by quads, once at K = 64).", "",
+                      "at the CPU's defaults (cuts shared by octets, once at K = 64).", "",
                       "| K | CPU s | Vulkan s | Vulkan/CPU | kernels s | kernels/CPU | heaps paused in global memory "
                       "| relative RMSE vulkan vs cpu |",
                       "|---|---|---|---|---|---|---|---|"]
@@ -229,12 +233,13 @@ def main():
                                                              "ratio": tv / default_cpu}
                     lines.append(f"| 64, CPU at its defaults | {default_cpu:.3f} | {tv:.3f} | {tv / default_cpu:.1f} "
                                  f"| {tk:.3f} | {tk / default_cpu:.1f} | | |")
-            # The CPU's own cuts (quads) on Vulkan too (quadcuts.comp), at
-            # the default K, against the CPU at its defaults: the same cuts.
+            # The CPU's quads on Vulkan too (quadcuts.comp), at the default
+            # K: the same cuts as the CPU's with cut_sharing "quad" (the
+            # image compared), timed against the CPU at its defaults.
             try:
                 render(a.out, scene, "vk_warm_quad", 8, "lightcuts", device="vulkan", sharing="quad")
                 qimg, qs = render(a.out, scene, "vk_quad", size, "lightcuts", device="vulkan", sharing="quad")
-                dimg = os.path.join(a.out, "vk_cpu_default.exr")
+                dimg = render(a.out, scene, "vk_cpu_quad", size, "lightcuts", sharing="quad")[0]
                 c = compare(qimg, dimg)
                 tq = qs["seconds"]["render"]
                 tk = qs["seconds"]["primary"] + qs["seconds"]["shading"]
@@ -242,7 +247,7 @@ def main():
                 results["vulkan_quads"] = {"cpu_default_seconds": default_cpu, "vulkan_seconds": tq,
                                            "kernel_seconds": tk, "ratio": tq / default_cpu, "paused": paused,
                                            "rmse": c["rmse"]}
-                lines.append(f"| 64, quads on both (cut_sharing quad) | {default_cpu:.3f} | {tq:.3f} | "
+                lines.append(f"| 64, quads on Vulkan (cut_sharing quad), CPU at its defaults | {default_cpu:.3f} | {tq:.3f} | "
                              f"{tq / default_cpu:.1f} | {tk:.3f} | {tk / default_cpu:.1f} | {100 * paused:.1f}% | "
                              f"{c['rmse']:.2e} |")
             except subprocess.CalledProcessError:

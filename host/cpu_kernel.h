@@ -355,19 +355,22 @@ struct BasicShadeKernel {
         return lc_luminance(largest * lc_node_intensity(node));
     }
 
-    // lc_shade_brute's result, bit for bit, with the shadow rays traced four
-    // at a time: a point's rays to consecutive lights, which the tree's
-    // leaf order keeps close together, go down the tree as one packet
-    // (lc_visible4). The contributions are summed in light order, as there.
+    // lc_shade_brute's result, bit for bit, with the shadow rays traced
+    // eight at a time: a point's rays to consecutive lights, which the
+    // tree's leaf order keeps close together, go down the tree as one packet
+    // (lc_visible8; the room at 10^4 lights 4% faster than in packets of
+    // four, the gallery 1% slower, docs/results/speed.md). The
+    // contributions are summed in light order, as there.
     vec3 lc_shade_brute_packets(const SurfacePoint& sp, uint light_count, float min_distance2, ShadeStats& stats) {
         if (kRecordRays || wide_nodes == nullptr) return lc_shade_brute(sp, light_count, min_distance2, stats);
+        constexpr uint R = 8u;
         vec3 sum(0.0f);
-        RayPacket4 packet;
-        vec3 contribution[4];
+        RayPacket8 packet;
+        vec3 contribution[R];
         uint pending = 0u;
         auto trace = [&] {
             packet.valid = (1u << pending) - 1u;
-            const unsigned visible = lc_visible4(packet);
+            const unsigned visible = lc_visible8(packet);
             for (uint j = 0; j < pending; ++j)
                 if ((visible >> j & 1u) != 0u) sum += contribution[j];
             pending = 0u;
@@ -383,7 +386,7 @@ struct BasicShadeKernel {
             packet.dir[pending] = wi;
             packet.t_max[pending] = t_max;
             contribution[pending] = unit * lc_light_intensity(light);
-            if (++pending == 4u) trace();
+            if (++pending == R) trace();
         }
         if (pending > 0u) trace();
         return sum;
@@ -404,9 +407,9 @@ struct BasicShadeKernel {
     // lc_visible for up to four rays (bit r of packet.valid): bit r of the
     // result is set where ray r is visible. Each answer is lc_visible's;
     // the rays go down the 8-wide tree together where it is bound
-    // (trace_any_wide8x4: a quad's points' rays to one light, brute force's
-    // rays from one point to four lights), else through the 4-wide one as a
-    // packet (trace_any_wide4), else one at a time (the ray recorder).
+    // (trace_any_wide8x4: a quad's points' rays to one light), else through
+    // the 4-wide one as a packet (trace_any_wide4), else one at a time (the
+    // ray recorder).
     unsigned lc_visible4(const RayPacket4& packet) {
         const unsigned valid = packet.valid & 0xFu;
         if (!kEnableShadows) return valid;
@@ -422,6 +425,31 @@ struct BasicShadeKernel {
             SurfacePoint at;
             at.p = packet.org[r];
             if (lc_visible(at, packet.dir[r], packet.t_max[r])) visible |= 1u << r;
+        }
+        return visible;
+    }
+
+    // lc_visible4 for up to eight rays (an octet's points' rays to one
+    // light, brute force's rays from one point to eight lights): down the
+    // 8-wide tree together (trace_any_wide8x8), else as two packets of four.
+    unsigned lc_visible8(const RayPacket8& packet) {
+        const unsigned valid = packet.valid & 0xFFu;
+        if (!kEnableShadows) return valid;
+#if defined(LC_WIDE8_TRACE)
+        if (!kRecordRays && wide8_nodes != nullptr)
+            return valid & ~(cpu_has_avx512vl() ? trace_any_wide8x8_avx512(*this, wide8_nodes, wide8_leaves, packet)
+                                                : trace_any_wide8x8_avx2(*this, wide8_nodes, wide8_leaves, packet));
+#endif
+        unsigned visible = 0u;
+        for (unsigned h = 0; h < 2u; ++h) {
+            RayPacket4 half;
+            for (unsigned r = 0; r < 4u; ++r) {
+                half.org[r] = packet.org[4u * h + r];
+                half.dir[r] = packet.dir[4u * h + r];
+                half.t_max[r] = packet.t_max[4u * h + r];
+            }
+            half.valid = valid >> 4u * h & 0xFu;
+            if (half.valid != 0u) visible |= lc_visible4(half) << 4u * h;
         }
         return visible;
     }

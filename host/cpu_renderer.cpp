@@ -1,9 +1,9 @@
 // CPU reference renderer: the shared kernels (host/cpu_kernel.h) run per
 // pixel over 8x8 tiles handed out to worker threads; Lightcuts' cuts are
-// shared by the four pixels of each 2x2 quad of a tile (host/quad_cut.h)
-// unless cut_sharing is "pixel". Every pixel (or quad) is computed
-// independently in a fixed order, so the image is bit-identical whatever
-// the thread count.
+// shared by the eight pixels of each 4x2 octet of a tile (host/quad_cut.h),
+// or by the four of each 2x2 quad (cut_sharing "quad"), unless cut_sharing
+// is "pixel". Every pixel (or block) is computed independently in a fixed
+// order, so the image is bit-identical whatever the thread count.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -22,11 +22,13 @@
 namespace lc {
 namespace {
 
-// What each worker thread owns: its cut heap and its counters, on cache
-// lines of its own (the counters change at every pixel).
+// What each worker thread owns: its cut heap (a point's, a quad's or an
+// octet's) and its counters, on cache lines of its own (the counters change
+// at every pixel).
 struct alignas(64) Worker {
     cpu::CutHeap heap;
     cpu::QuadHeap quad_heap;
+    cpu::OctetHeap octet_heap;
     std::uint64_t shadow_rays = 0;
     std::uint64_t max_cut_hits = 0;
     std::uint64_t cut_indirect = 0;
@@ -95,38 +97,84 @@ PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Meth
     return {sum / float(frame.spp), float(double(cut_sum) / frame.spp), float(double(froze) / frame.spp)};
 }
 
-// The 2x2 block of pixels at (x0, y0) (those inside the image), its samples
-// shaded by quad-shared cuts (host/quad_cut.h).
-void shade_quad(cpu::ShadeKernel& k, const gpu::FrameParams& frame, std::uint32_t x0, std::uint32_t y0, Worker& t,
-                PixelResult* out) {
-    glm::vec3 sum[4] = {};
-    std::uint64_t cut_sum[4] = {};
-    std::uint32_t froze[4] = {};
-    cpu::QuadCut<cpu::ShadeKernel> quad(k, t.quad_heap, frame);
+// The block of N pixels at (x0, y0) (those inside the image), its samples
+// shaded by one shared cut (host/quad_cut.h): a 2x2 quad for N = 4, two
+// quads side by side (a 4x2 octet) for N = 8. Point q is pixel (x0 +
+// block_x(q), y0 + block_y(q)): each quad's four in the order of the
+// quad's subgroup lanes (shaders/quadcuts.comp), the left quad's first.
+// Returns whether some sample's cut stopped at max_cut.
+constexpr std::uint32_t block_x(std::uint32_t q) { return (q & 1u) + 2u * (q >> 2u); }
+constexpr std::uint32_t block_y(std::uint32_t q) { return q >> 1u & 1u; }
+
+template <std::uint32_t N>
+bool shade_block(cpu::ShadeKernel& k, const gpu::FrameParams& frame, std::uint32_t x0, std::uint32_t y0, Worker& t,
+                 PixelResult* out) {
+    glm::vec3 sum[N] = {};
+    std::uint64_t cut_sum[N] = {};
+    std::uint32_t froze[N] = {};
+    cpu::BlockHeap<N>* heap;
+    if constexpr (N == 4u) heap = &t.quad_heap;
+    else heap = &t.octet_heap;
+    cpu::BlockCut<cpu::ShadeKernel, N> block(k, *heap, frame);
+    bool hit = false;
     for (std::uint32_t s = 0; s < frame.spp; ++s) {
-        cpu::ShadeKernel::SurfacePoint sp[4];
+        cpu::ShadeKernel::SurfacePoint sp[N];
         unsigned active = 0u;
-        for (std::uint32_t q = 0; q < 4u; ++q) {
-            const std::uint32_t x = x0 + (q & 1u), y = y0 + (q >> 1u);
+        for (std::uint32_t q = 0; q < N; ++q) {
+            const std::uint32_t x = x0 + block_x(q), y = y0 + block_y(q);
             if (x >= frame.width || y >= frame.height) continue;
             glm::vec3 seen;
             if (k.lc_camera_sample(frame, x, y, s, sp[q], seen)) active |= 1u << q;
             sum[q] += seen;
         }
         if (active == 0u) continue;
-        glm::vec3 radiance[4];
-        cpu::ShadeKernel::ShadeStats ss[4];
-        quad.shade(sp, active, radiance, ss);
-        for (std::uint32_t q = 0; q < 4u; ++q) {
+        glm::vec3 radiance[N];
+        cpu::ShadeKernel::ShadeStats ss[N];
+        block.shade(sp, active, radiance, ss);
+        for (std::uint32_t q = 0; q < N; ++q) {
             if ((active >> q & 1u) == 0u) continue;
             sum[q] += radiance[q];
             cut_sum[q] += ss[q].cut_size;
             froze[q] += tally(t, ss[q]) ? 1u : 0u;
+            hit = hit || ss[q].hit_max_cut != 0u;
         }
     }
-    for (std::uint32_t q = 0; q < 4u; ++q)
+    for (std::uint32_t q = 0; q < N; ++q)
         out[q] = {sum[q] / float(frame.spp), float(double(cut_sum[q]) / frame.spp),
                   float(double(froze[q]) / frame.spp)};
+    return hit;
+}
+
+// A tile's pixels, 4x2 at a time, by octets' cuts where they stay below
+// max_cut. The union of eight points' refinements is capped at max_cut
+// like one point's cut (each point casts a ray for nearly every cluster
+// of it), so where the cuts are long the cap leaves each point less of a
+// cut of its own than a quad's would: on the spot gallery, every octet
+// cut alike, relative RMSE against brute force 0.0384 -> 0.0425 and 17.6%
+// -> 22.1% of its pixels above 5% (128x128). So after an octet whose cut
+// reached max_cut the tile's next blocks are cut as two quads, until both
+// stay below it (0.0403 and 18.5%, at 81% of the quads' time). Tiles are
+// shaded in a fixed order, so the image does not depend on the threads.
+// store(x, y, result) takes each pixel's result.
+template <class Store>
+void shade_tile_by_octets(cpu::ShadeKernel& k, const gpu::FrameParams& frame, std::uint32_t x0, std::uint32_t y0,
+                          Worker& t, const Store& store) {
+    bool as_quads = false;
+    for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); y += 2u)
+        for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); x += 4u) {
+            PixelResult px[8];
+            if (as_quads) {
+                const bool left = shade_block<4>(k, frame, x, y, t, px);
+                const bool right = x + 2u < frame.width && shade_block<4>(k, frame, x + 2u, y, t, px + 4);
+                as_quads = left || right;
+            } else {
+                as_quads = shade_block<8>(k, frame, x, y, t, px);
+            }
+            for (std::uint32_t q = 0; q < 8u; ++q) {
+                const std::uint32_t qx = x + block_x(q), qy = y + block_y(q);
+                if (qx < frame.width && qy < frame.height) store(qx, qy, px[q]);
+            }
+        }
 }
 
 }  // namespace
@@ -160,18 +208,23 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     const std::uint32_t tile_count = tiles_x * ((frame.height + kTile - 1) / kTile);
     unsigned threads = options.threads ? options.threads : std::max(1u, std::thread::hardware_concurrency());
     std::vector<Worker> workers(std::max(1u, std::min(threads, tile_count)));
-    const bool quads = cpu_shares_cuts(options.method, options.cut_sharing);
-    // A quad's heap pools its four points' K slots: the same number of
+    const std::uint32_t cut_points = cpu_cut_points(options.method, options.cut_sharing);
+    // A shared cut's heap pools its points' K slots: the same number of
     // slots per point (a quad's slot holds the four points' bounds and
-    // contributions, 76 bytes against a point's 20). With K slots a quad,
-    // the union of four points' refinements froze far more: on the stress
-    // tests' million lights the error against brute force was 0.0259,
-    // against a cut per pixel's 0.0169; pooled, 0.0140.
+    // contributions, 76 bytes with its key and handle against a point's 20,
+    // an octet's 140). With K slots a quad, the union of four points'
+    // refinements froze far more: on the stress tests' million lights the
+    // error against brute force was 0.0259, against a cut per pixel's
+    // 0.0169; pooled, 0.0140.
     const std::uint32_t heap_slots =
-        prepared.tree.cut_heap_slots(frame.max_cut, quads ? quad_cut_heap(options.cut_heap) : options.cut_heap);
+        prepared.tree.cut_heap_slots(frame.max_cut, shared_cut_heap(options.cut_heap, cut_points));
     for (Worker& w : workers) {
-        w.heap = cpu::CutHeap(lightcuts && !quads ? heap_slots : 0);
-        w.quad_heap = cpu::QuadHeap(quads ? heap_slots : 0);
+        w.heap = cpu::CutHeap(lightcuts && cut_points == 1u ? heap_slots : 0);
+        // Octets take a quad's heap too, for their tiles' blocks cut as
+        // quads (shade_tile_by_octets).
+        w.quad_heap = cpu::QuadHeap(
+            cut_points >= 4u ? prepared.tree.cut_heap_slots(frame.max_cut, shared_cut_heap(options.cut_heap, 4u)) : 0);
+        w.octet_heap = cpu::OctetHeap(cut_points == 8u ? heap_slots : 0);
     }
     std::atomic<std::uint32_t> tiles_done{0};
     Progress progress(options.progress);
@@ -185,13 +238,18 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     for_each_tile(tile_count, workers, [&](std::uint32_t tile, Worker& t) {
         cpu::ShadeKernel k = cpu::make_shade_kernel(prepared, &t.heap);
         const std::uint32_t x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
-        if (quads) {
+        if (cut_points == 8u) {
+            shade_tile_by_octets(k, frame, x0, y0, t, store);
+            progress.update(double(tiles_done.fetch_add(1) + 1) / tile_count);
+            return;
+        }
+        if (cut_points == 4u) {
             for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); y += 2u)
                 for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); x += 2u) {
                     PixelResult px[4];
-                    shade_quad(k, frame, x, y, t, px);
+                    shade_block<4>(k, frame, x, y, t, px);
                     for (std::uint32_t q = 0; q < 4u; ++q) {
-                        const std::uint32_t qx = x + (q & 1u), qy = y + (q >> 1u);
+                        const std::uint32_t qx = x + block_x(q), qy = y + block_y(q);
                         if (qx < frame.width && qy < frame.height) store(qx, qy, px[q]);
                     }
                 }
@@ -212,7 +270,7 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
         stats.heap_frozen_samples += t.frozen_samples;
     }
     if (lightcuts) stats.heap_slots = heap_slots;
-    stats.quad_cuts = quads;
+    stats.cut_points = cut_points;
     stats.spp_done = frame.spp;
     stats.camera_rays = std::uint64_t(frame.width) * frame.height * frame.spp;
     stats.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -49,8 +49,10 @@ RenderResult render(const PreparedScene& prepared, const RenderOptions& options,
         return render_cpu(prepared, options);
     } catch (const std::invalid_argument& e) {
         // The options are valid (render_vulkan checks them first, as the
-        // CPU would), so what the device refused is cut_sharing "quad".
-        if (!(method_selects_cuts(options.method) && options.cut_sharing == "quad")) throw;
+        // CPU would), so what the device refused is cut_sharing "quad" or
+        // "octet".
+        if (!(method_selects_cuts(options.method) && (options.cut_sharing == "quad" || options.cut_sharing == "octet")))
+            throw;
         say(choice, std::string(e.what()) + "; rendering on the CPU");
         return render_cpu(prepared, options);
     }

@@ -228,9 +228,9 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
                        "its clusters of smallest bound (default " + std::to_string(lc::kDefaultCutHeap) + ")")
         ->transform(setting(lc::kSettingCutHeap));
     render->add_option("--cut-sharing", r.cut_sharing,
-                       "lightcuts: pixel (a cut per pixel), quad (the four pixels of a 2x2 block share one cut: "
-                       "faster on the CPU; on Vulkan it needs subgroup quad operations) or auto (quad on the CPU, "
-                       "pixel on Vulkan; the default)")
+                       "lightcuts: pixel (a cut per pixel), quad (the four pixels of a 2x2 block share one cut; "
+                       "on Vulkan it needs subgroup quad operations), octet (the eight of a 4x2 block, CPU only: "
+                       "the fastest there) or auto (octet on the CPU, pixel on Vulkan; the default)")
         ->check(ask(lc::cut_sharing_problem));
     render->add_option("--area-samples", r.area_samples,
                        "Point lights the emissive surfaces become, in all (default 65536)")

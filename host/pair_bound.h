@@ -380,6 +380,19 @@ inline void widen(const quad4::QuadLanes& q, QuadLanes& w) {
     w.disney = q.disney;
 }
 
+// Two quads' lanes side by side: the first's points in lanes 0-3, the
+// second's in 4-7 (a block of eight points, host/quad_cut.h). Given the
+// same cluster twice, quad_pair_errors then gives its bound at the eight
+// points, and quad_light_units_pair a light's units there.
+inline void join(const quad4::QuadLanes& a, const quad4::QuadLanes& b, QuadLanes& w) {
+#define LC_JOIN(field) w.field = _mm256_insertf128_ps(_mm256_castps128_ps256(a.field), b.field, 1);
+    LC_QUAD_LANE_VECTORS(LC_JOIN)
+#undef LC_JOIN
+    w.specular = a.specular | b.specular << 4u;
+    w.covered = a.covered && b.covered;
+    w.disney = a.disney | b.disney << 4u;
+}
+
 // lc_cluster_error of `a` into errors_a[p] and of `b` into errors_b[p], at
 // the quad's points (zero in inactive lanes). For clusters that
 // quad_errors covers (the caller checks).

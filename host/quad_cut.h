@@ -1,23 +1,27 @@
-// Lightcuts for a quad of pixels that share one cut (the CPU path's
-// cut_sharing "quad"). The four shaded points of a 2x2 block of pixels
-// refine one cut together: a cluster is split when its error bound exceeds
-// relative_error times the estimate of any of the four, so when refinement
-// stops every cluster of the cut meets Walter's criterion at every one of
-// the points, except where the cut reached max_cut, clusters frozen out of
-// a full heap, and points held to the floor of update_weights. Each point
-// still has its own estimate: its own representative contributions, shadow
-// rays and sums. What the four share is the cut's bookkeeping (one list of
-// clusters, one pass over the tree, one read of each node) instead of
-// doing it four times. The cut is refined in passes while its list has
-// room, and largest bound first through a heap, Walter's order, once the
-// list is full (refine_all).
+// Lightcuts for a block of pixels that share one cut: the four of a 2x2
+// quad (the CPU path's cut_sharing "quad") or the eight of a 4x2 octet, two
+// quads side by side ("octet", and "auto" on the CPU). The block's shaded
+// points refine one cut together: a cluster is split when its error bound
+// exceeds relative_error times the estimate of any of them, so when
+// refinement stops every cluster of the cut meets Walter's criterion at
+// every one of the points, except where the cut reached max_cut, clusters
+// frozen out of a full heap, and points held to the floor of
+// update_weights. Each point still has its own estimate: its own
+// representative contributions, shadow rays and sums. What the points
+// share is the cut's bookkeeping (one list of clusters, one pass over the
+// tree, one read of each node) instead of doing it for each. The cut is
+// refined in passes while its list has room, and largest bound first
+// through a heap, Walter's order, once the list is full (refine_all).
 //
-// The shared cut is the union of the four points' own refinements, so it
-// is at least as fine as each point's own cut, and costs more shadow rays
-// (on the room at 128x128, 1.08 times a cut per pixel with a heap the tree
+// The shared cut is the union of the points' own refinements, so it is at
+// least as fine as each point's own cut, and costs more shadow rays (on the
+// room at 128x128, a quad's 1.08 times a cut per pixel with a heap the tree
 // cannot fill, 1.19 times one with the per-pixel heap of 64, which freezes
-// more); the bookkeeping it saves costs more than those rays
-// (docs/results/speed.md).
+// more; an octet's 1.08 times a quad's); the bookkeeping it saves costs
+// more than those rays (docs/results/speed.md). An octet's bounds and
+// units are a quad's vector evaluations with the two quads' points in the
+// lanes (quad8::join): the eight lanes of AVX2 take one cluster at eight
+// points, the sixteen of AVX-512 a refinement's two children there.
 #pragma once
 
 #include <algorithm>
@@ -32,10 +36,12 @@ namespace lc::cpu {
 
 inline constexpr uint kQuadLanes = 4u;
 
-// A colour at each of the four points, a row per channel (r, g, b), so
-// that the four points' sums are one vector operation a channel.
-struct QuadColor {
-    float c[3][kQuadLanes];
+// A colour at each of a block's N points (four for a quad, eight for two
+// quads side by side), a row per channel (r, g, b), so that the points'
+// sums are one vector operation a channel.
+template <uint N>
+struct BlockColor {
+    float c[3][N];
     vec3 at(uint p) const { return vec3(c[0][p], c[1][p], c[2][p]); }
     void set(uint p, vec3 v) { c[0][p] = v.x, c[1][p] = v.y, c[2][p] = v.z; }
     void clear() {
@@ -43,36 +49,40 @@ struct QuadColor {
             for (float& x : row) x = 0.0f;
     }
     // this += unit * intensity, channel by channel.
-    void add_scaled(const QuadColor& unit, vec3 intensity) {
+    void add_scaled(const BlockColor& unit, vec3 intensity) {
         for (uint k = 0; k < 3u; ++k)
-            for (uint p = 0; p < kQuadLanes; ++p) c[k][p] += unit.c[k][p] * intensity[int(k)];
+            for (uint p = 0; p < N; ++p) c[k][p] += unit.c[k][p] * intensity[int(k)];
     }
 };
+using QuadColor = BlockColor<kQuadLanes>;
 
-// One cluster of a quad's cut: its node, and at each of the four points its
+// One cluster of a block's cut: its node, and at each of the points its
 // error bound and its representative's unit contribution (zero where the
 // light is hidden or the bound is zero).
-struct QuadEntry {
+template <uint N>
+struct BlockEntry {
     uint node;
-    float error[kQuadLanes];
-    QuadColor unit;
+    float error[N];
+    BlockColor<N> unit;
 };
+using QuadEntry = BlockEntry<kQuadLanes>;
 
-// The quad's cut heap: `slot` lists the refinable clusters, `entries` the
+// The block's cut heap: `slot` lists the refinable clusters, `entries` the
 // clusters the list refers to, which stay where they are while the list
 // moves their 8-byte handles, and `marks` a bit per place: the clusters
 // the current pass refines. Once the list has been full it is a heap, a
 // max-heap on `key` (the largest ratio of a cluster's bound to a point's
-// estimate; QuadCut::add).
-class QuadHeap {
+// estimate; BlockCut::add).
+template <uint N>
+class BlockHeap {
 public:
-    explicit QuadHeap(std::size_t slots = 0)
+    explicit BlockHeap(std::size_t slots = 0)
         : slots_(uint(slots)), key_(slots + 2 * kPad), slot_(slots + 2 * kPad), entries_(slots + 1), free_(slots + 1),
           marks_((slots + 31) / 32 + 1) {}
     uint slots() const { return slots_; }
     float* key() { return key_.data() + kPad; }
     uint* slot() { return slot_.data() + kPad; }
-    QuadEntry* entries() { return entries_.data(); }
+    BlockEntry<N>* entries() { return entries_.data(); }
     uint* free_slots() { return free_.data(); }
     uint* marks() { return marks_.data(); }
 
@@ -81,32 +91,46 @@ private:
     uint slots_;
     std::vector<float> key_;
     std::vector<uint> slot_;
-    std::vector<QuadEntry> entries_;
+    std::vector<BlockEntry<N>> entries_;
     std::vector<uint> free_;
     std::vector<uint> marks_;
 };
+using QuadHeap = BlockHeap<kQuadLanes>;
+using OctetHeap = BlockHeap<2u * kQuadLanes>;
 
-// One sample of a quad: the four points (`active` bit p where point p is a
-// surface to shade) refine one cut; radiance[p] is point p's estimate.
-template <class Kernel>
-class QuadCut {
+// One sample of a block: its N points (`active` bit p where point p is a
+// surface to shade; points 4g to 4g + 3 are quad g's) refine one cut;
+// radiance[p] is point p's estimate.
+template <class Kernel, uint N>
+class BlockCut {
 public:
     using SurfacePoint = typename Kernel::SurfacePoint;
     using ShadeStats = typename Kernel::ShadeStats;
+    using Entry = BlockEntry<N>;
+    using Color = BlockColor<N>;
+    static constexpr uint kGroups = N / kQuadLanes;  // quads in the block
+    static_assert(N == 4u || N == 8u);
 
-    QuadCut(Kernel& kernel, QuadHeap& heap, const FrameParams& frame)
+    BlockCut(Kernel& kernel, BlockHeap<N>& heap, const FrameParams& frame)
         : k_(kernel), f_(frame), key_(heap.key()), slot_(heap.slot()), entries_(heap.entries()),
           free_(heap.free_slots()), marks_(heap.marks()), capacity_(heap.slots()) {}
 
     // Shades the active points of `sp`; their results in radiance[p], the
-    // stats in stats[p] (cut_size, hit_max_cut and frozen are the quad's).
+    // stats in stats[p] (cut_size, hit_max_cut and frozen are the block's).
     void shade(const SurfacePoint* sp, unsigned active, vec3* radiance, ShadeStats* stats) {
         sp_ = sp;
         active_ = active;
 #if defined(__SSE2__)
-        lanes_ = quad_lanes(k_, sp, active);
-        wide_ = lanes_.covered && cpu_has_avx2();
-        if (wide_) quad8::widen(lanes_, lanes8_);
+        bool covered = true;
+        for (uint g = 0; g < kGroups; ++g) {
+            lanes_[g] = quad_lanes(k_, sp + 4u * g, active >> 4u * g & 0xFu);
+            covered = covered && lanes_[g].covered;
+        }
+        wide_ = covered && cpu_has_avx2();
+        if (wide_) {
+            if constexpr (N == 4u) quad8::widen(lanes_[0], lanes8_);
+            else quad8::join(lanes_[0], lanes_[1], lanes8_);
+        }
         wide16_ = wide_ && cpu_has_avx512dq();
         if (wide16_) quad16::widen(lanes8_, lanes16_);
 #endif
@@ -119,7 +143,7 @@ public:
         heap_mode_ = false;
         fixed_.clear();
         heap_sum_.clear();
-        for (uint p = 0; p < kQuadLanes; ++p) {
+        for (uint p = 0; p < N; ++p) {
             frozen_error_[p] = 0.0f;
             stats[p] = ShadeStats{};
         }
@@ -128,24 +152,24 @@ public:
         frozen_ = 0u;
         hit_max_cut_ = 0u;
         root_bounds_ = 0.0f;
-        float root_quarters[kQuadLanes] = {};  // each point's finite root bounds, a quarter of each, summed
+        float root_quarters[N] = {};  // each point's finite root bounds, its share (kShare) of each, summed
         for (uint type = 0u; type < kLightTypeCount; ++type) {
             if (f_.roots[type] == kInvalidIndex) continue;
             const LightNode& root = k_.light_nodes[f_.roots[type]];
             const uint slot = free_[--free_count_];
-            QuadEntry& e = entries_[slot];
+            Entry& e = entries_[slot];
             e.node = f_.roots[type];
             errors(root, e.error);
             e.unit.clear();
-            for (uint p = 0; p < kQuadLanes; ++p) {
+            for (uint p = 0; p < N; ++p) {
                 if (lane(p) && k_.lc_cluster_needs_unit(root, e.error[p])) {
                     bool visible;
                     e.unit.set(p, k_.lc_rep_unit(sp_[p], root.rep_light, f_.min_distance2, visible, stats_[p]));
                 }
             }
-            for (uint p = 0; p < kQuadLanes; ++p)
-                if (e.error[p] > 0.0f && !std::isinf(e.error[p])) root_quarters[p] += e.error[p] * 0.25f;
-            root_bounds_ = quad_sum(root_quarters);
+            for (uint p = 0; p < N; ++p)
+                if (e.error[p] > 0.0f && !std::isinf(e.error[p])) root_quarters[p] += e.error[p] * kShare;
+            root_bounds_ = lane_sum(root_quarters);
             if (enter(root, e)) {
                 update_weights();
                 add(slot);
@@ -156,13 +180,13 @@ public:
         }
         refine_all();
         // Each point's sum over the list's clusters in list order, each
-        // cluster's node read once for the four.
-        QuadColor sum = fixed_;
+        // cluster's node read once for them all.
+        Color sum = fixed_;
         for (uint i = 0; i < size_; ++i) {
-            const QuadEntry& e = entries_[slot_[i]];
+            const Entry& e = entries_[slot_[i]];
             sum.add_scaled(e.unit, k_.lc_node_intensity(k_.light_nodes[e.node]));
         }
-        for (uint p = 0; p < kQuadLanes; ++p) {
+        for (uint p = 0; p < N; ++p) {
             radiance[p] = sum.at(p);
             stats[p].cut_size = cut_size_;
             stats[p].cut_indirect = cut_indirect_;
@@ -184,14 +208,14 @@ private:
     // the fixed sums; an interior cluster with a nonzero bound at some
     // point is refinable (true), its units counted in the heap's sums; one
     // whose bound is zero at a point contributes nothing there.
-    bool enter(const LightNode& node, QuadEntry& e) {
+    bool enter(const LightNode& node, Entry& e) {
         const vec3 intensity = k_.lc_node_intensity(node);
         if ((node.flags & kNodeLeaf) != 0u) {
             fixed_.add_scaled(e.unit, intensity);
             return false;
         }
         bool any = false;
-        for (uint p = 0; p < kQuadLanes; ++p) {
+        for (uint p = 0; p < N; ++p) {
             if (!(e.error[p] > 0.0f)) {
                 e.unit.set(p, vec3(0.0f));
                 continue;
@@ -207,75 +231,86 @@ private:
 
     // Each point's 1 / estimate (as luminance), which turns a bound into
     // the ratio the criterion tests. An estimate is taken as at least
-    // 2^-20 of the quad's summed estimate (of the roots' summed bounds
-    // while that sum is zero): a point whose estimate is zero would
+    // 2^-18 of the points' mean estimate (of their roots' mean bound
+    // while that mean is zero): a point whose estimate is zero would
     // otherwise weigh every bound there infinitely, and the keys could not
     // order them. Such a point is held to relative_error times that floor
     // instead of to Walter's bound > 0. The floor scales with the lights,
     // so scaling every light by a power of two leaves the keys, and so the
     // cuts, unchanged.
-    // The sum is the Vulkan kernel's (shaders/quadcuts.comp), bit for bit:
-    // in float, each term a quarter of its estimate (four of them cannot
-    // pass the float range), added (0 + 1) + (2 + 3) as its quad swaps add
-    // them, and the floor kept within the normal floats. A point whose
-    // estimate is not finite adds nothing to the sum.
+    // A quad's mean is the Vulkan kernel's (shaders/quadcuts.comp), bit
+    // for bit: in float, each term a quarter of its estimate (four of them
+    // cannot pass the float range), added (0 + 1) + (2 + 3) as its quad
+    // swaps add them, and the floor kept within the normal floats; an
+    // octet's adds its quads' sums of eighths. A point whose estimate is
+    // not finite adds nothing to the mean.
     void update_weights() {
-        // Loops over the four points, one vector operation each.
-        float estimate[kQuadLanes], quarter[kQuadLanes];
-        for (uint p = 0; p < kQuadLanes; ++p)
+        // Loops over the points, one vector operation each.
+        float estimate[N], quarter[N];
+        for (uint p = 0; p < N; ++p)
             estimate[p] = 0.2126f * (fixed_.c[0][p] + heap_sum_.c[0][p]) +
                           0.7152f * (fixed_.c[1][p] + heap_sum_.c[1][p]) +
                           0.0722f * (fixed_.c[2][p] + heap_sum_.c[2][p]);  // lc_luminance
         unsigned counts = 0u;
-        for (uint p = 0; p < kQuadLanes; ++p) {
+        for (uint p = 0; p < N; ++p) {
             const bool finite_positive = estimate[p] > 0.0f && estimate[p] < INFINITY;
-            quarter[p] = finite_positive ? estimate[p] * 0.25f : 0.0f;
+            quarter[p] = finite_positive ? estimate[p] * kShare : 0.0f;
             counts |= unsigned(finite_positive);
         }
-        const float total = counts != 0u ? quad_sum(quarter) : root_bounds_;
+        const float total = counts != 0u ? lane_sum(quarter) : root_bounds_;
         const float floor = std::clamp(total * 0x1p-18f, FLT_MIN, FLT_MAX);
-        for (uint p = 0; p < kQuadLanes; ++p) weight_[p] = 1.0f / (estimate[p] < floor ? floor : estimate[p]);
+        for (uint p = 0; p < N; ++p) weight_[p] = 1.0f / (estimate[p] < floor ? floor : estimate[p]);
     }
+    static constexpr float kShare = 1.0f / float(N);  // each point's share of the block's mean
     static float quad_sum(const float* v) { return (v[0] + v[1]) + (v[2] + v[3]); }
+    static float lane_sum(const float* v) {
+        if constexpr (N == 4u) return quad_sum(v);
+        else return quad_sum(v) + quad_sum(v + 4);
+    }
     // A cluster's key: its largest ratio of bound to estimate
     // over the points, at most FLT_MAX. A NaN bound is passed over, as
     // Walter's test never refines it.
-    float key_of(const QuadEntry& e) const {
+    float key_of(const Entry& e) const {
 #if defined(__SSE2__)
-        __m128 m = key_terms(e);
+        __m128 m = key_terms(e, 0u);
+        if constexpr (N == 8u) m = _mm_max_ps(m, key_terms(e, 4u));
         m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
         m = _mm_max_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
         return std::min(_mm_cvtss_f32(m), FLT_MAX);
 #else
         float key = 0.0f;
-        for (uint p = 0; p < kQuadLanes; ++p)
+        for (uint p = 0; p < N; ++p)
             if (e.error[p] > 0.0f) key = std::max(key, e.error[p] * weight_[p]);
         return std::min(key, FLT_MAX);
 #endif
     }
     // key_of(e) > relative_error: whether some point's ratio is above it.
-    bool above(const QuadEntry& e) const {
+    bool above(const Entry& e) const {
 #if defined(__SSE2__)
-        return _mm_movemask_ps(_mm_cmpgt_ps(key_terms(e), _mm_set1_ps(f_.relative_error))) != 0;
+        const __m128 limit = _mm_set1_ps(f_.relative_error);
+        if constexpr (N == 8u)
+            return (_mm_movemask_ps(_mm_cmpgt_ps(key_terms(e, 0u), limit)) |
+                    _mm_movemask_ps(_mm_cmpgt_ps(key_terms(e, 4u), limit))) != 0;
+        return _mm_movemask_ps(_mm_cmpgt_ps(key_terms(e, 0u), limit)) != 0;
 #else
         return key_of(e) > f_.relative_error;
 #endif
     }
 #if defined(__SSE2__)
-    // key_of's ratios at the four points: each bound times its point's
+    // key_of's ratios at four points from `first`: each bound times its point's
     // weight, zero where the bound is not above zero (NaN included). The
     // products are the scalar ones, and a maximum or a comparison of them
     // is exact, so key_of and above are bit for bit the loop's.
-    __m128 key_terms(const QuadEntry& e) const {
-        const __m128 error = _mm_loadu_ps(e.error);
-        return _mm_and_ps(_mm_mul_ps(error, _mm_loadu_ps(weight_)), _mm_cmpgt_ps(error, _mm_setzero_ps()));
+    __m128 key_terms(const Entry& e, uint first) const {
+        const __m128 error = _mm_loadu_ps(e.error + first);
+        return _mm_and_ps(_mm_mul_ps(error, _mm_loadu_ps(weight_ + first)), _mm_cmpgt_ps(error, _mm_setzero_ps()));
     }
 #endif
 
-    void remove_estimate(const QuadEntry& e, QuadColor* into) {
+    void remove_estimate(const Entry& e, Color* into) {
         const vec3 intensity = k_.lc_node_intensity(k_.light_nodes[e.node]);
         for (uint k = 0; k < 3u; ++k)
-            for (uint p = 0; p < kQuadLanes; ++p) {
+            for (uint p = 0; p < N; ++p) {
                 const float estimate = e.unit.c[k][p] * intensity[int(k)];
                 heap_sum_.c[k][p] -= estimate;
                 if (into != nullptr) into->c[k][p] += estimate;
@@ -338,7 +373,9 @@ private:
                         return;
                     }
 #if defined(__SSE2__)
-                    if (wide16_) look_ahead(i, w, words);
+                    // (An octet's refinement fills the sixteen lanes alone.)
+                    if constexpr (N == 4u)
+                        if (wide16_) look_ahead(i, w, words);
 #endif
                     refine_at(i);
                 }
@@ -394,7 +431,7 @@ private:
         frozen_ += 1u;
         const uint smallest = heap_smallest(key_, size_ / 2u, size_, key);
         const uint leaving = smallest == kInvalidIndex ? slot : slot_[smallest];
-        for (uint p = 0; p < kQuadLanes; ++p) frozen_error_[p] += entries_[leaving].error[p];
+        for (uint p = 0; p < N; ++p) frozen_error_[p] += entries_[leaving].error[p];
         remove_estimate(entries_[leaving], &fixed_);
         if (smallest == kInvalidIndex) {
             free_[free_count_++] = slot;
@@ -434,27 +471,53 @@ private:
         }
     }
 
-    // lc_cluster_error of `node` at the four points (zero at inactive ones).
+    // lc_cluster_error of `node` at the block's points (zero at inactive
+    // ones): for an octet in the eight lanes of AVX2 (both quads' points,
+    // the cluster twice), else a quad's four lanes at a time.
     void errors(const LightNode& node, float* out) {
         if (Kernel::tightest_bound) {  // benchmarks only (host/cpu_kernel.h)
-            for (uint p = 0; p < kQuadLanes; ++p)
+            for (uint p = 0; p < N; ++p)
                 out[p] = lane(p) ? k_.tightest_error(sp_[p], node, f_.min_distance2) : 0.0f;
             return;
         }
 #if defined(__SSE2__)
-        if (quad_errors(k_, lanes_, sp_, node, f_.min_distance2, out)) return;
+        if constexpr (N == 8u) {
+            if (wide_ && quad_bound_covers(node)) {
+                quad8::quad_pair_errors(k_, lanes8_, node, node, f_.min_distance2, out, out + 4);
+                return;
+            }
+        }
+        for (uint g = 0; g < kGroups; ++g)
+            if (!quad_errors(k_, lanes_[g], sp_ + 4u * g, node, f_.min_distance2, out + 4u * g))
+                for (uint p = 4u * g; p < 4u * g + 4u; ++p)
+                    out[p] = lane(p) ? k_.lc_cluster_error(sp_[p], sp_[p].mat, node, f_.min_distance2) : 0.0f;
+        return;
 #endif
-        for (uint p = 0; p < kQuadLanes; ++p)
+        for (uint p = 0; p < N; ++p)
             out[p] = lane(p) ? k_.lc_cluster_error(sp_[p], sp_[p].mat, node, f_.min_distance2) : 0.0f;
     }
 
-    // errors() of both children of a refinement: in one evaluation of
-    // eight lanes where the CPU has AVX2 and quad_errors covers both.
+    // errors() of both children of a refinement: in one evaluation where
+    // quad_errors covers both, a quad's in the eight lanes of AVX2, an
+    // octet's in the sixteen of AVX-512.
     void child_errors(const LightNode& a, const LightNode& b, float* errors_a, float* errors_b) {
 #if defined(__SSE2__)
         if (!Kernel::tightest_bound && wide_ && quad_bound_covers(a) && quad_bound_covers(b)) {
-            quad8::quad_pair_errors(k_, lanes8_, a, b, f_.min_distance2, errors_a, errors_b);
-            return;
+            if constexpr (N == 4u) {
+                quad8::quad_pair_errors(k_, lanes8_, a, b, f_.min_distance2, errors_a, errors_b);
+                return;
+            } else if (wide16_) {
+                // Both children at both quads: (a, a, b, b) over lanes16_'s
+                // (quad 0, quad 1, quad 0, quad 1).
+                const LightNode* nodes[4] = {&a, &a, &b, &b};
+                float e[4][kQuadLanes];
+                quad16::quad_four_errors(k_, lanes16_, nodes, f_.min_distance2, e);
+                for (uint p = 0; p < kQuadLanes; ++p) {
+                    errors_a[p] = e[0][p], errors_a[p + 4u] = e[1][p];
+                    errors_b[p] = e[2][p], errors_b[p + 4u] = e[3][p];
+                }
+                return;
+            }
         }
 #endif
         errors(a, errors_a);
@@ -466,10 +529,10 @@ private:
     // units, directions and ray lengths as quad_light_units gives them.
     struct Ahead {
         uint parent;  // the refined node, kInvalidIndex where none
-        float kept[kQuadLanes], fresh[kQuadLanes];
+        float kept[N], fresh[N];
         bool has_units;
-        vec3 units[kQuadLanes], wi[kQuadLanes];
-        float t_max[kQuadLanes];
+        vec3 units[N], wi[N];
+        float t_max[N];
     };
 
     // The children's errors of `parent`'s refinement into errors_kept and
@@ -478,7 +541,7 @@ private:
     const Ahead* take_ahead(uint parent, float* errors_kept, float* errors_fresh) {
         for (Ahead& c : ahead_) {
             if (c.parent != parent) continue;
-            for (uint p = 0; p < kQuadLanes; ++p) errors_kept[p] = c.kept[p], errors_fresh[p] = c.fresh[p];
+            for (uint p = 0; p < N; ++p) errors_kept[p] = c.kept[p], errors_fresh[p] = c.fresh[p];
             c.parent = kInvalidIndex;
             return &c;
         }
@@ -493,7 +556,7 @@ private:
     // split. Their values do not depend on when they are computed (the
     // points, nodes and lights do not change during a cut), so the cut is
     // the one refined pair by pair; this halves the evaluations of a pass's
-    // bounds and units where AVX-512 has the lanes.
+    // bounds and units where AVX-512 has the lanes. A quad's only.
     void look_ahead(uint at, uint w, uint words) {
         const uint parent = entries_[slot_[at]].node;
         if (ahead_[0].parent == parent || ahead_[1].parent == parent) return;
@@ -514,11 +577,11 @@ private:
         }
         for (const LightNode* node : nodes)
             if (!quad_bound_covers(*node)) return;
-        float errors[4][kQuadLanes];
+        float errors[4][N];
         quad16::quad_four_errors(k_, lanes16_, nodes, f_.min_distance2, errors);
         // And both new representatives' units, in the eight lanes of AVX2.
-        vec3 units[2][kQuadLanes], wi[2][kQuadLanes];
-        float t_max[2][kQuadLanes];
+        vec3 units[2][N], wi[2][N];
+        float t_max[2][N];
         const bool has_units = quad8::quad_light_units_pair(k_, lanes8_, k_.lights[nodes[1]->rep_light],
                                                             k_.lights[nodes[3]->rep_light], f_.min_distance2,
                                                             units, wi, t_max);
@@ -526,7 +589,7 @@ private:
             Ahead& c = ahead_[k];
             c.parent = parents[k];
             c.has_units = has_units;
-            for (uint p = 0; p < kQuadLanes; ++p) {
+            for (uint p = 0; p < N; ++p) {
                 c.kept[p] = errors[2u * k][p], c.fresh[p] = errors[2u * k + 1u][p];
                 if (!has_units) continue;
                 c.units[p] = units[k][p];
@@ -547,7 +610,7 @@ private:
         bool has_kept, has_fresh;
     };
     Children split(uint kept_slot) {
-        QuadEntry& kept = entries_[kept_slot];
+        Entry& kept = entries_[kept_slot];
         const uint parent = kept.node;
         const LightNode& node = k_.light_nodes[parent];
         remove_estimate(kept, nullptr);
@@ -557,37 +620,55 @@ private:
         const LightNode& kept_node = k_.light_nodes[kept_index];
         const LightNode& fresh_node = k_.light_nodes[fresh_index];
         const uint fresh_slot = free_[--free_count_];
-        QuadEntry& fresh = entries_[fresh_slot];
+        Entry& fresh = entries_[fresh_slot];
         kept.node = kept_index;
         fresh.node = fresh_index;
         const Ahead* ahead = take_ahead(parent, kept.error, fresh.error);
         if (ahead == nullptr) child_errors(kept_node, fresh_node, kept.error, fresh.error);
         const bool fresh_leaf = (fresh_node.flags & kNodeLeaf) != 0u;
-        // The new representative's shadow ray from each point, the four
-        // traced together (lc_visible4: each ray tested on its own at every
-        // node it enters, the nodes read and the branches taken once; a
-        // packet bounding the four rays with one box test ran slower, as the
-        // points' spread widens its bounds).
+        // The new representative's shadow ray from each point, all traced
+        // together (lc_visible4 or lc_visible8: each ray tested on its own
+        // at every node it enters, the nodes read and the branches taken
+        // once; a packet bounding the four rays with one box test ran
+        // slower, as the points' spread widens its bounds).
         const Light& rep = k_.lights[fresh_node.rep_light];
-        vec3 units[kQuadLanes], wi[kQuadLanes];
-        float t_max[kQuadLanes];
+        vec3 units[N], wi[N];
+        float t_max[N];
         bool lanes_done = false;
         if (ahead != nullptr && ahead->has_units) {
-            for (uint p = 0; p < kQuadLanes; ++p) {
+            for (uint p = 0; p < N; ++p) {
                 units[p] = ahead->units[p];
                 if (units[p] != vec3(0.0f)) wi[p] = ahead->wi[p], t_max[p] = ahead->t_max[p];
             }
             lanes_done = true;
         }
 #if defined(__SSE2__)
-        if (!lanes_done) lanes_done = quad_light_units(k_, lanes_, rep, f_.min_distance2, units, wi, t_max);
+        if constexpr (N == 4u) {
+            if (!lanes_done) lanes_done = quad_light_units(k_, lanes_[0], rep, f_.min_distance2, units, wi, t_max);
+        } else if (!wide_) {
+            lanes_done = quad_light_units(k_, lanes_[0], rep, f_.min_distance2, units, wi, t_max) &&
+                         quad_light_units(k_, lanes_[1], rep, f_.min_distance2, units + 4, wi + 4, t_max + 4);
+        } else {
+            // The light twice, over both quads' points.
+            vec3 u2[2][kQuadLanes], w2[2][kQuadLanes];
+            float t2[2][kQuadLanes];
+            lanes_done = quad8::quad_light_units_pair(k_, lanes8_, rep, rep, f_.min_distance2, u2, w2, t2);
+            if (lanes_done)
+                for (uint g = 0; g < 2u; ++g)
+                    for (uint p = 0; p < kQuadLanes; ++p) {
+                        units[4u * g + p] = u2[g][p];
+                        if (u2[g][p] != vec3(0.0f)) wi[4u * g + p] = w2[g][p], t_max[4u * g + p] = t2[g][p];
+                    }
+        }
 #endif
-        RayPacket4 rays;
-        for (uint p = 0; p < kQuadLanes; ++p) {
+        // The new representative's rays, a point's in its lane: a quad's
+        // four in a packet of four, an octet's eight in one of eight.
+        std::conditional_t<N == 4u, RayPacket4, RayPacket8> rays;
+        for (uint p = 0; p < N; ++p) {
             fresh.unit.set(p, vec3(0.0f));
             if (!lane(p) || !(fresh_leaf || fresh.error[p] > 0.0f)) continue;
-            // lc_rep_unit, on the unit found for all four points at once
-            // where quad_light_units covers the light.
+            // lc_rep_unit, on the unit found for the points at once where
+            // quad_light_units covers the light.
             if (!lanes_done) units[p] = k_.lc_light_unit(sp_[p], rep, f_.min_distance2, wi[p], t_max[p]);
             if (!(units[p].x + units[p].y + units[p].z > 0.0f)) continue;
             stats_[p].shadow_rays += 1u;
@@ -596,8 +677,12 @@ private:
             rays.t_max[p] = t_max[p];
             rays.valid |= 1u << p;
         }
-        const unsigned visible = rays.valid != 0u ? k_.lc_visible4(rays) : 0u;
-        for (uint p = 0; p < kQuadLanes; ++p)
+        unsigned visible = 0u;
+        if (rays.valid != 0u) {
+            if constexpr (N == 4u) visible = k_.lc_visible4(rays);
+            else visible = k_.lc_visible8(rays);
+        }
+        for (uint p = 0; p < N; ++p)
             if ((visible >> p & 1u) != 0u) fresh.unit.set(p, units[p]);
         const bool has_kept = enter(kept_node, kept);
         const bool has_fresh = enter(fresh_node, fresh);
@@ -630,7 +715,7 @@ private:
     void refine_top() {
         const uint kept_slot = slot_[0];
         const auto [fresh_slot, has_kept, has_fresh] = split(kept_slot);
-        const QuadEntry &kept = entries_[kept_slot], &fresh = entries_[fresh_slot];
+        const Entry &kept = entries_[kept_slot], &fresh = entries_[fresh_slot];
         update_weights();
         float key_a = has_kept ? key_of(kept) : 0.0f, key_b = has_fresh ? key_of(fresh) : 0.0f;
         uint slot_a = kept_slot, slot_b = fresh_slot;
@@ -655,7 +740,7 @@ private:
     const FrameParams& f_;
     float* key_;
     uint* slot_;
-    QuadEntry* entries_;
+    Entry* entries_;
     uint* free_;
     uint* marks_;  // refine_all's marks, a bit per place in the list
     bool heap_mode_ = false;  // the list is a heap (add), refined largest first
@@ -665,20 +750,25 @@ private:
     const SurfacePoint* sp_ = nullptr;
     unsigned active_ = 0u;
 #if defined(__SSE2__)
-    QuadLanes lanes_;
-    quad8::QuadLanes lanes8_;  // lanes_ in both halves (child_errors)
+    QuadLanes lanes_[kGroups];  // each quad's points
+    quad8::QuadLanes lanes8_;  // a quad's lanes_ in both halves (child_errors); an octet's quads' side by side
     bool wide_ = false;        // lanes8_ is set and used
     quad16::QuadLanes lanes16_;  // lanes_ in all four quarters (look_ahead)
     bool wide16_ = false;        // lanes16_ is set and used
 #endif
     Ahead ahead_[2];  // look_ahead
     ShadeStats* stats_ = nullptr;
-    QuadColor fixed_;     // each point's final estimates: leaves and frozen clusters
-    QuadColor heap_sum_;  // ... and the running sum of the heap's
-    float weight_[kQuadLanes];   // update_weights
-    float frozen_error_[kQuadLanes];
+    Color fixed_;     // each point's final estimates: leaves and frozen clusters
+    Color heap_sum_;  // ... and the running sum of the heap's
+    float weight_[N];   // update_weights
+    float frozen_error_[N];
     float root_bounds_ = 0.0f;  // a quarter of the roots' finite bounds, summed over the points (update_weights)
     uint cut_size_ = 0u, cut_indirect_ = 0u, frozen_ = 0u, hit_max_cut_ = 0u;
 };
+
+template <class Kernel>
+using QuadCut = BlockCut<Kernel, kQuadLanes>;
+template <class Kernel>
+using OctetCut = BlockCut<Kernel, 2u * kQuadLanes>;
 
 }  // namespace lc::cpu

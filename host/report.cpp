@@ -58,7 +58,7 @@ LightcutsReport lightcuts_report(const RenderOptions& o, const PreparedScene& p,
     const double samples = double(cuts.size()) * std::max(s.spp_done, 1u);
     l.cut_indirect_mean = samples > 0.0 ? double(s.cut_indirect_total) / samples : 0.0;
     l.cut_heap = o.cut_heap;
-    l.quad_cuts = s.quad_cuts;
+    l.cut_points = s.cut_points;
     l.heap_slots = s.heap_slots;
     l.heap_bytes = s.heap_shared_bytes;
     l.heap_private = s.heap_private;
@@ -78,15 +78,17 @@ std::string lightcuts_text(const RenderReport& r, const LightcutsReport& l) {
         text += format("  of the cut: %.1f direct, %.1f indirect (VPL) clusters on average\n",
                        l.cut_size_mean - l.cut_indirect_mean, l.cut_indirect_mean);
     const double samples = double(std::max<std::uint64_t>(r.camera_rays, 1));
-    if (l.quad_cuts) text += "  cuts shared by the pixels of each 2x2 quad (cut_sharing)\n";
+    const char* const shared_by = l.cut_points == 8u ? "octet" : l.cut_points == 4u ? "quad" : "point";
+    if (l.cut_points == 4u) text += "  cuts shared by the pixels of each 2x2 quad (cut_sharing)\n";
+    if (l.cut_points == 8u) text += "  cuts shared by the eight pixels of each 4x2 octet (cut_sharing)\n";
     text += format("  cut heap: %u slots per %s (cut_heap %u); %llu samples (%.2f%%) froze clusters out of a full "
                    "heap\n",
-                   l.heap_slots, l.quad_cuts ? "quad" : "point", l.cut_heap, static_cast<unsigned long long>(l.heap_frozen_samples),
+                   l.heap_slots, shared_by, l.cut_heap, static_cast<unsigned long long>(l.heap_frozen_samples),
                    100.0 * double(l.heap_frozen_samples) / samples);
     if (r.device != "cpu") {
         const std::string where =
             l.heap_private ? format("cut heap in private memory: %s per invocation",
-                                    human_bytes(std::uint64_t(l.heap_slots) * (l.quad_cuts ? sizeof(gpu::QuadCutEntry)
+                                    human_bytes(std::uint64_t(l.heap_slots) * (l.cut_points == 4u ? sizeof(gpu::QuadCutEntry)
                                                                                 : sizeof(gpu::CutEntry))).c_str())
                            : format("cut heap in shared memory: %s per workgroup of %u",
                                     human_bytes(l.heap_bytes).c_str(), l.workgroup_size);
@@ -109,7 +111,7 @@ json lightcuts_json(const LightcutsReport& l) {
             {"cut_size_max", l.cut_size_max},
             {"max_cut_samples", l.max_cut_samples},
             {"cut_heap", l.cut_heap},
-            {"cut_sharing", l.quad_cuts ? "quad" : "pixel"},
+            {"cut_sharing", l.cut_points == 8u ? "octet" : l.cut_points == 4u ? "quad" : "pixel"},
             {"heap_slots", l.heap_slots},
             {"heap_bytes_per_workgroup", l.heap_bytes},
             {"heap_memory", l.heap_private ? "private" : "shared"},

@@ -65,12 +65,14 @@ std::string light_pick_problem(std::string_view pick) {
 }
 
 std::string cut_sharing_problem(std::string_view sharing) {
-    if (sharing == "auto" || sharing == "pixel" || sharing == "quad") return "";
-    return "must be \"auto\", \"pixel\" or \"quad\", got \"" + std::string(sharing) + "\"";
+    if (sharing == "auto" || sharing == "pixel" || sharing == "quad" || sharing == "octet") return "";
+    return "must be \"auto\", \"pixel\", \"quad\" or \"octet\", got \"" + std::string(sharing) + "\"";
 }
 
-bool cpu_shares_cuts(std::string_view method, std::string_view sharing) {
-    return method == "lightcuts" && (sharing == "quad" || sharing == "auto");
+std::uint32_t cpu_cut_points(std::string_view method, std::string_view sharing) {
+    if (method != "lightcuts") return 1u;
+    if (sharing == "octet" || sharing == "auto") return 8u;
+    return sharing == "quad" ? 4u : 1u;
 }
 
 void validate_render_options(const RenderOptions& o) {

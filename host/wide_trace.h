@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 
 #include <glm/glm.hpp>
 
@@ -181,12 +182,15 @@ bool trace_any_wide(Kernel& kernel, const WideBvhNode* nodes, const WideLeaf* le
 // where bit r of `valid` is set. (One struct by reference: with the three
 // arrays as separate pointer parameters, GCC 12.2 at -O3 dropped a caller's
 // stores to them as dead; -fno-ipa-modref or -fno-tree-dse kept them.)
-struct RayPacket4 {
-    glm::vec3 org[4];
-    glm::vec3 dir[4];
-    float t_max[4];
+template <unsigned R>
+struct RayPacket {
+    glm::vec3 org[R];
+    glm::vec3 dir[R];
+    float t_max[R];
     unsigned valid = 0u;
 };
+using RayPacket4 = RayPacket<4>;
+using RayPacket8 = RayPacket<8>;
 
 #if defined(__SSE2__) && (defined(__x86_64__) || defined(__i386__))
 #define LC_WIDE8_TRACE 1
@@ -273,28 +277,32 @@ __attribute__((target("avx2"), always_inline)) inline bool wide8_walk(Kernel& ke
     return false;
 }
 
-// Up to four rays (bit r of packet.valid) through the 8-wide tree together:
-// bit r of the result is set where ray r is blocked. Each stack entry
-// carries the rays that entered its node, and each of them is tested
-// against the node's boxes on its own (wide8_hit_boxes): a ray visits
-// exactly the nodes and leaves its own walk would, so every answer is
-// trace_any_wide8's; what the rays share is the pops, the reads of the
-// nodes and the branches. For rays that take nearly the same path: the four
-// points of a quad to one light.
-template <class Kernel>
-__attribute__((target("avx2"), always_inline)) inline unsigned wide8_walk4(Kernel& kernel,
+// Up to R rays (bit r of packet.valid; R is 4 or 8) through the 8-wide
+// tree together: bit r of the result is set where ray r is blocked. Each
+// stack entry carries the rays that entered its node, and each of them is
+// tested against the node's boxes on its own (wide8_hit_boxes): a ray
+// visits exactly the nodes and leaves its own walk would, so every answer
+// is trace_any_wide8's; what the rays share is the pops, the reads of the
+// nodes and the branches. For rays that take nearly the same path: the
+// points of a quad or an octet to one light, a point to neighbouring
+// lights. (Eight rays rather than four: the octets' cuts 2 to 5% faster,
+// brute force 3 to 4%, docs/results/speed.md.)
+template <unsigned R, class Kernel>
+__attribute__((target("avx2"), always_inline)) inline unsigned wide8_walk_packet(Kernel& kernel,
                                                                           const WideBvhNode8* nodes,
                                                                           const WideLeaf* leaves,
-                                                                          const RayPacket4& packet) {
-    const unsigned valid = packet.valid & 0xFu;
-    Wide8Ray rays[4];
-    WideRay sheared[4];
+                                                                          const RayPacket<R>& packet) {
+    static_assert(R == 4u || R == 8u);
+    using Bits = std::conditional_t<R == 4u, std::uint32_t, std::uint64_t>;
+    const unsigned valid = packet.valid & ((1u << R) - 1u);
+    Wide8Ray rays[R];
+    WideRay sheared[R];
     unsigned has_shear = 0u;
     // Every slot gets a ray, so that the four box tests below run without
     // branches: a slot not in the packet repeats the first ray, and its
     // answers are masked off.
     const unsigned first = valid != 0u ? unsigned(__builtin_ctz(valid)) : 0u;
-    for (unsigned r = 0; r < 4u; ++r) {
+    for (unsigned r = 0; r < R; ++r) {
         const unsigned from = (valid >> r & 1u) != 0u ? r : first;
         rays[r] = wide8_ray(kernel, packet.org[from], packet.dir[from], packet.t_max[from]);
     }
@@ -309,17 +317,24 @@ __attribute__((target("avx2"), always_inline)) inline unsigned wide8_walk4(Kerne
         const unsigned active = stack_rays[sp] & ~blocked;
         if (active == 0u) continue;
         const WideBvhNode8& node = nodes[stack[sp]];
-        unsigned masks[4];
-        for (unsigned r = 0; r < 4u; ++r) masks[r] = wide8_hit_boxes(node, rays[r]) & (0u - (active >> r & 1u));
-        unsigned any = masks[0] | masks[1] | masks[2] | masks[3];
+        unsigned any = 0u;
+        Bits by_ray = 0u;
+        for (unsigned r = 0; r < R; ++r) {
+            const unsigned mask = wide8_hit_boxes(node, rays[r]) & (0u - (active >> r & 1u));
+            any |= mask;
+            by_ray |= Bits(mask) << 8u * r;
+        }
         // Ray r's box bits in byte r: a child's rays are one bit of each
-        // byte, gathered into bits 24-27 by one multiplication (the four
+        // byte, gathered into the top byte by one multiplication (the
         // partial products land on distinct bits, so nothing carries).
-        const std::uint32_t by_ray = masks[0] | masks[1] << 8 | masks[2] << 16 | masks[3] << 24;
         while (any != 0u) {
             const unsigned s = unsigned(__builtin_ctz(any));
             any &= any - 1u;
-            const unsigned entered = (((by_ray >> s) & 0x01010101u) * 0x01020408u) >> 24 & 0xFu;
+            unsigned entered;
+            if constexpr (R == 4u)
+                entered = (((by_ray >> s) & 0x01010101u) * 0x01020408u) >> 24 & 0xFu;
+            else
+                entered = unsigned((((by_ray >> s) & 0x0101010101010101ull) * 0x0102040810204080ull) >> 56);
             const std::int32_t count = node.count[s];
             if (count == 0) {
                 stack[sp] = node.child[s];
@@ -367,11 +382,11 @@ __attribute__((target("avx2,avx512f,avx512vl"))) bool trace_any_wide8_avx512(Ker
     return wide8_walk(kernel, nodes, leaves, org, dir, t_max);
 }
 
-// wide8_walk4 for AVX2 and for AVX-512VL CPUs.
+// wide8_walk_packet for AVX2 and for AVX-512VL CPUs, four rays and eight.
 template <class Kernel>
 __attribute__((target("avx2"))) unsigned trace_any_wide8x4_avx2(Kernel& kernel, const WideBvhNode8* nodes,
                                                                  const WideLeaf* leaves, const RayPacket4& packet) {
-    return wide8_walk4(kernel, nodes, leaves, packet);
+    return wide8_walk_packet(kernel, nodes, leaves, packet);
 }
 
 template <class Kernel>
@@ -379,7 +394,22 @@ __attribute__((target("avx2,avx512f,avx512vl"))) unsigned trace_any_wide8x4_avx5
                                                                                     const WideBvhNode8* nodes,
                                                                                     const WideLeaf* leaves,
                                                                                     const RayPacket4& packet) {
-    return wide8_walk4(kernel, nodes, leaves, packet);
+    return wide8_walk_packet(kernel, nodes, leaves, packet);
+}
+
+// The same for up to eight rays (an octet's points to one light).
+template <class Kernel>
+__attribute__((target("avx2"))) unsigned trace_any_wide8x8_avx2(Kernel& kernel, const WideBvhNode8* nodes,
+                                                                 const WideLeaf* leaves, const RayPacket8& packet) {
+    return wide8_walk_packet(kernel, nodes, leaves, packet);
+}
+
+template <class Kernel>
+__attribute__((target("avx2,avx512f,avx512vl"))) unsigned trace_any_wide8x8_avx512(Kernel& kernel,
+                                                                                    const WideBvhNode8* nodes,
+                                                                                    const WideLeaf* leaves,
+                                                                                    const RayPacket8& packet) {
+    return wide8_walk_packet(kernel, nodes, leaves, packet);
 }
 
 // The 8-wide walk for this CPU: only where cpu_has_avx2().

@@ -128,6 +128,10 @@ accept --width 3 --height 3 --method lightcuts --cut-sharing quad --stats "$tmp/
 grep -q '"cut_sharing": "quad"' "$tmp/quad.json" || fail "--cut-sharing quad: the stats do not say quad"
 accept --width 3 --height 3 --method lightcuts --cut-sharing pixel --stats "$tmp/quad.json"
 grep -q '"cut_sharing": "pixel"' "$tmp/quad.json" || fail "--cut-sharing pixel: the stats do not say pixel"
+accept --width 5 --height 3 --method lightcuts --cut-sharing octet --stats "$tmp/quad.json"
+grep -q '"cut_sharing": "octet"' "$tmp/quad.json" || fail "--cut-sharing octet: the stats do not say octet"
+accept --width 5 --height 3 --method lightcuts --stats "$tmp/quad.json"
+grep -q '"cut_sharing": "octet"' "$tmp/quad.json" || fail "the CPU's default sharing is not octet"
 rm -f "$tmp/quad.json"
 accept --width 2 --height 2 --method path --max-bounces 1024 --time-limit 1e30
 accept --width 16384 --height 1 --method brute
@@ -165,10 +169,13 @@ if ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" "$exe" render "$
   grep '"cut_sharing": "quad"' "$tmp/vq.json" >/dev/null || fail "--cut-sharing quad --device vulkan: the stats do not say quad"
   ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" LC_VK_HEAP_MEMORY=shared expect_error 'cut_sharing "quad" on ' render "$root/scenes/room/room.json" \
     -o "$tmp/edge2.exr" --width 2 --height 2 --method lightcuts --cut-sharing quad --device vulkan
+  # Octets are the CPU's alone.
+  ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0" expect_error 'cut_sharing "octet" on ' render "$mini" \
+    -o "$tmp/edge2.exr" --width 2 --height 2 --method lightcuts --cut-sharing octet --device vulkan
 elif ! grep "no Vulkan device" "$tmp/vq.txt" >/dev/null || [ -n "${LC_REQUIRE_VULKAN:-}" ]; then
   fail "--cut-sharing quad --device vulkan: $(cat "$tmp/vq.txt")"
 fi
-expect_error '--cut-sharing: must be "auto", "pixel" or "quad", got "tiles"' render "$mini" -o "$tmp/edge2.exr" --cut-sharing tiles
+expect_error '--cut-sharing: must be "auto", "pixel", "quad" or "octet", got "tiles"' render "$mini" -o "$tmp/edge2.exr" --cut-sharing tiles
 expect_error '--method: must be "brute", "lightcuts", "sampled", "stochastic" or "path", got "fast"' render "$mini" -o "$tmp/edge2.exr" --method fast
 expect_error '--light-pick: must be "tree", "uniform" or "power", got "random"' render "$mini" -o "$tmp/edge2.exr" --light-pick random
 expect_error '--device: must be "auto", "cpu" or "vulkan"' render "$mini" -o "$tmp/edge2.exr" --device gpu

@@ -565,11 +565,12 @@ TEST(Bvh, PacketsOfFourGiveEachRaysAnswer) {
     EXPECT_LT(blocked, rays - rays / 10);
 }
 
-// trace_any_wide8x4: four rays from four points (a quad's points to one
-// light, or anywhere), some of them not in the packet, each answered as its
-// own walk would, in both builds this CPU runs.
-TEST(Bvh, EightWidePacketsFromFourPointsGiveEachRaysAnswer) {
 #if defined(LC_WIDE8_TRACE)
+// trace_any_wide8x4 and trace_any_wide8x8: R rays from R points (a quad's
+// or an octet's points to one light, or anywhere), some of them not in the
+// packet, each answered as its own walk would, in both builds this CPU runs.
+template <unsigned R>
+void expect_packets_from_points_give_each_rays_answer() {
     if (!lc::cpu::cpu_has_avx2()) GTEST_SKIP() << "this CPU has no AVX2: the 8-wide walk is not used";
     std::mt19937 rng(20261202u);
     GridCube cube = traversal_cube();
@@ -585,18 +586,19 @@ TEST(Bvh, EightWidePacketsFromFourPointsGiveEachRaysAnswer) {
                                 : vec3(box(rng) + 10.0f, box(rng), box(rng));
         const float spread = std::pow(10.0f, -3.0f * u01(rng));
         const vec3 target = in_cube ? cube.random_edge_point(rng).first : centre + 30.0f * random_unit(rng);
-        lc::cpu::RayPacket4 packet;
-        for (int j = 0; j < 4; ++j) {
+        lc::cpu::RayPacket<R> packet;
+        for (unsigned j = 0; j < R; ++j) {
             packet.org[j] = centre + (in_cube ? 0.01f : spread) * random_unit(rng);
             const bool to_target = packet_index % 3 != 0;
             packet.dir[j] = to_target ? target - packet.org[j] : random_unit(rng);
             packet.t_max[j] = to_target ? (u01(rng) < 0.5f ? 0.999f : kRayInfinity)
                                         : (u01(rng) < 0.5f ? kRayInfinity : 30.0f * u01(rng));
         }
-        packet.valid = packet_index % 8 == 5 ? 1u + unsigned(u01(rng) * 14.99f) : 15u;
+        const unsigned all = (1u << R) - 1u;
+        packet.valid = packet_index % 8 == 5 ? 1u + unsigned(u01(rng) * (float(all) - 1.01f)) : all;
         const unsigned valid = packet.valid;
         unsigned expected = 0u;
-        for (int j = 0; j < 4; ++j)
+        for (unsigned j = 0; j < R; ++j)
             if ((valid >> j & 1u) != 0u && brute_any(scene, packet.org[j], packet.dir[j], packet.t_max[j]))
                 expected |= 1u << j;
         rays += __builtin_popcount(valid);
@@ -607,16 +609,34 @@ TEST(Bvh, EightWidePacketsFromFourPointsGiveEachRaysAnswer) {
                 first_failure = std::string(build) + ", packet " + std::to_string(packet_index) + ": blocked " +
                                 std::to_string(got) + ", brute force " + std::to_string(expected);
         };
-        check("AVX2", lc::cpu::trace_any_wide8x4_avx2(k, scene.bvh.wide8_nodes.data(), scene.bvh.wide8_leaves.data(),
-                                                       packet));
-        if (lc::cpu::cpu_has_avx512vl())
-            check("AVX-512", lc::cpu::trace_any_wide8x4_avx512(k, scene.bvh.wide8_nodes.data(),
-                                                                scene.bvh.wide8_leaves.data(), packet));
+        const lc::WideBvhNode8* nodes = scene.bvh.wide8_nodes.data();
+        const lc::WideLeaf* leaves = scene.bvh.wide8_leaves.data();
+        if constexpr (R == 4u) {
+            check("AVX2", lc::cpu::trace_any_wide8x4_avx2(k, nodes, leaves, packet));
+            if (lc::cpu::cpu_has_avx512vl()) check("AVX-512", lc::cpu::trace_any_wide8x4_avx512(k, nodes, leaves, packet));
+        } else {
+            check("AVX2", lc::cpu::trace_any_wide8x8_avx2(k, nodes, leaves, packet));
+            if (lc::cpu::cpu_has_avx512vl()) check("AVX-512", lc::cpu::trace_any_wide8x8_avx512(k, nodes, leaves, packet));
+        }
     }
     EXPECT_EQ(failures, 0) << "first: " << first_failure;
     EXPECT_GT(blocked, rays / 10);
     EXPECT_LT(blocked, rays - rays / 10);
     EXPECT_GT(mixed, 100) << "packets whose rays disagree, which a shared answer would get wrong";
+}
+#endif
+
+TEST(Bvh, EightWidePacketsFromFourPointsGiveEachRaysAnswer) {
+#if defined(LC_WIDE8_TRACE)
+    expect_packets_from_points_give_each_rays_answer<4>();
+#else
+    GTEST_SKIP() << "no 8-wide walk on this architecture";
+#endif
+}
+
+TEST(Bvh, EightWidePacketsFromEightPointsGiveEachRaysAnswer) {
+#if defined(LC_WIDE8_TRACE)
+    expect_packets_from_points_give_each_rays_answer<8>();
 #else
     GTEST_SKIP() << "no 8-wide walk on this architecture";
 #endif

@@ -1,7 +1,7 @@
-// Cuts shared by the four pixels of a 2x2 quad (host/quad_cut.h, the CPU's
-// cut_sharing "quad"): the four points' bounds in SSE lanes, the criterion
-// at every point, and quads cut short by the image's edge or by camera rays
-// that miss.
+// Cuts shared by the four pixels of a 2x2 quad and by the eight of a 4x2
+// octet (host/quad_cut.h, the CPU's cut_sharing "quad" and "octet"): the
+// points' bounds in vector lanes, the criterion at every point, and blocks
+// cut short by the image's edge or by camera rays that miss.
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -329,44 +329,143 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
 #endif
 }
 
+#if defined(__SSE2__)
+// An octet's lanes (quad8::join, the two quads' points side by side): one
+// cluster given twice to quad_pair_errors, a refinement's two children
+// given as (a, a, b, b) to quad16::quad_four_errors over the joined lanes
+// widened, and a light given twice to quad_light_units_pair give the
+// scalar bounds and units at all eight points, bit for bit, over random
+// clusters with and without emission cones, lights, materials (Lambert,
+// GGX, Disney) and active points (a quad with none among them).
+TEST(OctetCut, LanesAreTheScalarOnesBitForBit) {
+    if (!cpu::cpu_has_avx2()) GTEST_SKIP() << "octets take the quads' lanes without AVX2";
+    std::mt19937 rng(808);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const std::vector<gpu::Material> materials = {test::lambert(glm::vec3(0.5f))};
+    Kernel k;
+    k.materials = materials.data();
+    k.vpl_min_distance2 = 0.01f;
+    const auto same = [](float a, float b) { return a == b || (std::isnan(a) && std::isnan(b)); };
+    const auto random_node = [&](glm::vec3 centre) {
+        const glm::vec3 half = glm::vec3(u(rng), u(rng), u(rng)) * 0.7f;
+        const float pick = u(rng);
+        const std::uint32_t type = pick < 0.6f ? gpu::kLightPoint : pick < 0.8f ? gpu::kLightSpot : gpu::kLightOriented;
+        gpu::LightNode node = test::node_with_box(centre - half, centre + half, type);
+        if (type != gpu::kLightPoint) {
+            node.axis_oct = std::uint32_t(rng());
+            node.cos_theta_o = 1.0f - 1.9f * u(rng);
+            node.cos_theta_e = type == gpu::kLightSpot ? 1.0f - 2.0f * u(rng) * u(rng) : std::cos(1.5707964f);
+            node.falloff_width = std::max(1e-3f, u(rng));
+        }
+        node.intensity_r = 10.0f * u(rng), node.intensity_g = 10.0f * u(rng), node.intensity_b = 10.0f * u(rng);
+        return node;
+    };
+    int lit_bounds = 0, lit_units = 0, checked = 0;
+    for (int trial = 0; trial < 4000; ++trial) {
+        const glm::vec3 centre = (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 4.0f;
+        const gpu::LightNode a = random_node(centre), b = random_node(centre + glm::vec3(0.3f));
+        const gpu::Light light = trial % 3 == 0 ? test::point_light(centre, glm::vec3(u(rng), u(rng), u(rng)) * 10.0f)
+                                 : trial % 3 == 1
+                                     ? test::spot_light(centre, test::random_unit(rng), glm::vec3(5.0f), 20.0f, 40.0f)
+                                     : test::oriented_light(centre, test::random_unit(rng), glm::vec3(5.0f));
+        Kernel::SurfacePoint sp[8];
+        const int disney = trial % 4;
+        for (Kernel::SurfacePoint& s : sp)
+            s = random_point(k, rng, centre + (glm::vec3(u(rng), u(rng), u(rng)) - 0.5f) * 6.0f,
+                             disney == 1 || (disney > 1 && u(rng) < 0.5f));
+        const unsigned active = trial % 7 == 0 ? 0x0Fu : trial % 5 == 0 ? unsigned(rng() & 0xFFu) : 0xFFu;
+        const cpu::QuadLanes quads[2] = {cpu::quad_lanes(k, sp, active & 0xFu), cpu::quad_lanes(k, sp + 4, active >> 4u)};
+        if (!quads[0].covered || !quads[1].covered) continue;
+        cpu::quad8::QuadLanes octet;
+        cpu::quad8::join(quads[0], quads[1], octet);
+        const float md2 = u(rng) < 0.5f ? 1e-8f : 0.05f;
+        const auto scalar_error = [&](const gpu::LightNode& node, unsigned p) {
+            return (active >> p & 1u) != 0u ? k.lc_cluster_error(sp[p], sp[p].mat, node, md2) : 0.0f;
+        };
+        float errors[8];
+        cpu::quad8::quad_pair_errors(k, octet, a, a, md2, errors, errors + 4);
+        for (unsigned p = 0; p < 8u; ++p) {
+            ASSERT_TRUE(same(errors[p], scalar_error(a, p))) << "trial " << trial << " point " << p;
+            lit_bounds += errors[p] > 0.0f ? 1 : 0;
+            ++checked;
+        }
+        if (cpu::cpu_has_avx512dq()) {
+            cpu::quad16::QuadLanes wider;
+            cpu::quad16::widen(octet, wider);
+            const gpu::LightNode* nodes[4] = {&a, &a, &b, &b};
+            float four[4][4];
+            cpu::quad16::quad_four_errors(k, wider, nodes, md2, four);
+            for (unsigned c = 0; c < 4u; ++c)
+                for (unsigned p = 0; p < 4u; ++p)
+                    ASSERT_TRUE(same(four[c][p], scalar_error(*nodes[c], 4u * (c & 1u) + p)))
+                        << "trial " << trial << " cluster " << c << " lane " << p;
+        }
+        glm::vec3 units[2][4], wi[2][4];
+        float t_max[2][4];
+        ASSERT_TRUE(cpu::quad8::quad_light_units_pair(k, octet, light, light, md2, units, wi, t_max));
+        for (unsigned p = 0; p < 8u; ++p) {
+            glm::vec3 scalar_wi(0.0f);
+            float scalar_t_max = 0.0f;
+            const glm::vec3 scalar = (active >> p & 1u) != 0u ? k.lc_light_unit(sp[p], light, md2, scalar_wi, scalar_t_max)
+                                                              : glm::vec3(0.0f);
+            const glm::vec3 unit = units[p / 4u][p % 4u];
+            ASSERT_EQ(unit, scalar) << "trial " << trial << " point " << p;
+            if (!(scalar.x + scalar.y + scalar.z > 0.0f)) continue;
+            ++lit_units;
+            ASSERT_EQ(wi[p / 4u][p % 4u], scalar_wi) << "trial " << trial << " point " << p;
+            ASSERT_EQ(t_max[p / 4u][p % 4u], scalar_t_max) << "trial " << trial << " point " << p;
+        }
+    }
+    EXPECT_GT(checked, 8 * 3000);
+    EXPECT_GT(lit_bounds, checked / 4);
+    EXPECT_GT(lit_units, checked / 10);
+}
+#endif
+
 // With a heap as large as the tree needs and no cut limit, every cluster
 // left in a quad's cut meets Walter's criterion at each of the four points:
 // its bound there is at most relative_error times that point's estimate.
 // (The estimate the refinement tests is the running sum, which differs
 // from the final sum by float rounding: the check allows 1e-5 of it.)
 // Nothing is frozen, and every cut refines beyond the roots.
-TEST(QuadCut, EveryClusterMeetsTheCriterionAtEveryPoint) {
+// Point q of the block of N pixels at (x, y): host/cpu_renderer.cpp's
+// order, each quad's four points, the left quad's first.
+std::uint32_t block_x(std::uint32_t q) { return (q & 1u) + 2u * (q >> 2u); }
+std::uint32_t block_y(std::uint32_t q) { return q >> 1u & 1u; }
+
+template <std::uint32_t N>
+void expect_every_cluster_meets_the_criterion() {
     Scene s = test::room_scene(test::random_point_lights(500, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 17), 16);
     PreparedScene p = prepare_scene(std::move(s), 1);
     RenderOptions o = test::options("lightcuts", 16);
     o.max_cut = 1u << 20;
     const gpu::FrameParams f = make_frame_params(p, o);
-    cpu::QuadHeap heap(p.tree.cut_heap_capacity(f.max_cut));
+    cpu::BlockHeap<N> heap(p.tree.cut_heap_capacity(f.max_cut));
     Kernel k = cpu::make_shade_kernel(p);
-    cpu::QuadCut<Kernel> quad(k, heap, f);
+    cpu::BlockCut<Kernel, N> block(k, heap, f);
     std::size_t checked = 0;
     for (std::uint32_t y = 0; y < 16; y += 2)
-        for (std::uint32_t x = 0; x < 16; x += 2) {
-            Kernel::SurfacePoint sp[4];
+        for (std::uint32_t x = 0; x < 16; x += N / 2u) {
+            Kernel::SurfacePoint sp[N];
             unsigned active = 0u;
-            for (std::uint32_t q = 0; q < 4u; ++q)
-                if (k.lc_camera_hit(f, x + (q & 1u), y + (q >> 1u), 0, sp[q])) active |= 1u << q;
-            ASSERT_EQ(active, 0xFu) << "the room is closed";
-            glm::vec3 radiance[4];
-            Kernel::ShadeStats stats[4];
-            quad.shade(sp, active, radiance, stats);
-            for (std::uint32_t q = 0; q < 4u; ++q) {
+            for (std::uint32_t q = 0; q < N; ++q)
+                if (k.lc_camera_hit(f, x + block_x(q), y + block_y(q), 0, sp[q])) active |= 1u << q;
+            ASSERT_EQ(active, (1u << N) - 1u) << "the room is closed";
+            glm::vec3 radiance[N];
+            Kernel::ShadeStats stats[N];
+            block.shade(sp, active, radiance, stats);
+            for (std::uint32_t q = 0; q < N; ++q) {
                 ASSERT_EQ(stats[q].frozen, 0u);
                 ASSERT_EQ(stats[q].hit_max_cut, 0u);
                 ASSERT_GT(stats[q].cut_size, 1u);
-                ASSERT_EQ(stats[q].cut_size, stats[0].cut_size) << "one cut for the quad";
+                ASSERT_EQ(stats[q].cut_size, stats[0].cut_size) << "one cut for the block";
             }
-            for (std::uint32_t i = 0; i < quad.heap_size(); ++i) {
-                const cpu::QuadEntry& e = heap.entries()[heap.slot()[i]];
-                for (std::uint32_t q = 0; q < 4u; ++q) {
+            for (std::uint32_t i = 0; i < block.heap_size(); ++i) {
+                const cpu::BlockEntry<N>& e = heap.entries()[heap.slot()[i]];
+                for (std::uint32_t q = 0; q < N; ++q) {
                     const float estimate = gpu::lc_luminance(radiance[q]);
                     ASSERT_LE(e.error[q], f.relative_error * estimate * (1.0f + 1e-5f))
-                        << "quad " << x << "," << y << " point " << q << " node " << e.node;
+                        << "block " << x << "," << y << " point " << q << " node " << e.node;
                     ++checked;
                 }
             }
@@ -374,14 +473,18 @@ TEST(QuadCut, EveryClusterMeetsTheCriterionAtEveryPoint) {
     EXPECT_GT(checked, 1000u);
 }
 
-// What the stress tests check of a cut per pixel, for quads: at each point
+TEST(QuadCut, EveryClusterMeetsTheCriterionAtEveryPoint) { expect_every_cluster_meets_the_criterion<4>(); }
+TEST(OctetCut, EveryClusterMeetsTheCriterionAtEveryPoint) { expect_every_cluster_meets_the_criterion<8>(); }
+
+// What the stress tests check of a cut per pixel, for shared cuts: at each point
 // the error of the result against brute force is at most the sum of the
 // bounds of the cut's clusters there, those left in the heap and those
 // frozen out of it (each cluster's true contribution and its estimate both
-// lie between 0 and its bound). With heaps of 4 and 12 slots, which freeze
-// at almost every quad, and two trees (point and directional lights), so
+// lie between 0 and its bound). With heaps of 1 and 3 slots a point, which
+// freeze at almost every block, and two trees (point and directional lights), so
 // two roots. The sums of floats are allowed 1e-4 of the bound.
-TEST(QuadCut, ErrorIsWithinTheCutsBoundsAtEveryPoint) {
+template <std::uint32_t N>
+void expect_error_within_the_cuts_bounds() {
     std::vector<gpu::Light> lights = test::random_point_lights(300, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 6);
     lights.push_back(test::directional_light({0.3f, -1.0f, 0.2f}, glm::vec3(0.5f)));
     lights.push_back(test::directional_light({-0.4f, -1.0f, -0.1f}, glm::vec3(0.3f)));
@@ -390,29 +493,29 @@ TEST(QuadCut, ErrorIsWithinTheCutsBoundsAtEveryPoint) {
     cpu::CutHeap brute_heap(1);
     Kernel k = cpu::make_shade_kernel(p, &brute_heap);
     std::size_t points = 0, froze = 0;
-    for (std::uint32_t slots : {4u, 12u}) {
-        cpu::QuadHeap heap(slots);
-        cpu::QuadCut<Kernel> quad(k, heap, f);
+    for (std::uint32_t slots : {N, 3u * N}) {
+        cpu::BlockHeap<N> heap(slots);
+        cpu::BlockCut<Kernel, N> block(k, heap, f);
         for (std::uint32_t y = 0; y < 12; y += 2)
-            for (std::uint32_t x = 0; x < 12; x += 2) {
-                Kernel::SurfacePoint sp[4];
+            for (std::uint32_t x = 0; x < 12; x += N / 2u) {
+                Kernel::SurfacePoint sp[N];
                 unsigned active = 0u;
-                for (std::uint32_t q = 0; q < 4u; ++q)
-                    if (k.lc_camera_hit(f, x + (q & 1u), y + (q >> 1u), 0, sp[q])) active |= 1u << q;
-                glm::vec3 radiance[4];
-                Kernel::ShadeStats stats[4];
-                quad.shade(sp, active, radiance, stats);
-                for (std::uint32_t q = 0; q < 4u; ++q) {
+                for (std::uint32_t q = 0; q < N; ++q)
+                    if (k.lc_camera_hit(f, x + block_x(q), y + block_y(q), 0, sp[q])) active |= 1u << q;
+                glm::vec3 radiance[N];
+                Kernel::ShadeStats stats[N];
+                block.shade(sp, active, radiance, stats);
+                for (std::uint32_t q = 0; q < N; ++q) {
                     if ((active >> q & 1u) == 0u) continue;
                     double bounds = stats[q].frozen_error;
-                    for (std::uint32_t i = 0; i < quad.heap_size(); ++i)
+                    for (std::uint32_t i = 0; i < block.heap_size(); ++i)
                         bounds += heap.entries()[heap.slot()[i]].error[q];
                     Kernel::ShadeStats ss{};
                     const glm::vec3 exact = k.lc_shade_brute(sp[q], f.light_count, f.min_distance2, ss);
                     const double error = std::abs(double(gpu::lc_luminance(radiance[q])) -
                                                   double(gpu::lc_luminance(exact)));
                     ASSERT_LE(error, bounds * (1.0 + 1e-4) + 1e-12)
-                        << slots << " slots, quad " << x << "," << y << " point " << q;
+                        << slots << " slots, block " << x << "," << y << " point " << q;
                     ++points;
                     froze += stats[q].frozen > 0u ? 1u : 0u;
                 }
@@ -422,13 +525,16 @@ TEST(QuadCut, ErrorIsWithinTheCutsBoundsAtEveryPoint) {
     EXPECT_GT(froze, points / 2);
 }
 
-// A floor seen at an angle, with the sky above the horizon: quads whose
-// camera rays partly miss, on an image whose odd sides cut the last column
-// and row of quads in half. With relative_error 0 and a heap as large as
-// the tree needs every cluster is refined to its lights, so each pixel of
-// the quads is brute force's up to the summation order, the missed ones
-// included.
-TEST(QuadCut, PartialQuadsAndMissedPixelsAreShaded) {
+TEST(QuadCut, ErrorIsWithinTheCutsBoundsAtEveryPoint) { expect_error_within_the_cuts_bounds<4>(); }
+TEST(OctetCut, ErrorIsWithinTheCutsBoundsAtEveryPoint) { expect_error_within_the_cuts_bounds<8>(); }
+
+// A floor seen at an angle, with the sky above the horizon: quads and
+// octets whose camera rays partly miss, on an image whose odd sides cut the
+// last column and row of blocks (the last octets' right quads lie wholly
+// outside). With relative_error 0 and a heap as large as the tree needs
+// every cluster is refined to its lights, so each pixel of the blocks is
+// brute force's up to the summation order, the missed ones included.
+TEST(QuadCut, PartialBlocksAndMissedPixelsAreShaded) {
     Scene s;
     s.materials = {test::lambert(glm::vec3(0.6f))};
     test::add_quad(s, {-4, 0, -8}, {4, 0, -8}, {4, 0, 2}, {-4, 0, 2}, 0);
@@ -438,50 +544,97 @@ TEST(QuadCut, PartialQuadsAndMissedPixelsAreShaded) {
     PreparedScene p = prepare_scene(std::move(s), 1);
     RenderOptions o = test::options("lightcuts", 13);
     o.height = 7;
-    o.cut_sharing = "quad";
     o.relative_error = 0.0f;
     o.max_cut = 1u << 20;
     o.cut_heap = o.max_cut;
-    const RenderResult lc = render_cpu(p, o);
-    EXPECT_TRUE(lc.stats.quad_cuts);
     o.method = "brute";
     const RenderResult brute = render_cpu(p, o);
-    int missed = 0, lit = 0;
-    for (std::uint32_t y = 0; y < 7; ++y)
-        for (std::uint32_t x = 0; x < 13; ++x) {
-            const glm::vec3 want = brute.image.at(x, y), got = lc.image.at(x, y);
-            for (int c = 0; c < 3; ++c) ASSERT_NEAR(got[c], want[c], 1e-5f * want[c] + 1e-9f) << x << "," << y;
-            const float cut = lc.stats.cut_size[std::size_t(y) * 13 + x];
-            if (want == glm::vec3(0.0f) && cut == 0.0f) ++missed;
-            if (want.x > 0.0f) ++lit;
-        }
-    EXPECT_GT(missed, 5) << "some camera rays must leave the scene";
-    EXPECT_GT(lit, 30);
+    o.method = "lightcuts";
+    for (const char* sharing : {"quad", "octet"}) {
+        SCOPED_TRACE(sharing);
+        o.cut_sharing = sharing;
+        const RenderResult lc = render_cpu(p, o);
+        EXPECT_EQ(lc.stats.cut_points, o.cut_sharing == "quad" ? 4u : 8u);
+        int missed = 0, lit = 0;
+        for (std::uint32_t y = 0; y < 7; ++y)
+            for (std::uint32_t x = 0; x < 13; ++x) {
+                const glm::vec3 want = brute.image.at(x, y), got = lc.image.at(x, y);
+                for (int c = 0; c < 3; ++c) ASSERT_NEAR(got[c], want[c], 1e-5f * want[c] + 1e-9f) << x << "," << y;
+                const float cut = lc.stats.cut_size[std::size_t(y) * 13 + x];
+                if (want == glm::vec3(0.0f) && cut == 0.0f) ++missed;
+                if (want.x > 0.0f) ++lit;
+            }
+        EXPECT_GT(missed, 5) << "some camera rays must leave the scene";
+        EXPECT_GT(lit, 30);
+    }
 }
 
-// Each pixel's cut alone, or the quad's: a render names the one it made.
-TEST(QuadCut, CutSharingSettingPicksThePath) {
-    // 400 lights: 399 interior nodes, more than a quad's 4 x 64 slots.
-    Scene s = test::room_scene(test::random_point_lights(400, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 2), 8);
+// Octets where their cuts stay below max_cut, quads after one that reached
+// it (host/cpu_renderer.cpp, shade_tile_by_octets): with max_cut 40 every
+// cut reaches it, so in each 8x8 tile the first 4x2 block is an octet and
+// every later one two quads, whose pixels are then the quad render's bit
+// for bit; the octets' are not (their last pass marks what eight points
+// need, a quad's what four do).
+TEST(OctetCut, BlocksAfterAnOctetAtMaxCutAreCutAsQuads) {
+    Scene s = test::room_scene(test::random_point_lights(300, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 5), 20);
     PreparedScene p = prepare_scene(std::move(s), 1);
-    ASSERT_GT(p.tree.cut_heap_capacity(1000), 4 * kDefaultCutHeap);
+    RenderOptions o = test::options("lightcuts", 20);
+    o.height = 12;
+    o.max_cut = 40;
+    o.cut_sharing = "quad";
+    const RenderResult quads = render_cpu(p, o);
+    o.cut_sharing = "octet";
+    const RenderResult octets = render_cpu(p, o);
+    ASSERT_EQ(octets.stats.cut_points, 8u);
+    for (float cut : octets.stats.cut_size) ASSERT_EQ(cut, 40.0f) << "every cut must reach max_cut";
+    int octet_pixels = 0, octet_pixels_differing = 0, quad_pixels = 0;
+    for (std::uint32_t y = 0; y < 12; ++y)
+        for (std::uint32_t x = 0; x < 20; ++x) {
+            const bool first_block = x % 8u < 4u && y % 8u < 2u;
+            const glm::vec3 got = octets.image.at(x, y), quad = quads.image.at(x, y);
+            if (first_block) {
+                ++octet_pixels;
+                octet_pixels_differing += got != quad ? 1 : 0;
+                continue;
+            }
+            ++quad_pixels;
+            ASSERT_EQ(got, quad) << "pixel " << x << "," << y << " is not its quad's";
+        }
+    EXPECT_EQ(octet_pixels, 3 * 2 * 4 * 2);  // 3 x 2 tiles (the last column and row cut short)
+    EXPECT_GT(octet_pixels_differing, 0) << "the octets' cuts are their own";  // 4 of the 24 here
+    EXPECT_GT(quad_pixels, 150);
+}
+
+// Each pixel's cut alone, the quad's or the octet's: a render names the
+// one it made, and its heap pools the points' slots.
+TEST(QuadCut, CutSharingSettingPicksThePath) {
+    // 700 lights: 699 interior nodes, more than an octet's 8 x 64 slots.
+    Scene s = test::room_scene(test::random_point_lights(700, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 2), 8);
+    PreparedScene p = prepare_scene(std::move(s), 1);
+    ASSERT_GT(p.tree.cut_heap_capacity(1000), 8 * kDefaultCutHeap);
     RenderOptions o = test::options("lightcuts", 8);
     EXPECT_EQ(o.cut_sharing, "auto");
-    EXPECT_TRUE(render_cpu(p, o).stats.quad_cuts);
+    const RenderResult automatic = render_cpu(p, o);
+    EXPECT_EQ(automatic.stats.cut_points, 8u);
     o.cut_sharing = "pixel";
     const RenderResult pixel = render_cpu(p, o);
-    EXPECT_FALSE(pixel.stats.quad_cuts);
+    EXPECT_EQ(pixel.stats.cut_points, 1u);
     EXPECT_EQ(pixel.stats.heap_slots, kDefaultCutHeap);
     o.cut_sharing = "quad";
     const RenderResult quad = render_cpu(p, o);
-    EXPECT_TRUE(quad.stats.quad_cuts);
+    EXPECT_EQ(quad.stats.cut_points, 4u);
     EXPECT_EQ(quad.stats.heap_slots, 4 * kDefaultCutHeap);
+    o.cut_sharing = "octet";
+    const RenderResult octet = render_cpu(p, o);
+    EXPECT_EQ(octet.stats.cut_points, 8u);
+    EXPECT_EQ(octet.stats.heap_slots, 8 * kDefaultCutHeap);
+    EXPECT_EQ(octet.image.rgb, automatic.image.rgb) << "auto is octet on the CPU";
     o.method = "stochastic";  // cuts each pixel alone
-    EXPECT_FALSE(render_cpu(p, o).stats.quad_cuts);
+    EXPECT_EQ(render_cpu(p, o).stats.cut_points, 1u);
     o.method = "lightcuts";
     o.cut_sharing = "tiles";
     EXPECT_THROW(render_cpu(p, o), std::invalid_argument);
-    EXPECT_EQ(cut_sharing_problem("tiles"), "must be \"auto\", \"pixel\" or \"quad\", got \"tiles\"");
+    EXPECT_EQ(cut_sharing_problem("tiles"), "must be \"auto\", \"pixel\", \"quad\" or \"octet\", got \"tiles\"");
 }
 
 }  // namespace

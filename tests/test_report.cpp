@@ -48,15 +48,22 @@ TEST(Report, JsonHasEveryKeyScriptsReadAndTheBlackLights) {
     EXPECT_THAT(json, HasSubstr("\"load\": 0.25"));
     EXPECT_THAT(report_text(report), HasSubstr("lights 20 (and 3 black, left out of the tree)"));
     EXPECT_THAT(report_text(report), HasSubstr("cut size mean"));
-    // The CPU's default: quads share cuts, and the heap is a quad's.
-    EXPECT_THAT(json, HasSubstr("\"cut_sharing\": \"quad\""));
-    EXPECT_THAT(report_text(report), HasSubstr("cuts shared by the pixels of each 2x2 quad"));
-    EXPECT_THAT(report_text(report), HasSubstr("slots per quad"));
+    // The CPU's default: octets share cuts, and the heap is an octet's.
+    EXPECT_THAT(json, HasSubstr("\"cut_sharing\": \"octet\""));
+    EXPECT_THAT(report_text(report), HasSubstr("cuts shared by the eight pixels of each 4x2 octet"));
+    EXPECT_THAT(report_text(report), HasSubstr("slots per octet"));
+    RenderOptions quad = o;
+    quad.cut_sharing = "quad";
+    const RenderReport per_quad = make_report("room.json", quad, p, render_cpu(p, quad), 0.25);
+    EXPECT_THAT(report_json(per_quad), HasSubstr("\"cut_sharing\": \"quad\""));
+    EXPECT_THAT(report_text(per_quad), HasSubstr("cuts shared by the pixels of each 2x2 quad"));
+    EXPECT_THAT(report_text(per_quad), HasSubstr("slots per quad"));
     RenderOptions pixel = o;
     pixel.cut_sharing = "pixel";
     const RenderReport per_pixel = make_report("room.json", pixel, p, render_cpu(p, pixel), 0.25);
     EXPECT_THAT(report_json(per_pixel), HasSubstr("\"cut_sharing\": \"pixel\""));
     EXPECT_THAT(report_text(per_pixel), Not(HasSubstr("2x2 quad")));
+    EXPECT_THAT(report_text(per_pixel), Not(HasSubstr("octet")));
     EXPECT_THAT(report_text(per_pixel), HasSubstr("slots per point"));
 }
 

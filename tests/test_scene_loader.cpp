@@ -841,6 +841,7 @@ TEST(SceneLoader, CutSharingSetting) {
     EXPECT_EQ(load_scene(scene_with_render(dir, R"({"method": "lightcuts"})")).render.cut_sharing, "auto");
     EXPECT_EQ(load_scene(scene_with_render(dir, R"({"cut_sharing": "pixel"})")).render.cut_sharing, "pixel");
     EXPECT_EQ(load_scene(scene_with_render(dir, R"({"cut_sharing": "quad"})")).render.cut_sharing, "quad");
+    EXPECT_EQ(load_scene(scene_with_render(dir, R"({"cut_sharing": "octet"})")).render.cut_sharing, "octet");
     const fs::path bad = scene_with_render(dir, R"({"cut_sharing": "tiles"})");
     EXPECT_EQ(input_error_of([&] { load_scene(bad); }),
               bad.lexically_normal().string() + ": render.cut_sharing: " + cut_sharing_problem("tiles"));

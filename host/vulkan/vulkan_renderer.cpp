@@ -83,7 +83,7 @@ RenderResult render(const Context& ctx, const PreparedScene& prepared,
     stats.heap_shared_bytes = stats.heap_private ? 0
                                                  : std::uint64_t(stats.heap_slots) * gpu::kWorkgroupSize *
                                                        setup.method->heap_entry_bytes();
-    stats.quad_cuts = setup.method->quad_cuts();
+    stats.cut_points = setup.method->quad_cuts() ? 4u : 1u;
     stats.workgroup_size = gpu::kWorkgroupSize;
     stats.buffer_bytes = setup.resources.buffer_bytes();
     return result;
@@ -97,6 +97,10 @@ bool share_cuts(const Context& ctx, const LightTree& tree, const RenderOptions& 
     // took 1.2 to 2 times as long as the per-pixel one (docs/results/
     // lavapipe.md, §17), as its lanes share the cut's decisions but not its
     // work. GPUs are not measured.
+    if (options.method == "lightcuts" && options.cut_sharing == "octet")
+        throw std::invalid_argument("cut_sharing \"octet\" on " + ctx.device_name() +
+                                    ": octets share cuts on the CPU only; use cut_sharing \"auto\", \"pixel\" or "
+                                    "\"quad\", or --device cpu");
     if (options.method != "lightcuts" || options.cut_sharing != "quad") return false;
     std::string why;
     if (!device_has_quad_subgroups(ctx)) {

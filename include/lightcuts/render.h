@@ -70,9 +70,10 @@ struct RenderOptions {
     float relative_error = 0.02f;
     std::uint32_t max_cut = 1000;
     std::uint32_t cut_heap = kDefaultCutHeap;  // lightcuts: cut-heap capacity K per shaded point
-                                               // (where quads share cuts, a quad's heap pools its
-                                               // four points' K slots)
-    std::string cut_sharing = "auto";  // lightcuts: "pixel", "quad" or "auto" ("quad" on the CPU, "pixel" on Vulkan)
+                                               // (where pixels share cuts, a shared cut's heap pools
+                                               // their K slots)
+    std::string cut_sharing = "auto";  // lightcuts: "pixel", "quad", "octet" or "auto" ("octet" on the CPU,
+                                       // "pixel" on Vulkan)
                                        // (cut_sharing_problem, lightcuts/settings.h)
     std::uint32_t seed = 1;
     std::uint32_t light_samples = 1;  // sampled: lights per camera sample; stochastic: draws per cluster
@@ -93,11 +94,11 @@ struct RenderStats {
     std::uint64_t camera_rays = 0;
     std::uint64_t shadow_rays = 0;
     std::uint64_t max_cut_pixels = 0;       // samples where refinement hit max_cut
-    bool quad_cuts = false;                 // lightcuts: 2x2 quads of pixels shared each cut
-                                            // (cut_sharing; then the heap is a quad's)
+    std::uint32_t cut_points = 1;           // lightcuts: the pixels that shared each cut: 1, 4 (2x2
+                                            // quads) or 8 (4x2 octets; cut_sharing); the heap is theirs
     std::uint32_t heap_slots = 0;           // lightcuts: cut-heap slots per shaded point (GPU: in
                                             // shared memory), min(cut_heap, what the tree can fill);
-                                            // per quad where quad_cuts: min(4 cut_heap, ...)
+                                            // per shared cut: min(cut_points cut_heap, ...)
     std::uint64_t heap_frozen_samples = 0;  // lightcuts: samples whose cut froze clusters out of a
                                             // full heap
     std::uint64_t heap_paused_samples = 0;  // GPU: samples whose heap waited in global memory

@@ -27,11 +27,12 @@ struct LightcutsReport {
     double cut_indirect_mean = 0.0;           // of cut_size_mean, VPL clusters (indirect light)
     std::uint64_t max_cut_samples = 0;        // samples whose refinement stopped at max_cut
     std::uint32_t cut_heap = 0;               // render.cut_heap, the heap's capacity K
-    bool quad_cuts = false;                   // CPU: the pixels of each 2x2 quad shared a cut (and a
-                                              // heap); cut sizes are then the quads' (cut_sharing)
+    std::uint32_t cut_points = 1;             // the pixels that shared each cut (and a heap): 1, 4 for
+                                              // 2x2 quads, 8 for 4x2 octets (CPU); cut sizes are then
+                                              // the shared cuts' (cut_sharing)
     std::uint32_t heap_slots = 0;             // slots a heap gets: K, or less where the tree
                                               // cannot fill K (GPU: in shared memory); a quad's
-                                              // heap (quad_cuts): 4K, or less
+                                              // heap: cut_points K, or less
     std::uint64_t heap_bytes = 0;             // GPU: shared memory the heaps of a workgroup take
     bool heap_private = false;                // GPU: each heap in its invocation's private memory instead
     std::uint32_t workgroup_size = 0;         // GPU: invocations per workgroup

@@ -61,21 +61,25 @@ inline bool method_selects_cuts(std::string_view method) { return method == "lig
 // What is wrong with a light pick, or "" for "tree", "uniform" and "power".
 std::string light_pick_problem(std::string_view pick);
 
-// What is wrong with a cut sharing, or "" for "auto", "pixel" and "quad".
-// Lightcuts cuts each shaded point alone ("pixel"), or the four points of a
-// 2x2 block of pixels together ("quad": host/quad_cut.h on the CPU,
-// shaders/quadcuts.comp on Vulkan devices with subgroup quad operations).
-// "auto" is "quad" on the CPU and "pixel" on Vulkan.
+// What is wrong with a cut sharing, or "" for "auto", "pixel", "quad" and
+// "octet". Lightcuts cuts each shaded point alone ("pixel"), the four
+// points of a 2x2 block of pixels together ("quad": host/quad_cut.h on the
+// CPU, shaders/quadcuts.comp on Vulkan devices with subgroup quad
+// operations), or the eight of a 4x2 block, two quads side by side
+// ("octet": the CPU only). "auto" is "octet" on the CPU and "pixel" on
+// Vulkan.
 std::string cut_sharing_problem(std::string_view sharing);
 
-// Whether a render on the CPU with these settings shares cuts between the
-// pixels of a quad: method "lightcuts" and cut_sharing "quad" or "auto".
-bool cpu_shares_cuts(std::string_view method, std::string_view sharing);
+// The shaded points that share each cut in a render on the CPU with these
+// settings: 8 for method "lightcuts" with cut_sharing "octet" or "auto", 4
+// with "quad", else 1 (each point cut alone).
+std::uint32_t cpu_cut_points(std::string_view method, std::string_view sharing);
 
-// The heap slots of a quad's shared cut for render.cut_heap K: its four
-// points' K, pooled (a quad's slot holds the four points' bounds).
-inline std::uint32_t quad_cut_heap(std::uint32_t cut_heap) {
-    return cut_heap > UINT32_MAX / 4u ? UINT32_MAX : 4u * cut_heap;
+// The heap slots of a cut shared by `points` points for render.cut_heap K:
+// their K each, pooled (a shared cut's slot holds every point's bounds).
+inline std::uint32_t shared_cut_heap(std::uint32_t cut_heap, std::uint32_t points) {
+    return cut_heap > UINT32_MAX / points ? UINT32_MAX : points * cut_heap;
 }
+inline std::uint32_t quad_cut_heap(std::uint32_t cut_heap) { return shared_cut_heap(cut_heap, 4u); }
 
 }  // namespace lc

@@ -202,7 +202,8 @@ TEST_F(Vulkan, LightcutsMatchesCpuOnRandomScenes) {
 
 // Cuts shared by the pixels of 2x2 quads (quadcuts.comp) against the CPU's
 // (host/quad_cut.h), at odd image sizes (quads cut by the right and bottom
-// edges, lanes without a pixel). "auto" cuts each pixel alone on Vulkan.
+// edges, lanes without a pixel). "auto" cuts each pixel alone on Vulkan;
+// "octet", the CPU's default sharing, is refused there, naming the setting.
 TEST_F(Vulkan, QuadCutsMatchCpu) {
     for (std::uint32_t seed = 20; seed < 23; ++seed) {
         SCOPED_TRACE("seed " + std::to_string(seed));
@@ -212,11 +213,20 @@ TEST_F(Vulkan, QuadCutsMatchCpu) {
         o.max_cut = 100;
         o.cut_sharing = "quad";
         RenderResult g = gpu(p, o);
-        EXPECT_TRUE(g.stats.quad_cuts);
+        EXPECT_EQ(g.stats.cut_points, 4u);
         expect_lightcuts_matches(p, o, g);
         EXPECT_EQ(g.stats.heap_slots, std::min(4 * kDefaultCutHeap, p.tree.cut_heap_capacity(o.max_cut)));
         o.cut_sharing = "auto";
-        EXPECT_FALSE(gpu(p, o).stats.quad_cuts);
+        EXPECT_EQ(gpu(p, o).stats.cut_points, 1u);
+    }
+    PreparedScene p = prepare_scene(random_scene(20, 50, 1, 8, 8), 20);
+    RenderOptions o = options("lightcuts", 8, 8);
+    o.cut_sharing = "octet";
+    try {
+        gpu(p, o);
+        ADD_FAILURE() << "cut_sharing \"octet\" rendered on Vulkan";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("cut_sharing \"octet\""), std::string::npos) << e.what();
     }
 }
 
