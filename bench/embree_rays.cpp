@@ -280,23 +280,18 @@ int run(int argc, char** argv) {
         });
 #if defined(LC_WIDE8_TRACE)
         // Four and eight consecutive rays down the 8-wide tree together,
-        // each tested on its own (trace_any_wide8x4, trace_any_wide8x8): the
+        // each tested on its own (trace_any_wide8_packet): the
         // renderer's packets, brute force's eight lights from one point and
         // a quad's four or an octet's eight points to one light (the latter
         // are not in these ray lists).
         const lc::WideBvhNode8* nodes8 = p.bvh.wide8_nodes.data();
         const lc::WideLeaf* leaves8 = p.bvh.wide8_leaves.data();
         if (lc::cpu::cpu_has_avx2()) {
-            packets.template operator()<4>("software 8-wide BVH, packets of 4",
-                                           [&](lc::cpu::TraceKernel& tk, const lc::cpu::RayPacket4& packet) {
-                return lc::cpu::cpu_has_avx512vl() ? lc::cpu::trace_any_wide8x4_avx512(tk, nodes8, leaves8, packet)
-                                                   : lc::cpu::trace_any_wide8x4_avx2(tk, nodes8, leaves8, packet);
-            });
-            packets.template operator()<8>("software 8-wide BVH, packets of 8",
-                                           [&](lc::cpu::TraceKernel& tk, const lc::cpu::RayPacket8& packet) {
-                return lc::cpu::cpu_has_avx512vl() ? lc::cpu::trace_any_wide8x8_avx512(tk, nodes8, leaves8, packet)
-                                                   : lc::cpu::trace_any_wide8x8_avx2(tk, nodes8, leaves8, packet);
-            });
+            const auto walk = [&](lc::cpu::TraceKernel& tk, const auto& packet) {
+                return lc::cpu::trace_any_wide8_packet(tk, nodes8, leaves8, packet);
+            };
+            packets.template operator()<4>("software 8-wide BVH, packets of 4", walk);
+            packets.template operator()<8>("software 8-wide BVH, packets of 8", walk);
         }
 #endif
 

@@ -407,7 +407,7 @@ struct BasicShadeKernel {
     // lc_visible for up to four rays (bit r of packet.valid): bit r of the
     // result is set where ray r is visible. Each answer is lc_visible's;
     // the rays go down the 8-wide tree together where it is bound
-    // (trace_any_wide8x4: a quad's points' rays to one light), else through
+    // (trace_any_wide8_packet: a quad's points' rays to one light), else through
     // the 4-wide one as a packet (trace_any_wide4), else one at a time (the
     // ray recorder).
     unsigned lc_visible4(const RayPacket4& packet) {
@@ -415,8 +415,7 @@ struct BasicShadeKernel {
         if (!kEnableShadows) return valid;
 #if defined(LC_WIDE8_TRACE)
         if (!kRecordRays && wide8_nodes != nullptr)
-            return valid & ~(cpu_has_avx512vl() ? trace_any_wide8x4_avx512(*this, wide8_nodes, wide8_leaves, packet)
-                                                : trace_any_wide8x4_avx2(*this, wide8_nodes, wide8_leaves, packet));
+            return valid & ~trace_any_wide8_packet(*this, wide8_nodes, wide8_leaves, packet);
 #endif
         if (!kRecordRays && wide_nodes != nullptr) return valid & ~trace_any_wide4(*this, wide_nodes, wide_leaves, packet);
         unsigned visible = 0u;
@@ -431,14 +430,14 @@ struct BasicShadeKernel {
 
     // lc_visible4 for up to eight rays (an octet's points' rays to one
     // light, brute force's rays from one point to eight lights): down the
-    // 8-wide tree together (trace_any_wide8x8), else as two packets of four.
+    // 8-wide tree together (trace_any_wide8_packet), else as two packets of
+    // four.
     unsigned lc_visible8(const RayPacket8& packet) {
         const unsigned valid = packet.valid & 0xFFu;
         if (!kEnableShadows) return valid;
 #if defined(LC_WIDE8_TRACE)
         if (!kRecordRays && wide8_nodes != nullptr)
-            return valid & ~(cpu_has_avx512vl() ? trace_any_wide8x8_avx512(*this, wide8_nodes, wide8_leaves, packet)
-                                                : trace_any_wide8x8_avx2(*this, wide8_nodes, wide8_leaves, packet));
+            return valid & ~trace_any_wide8_packet(*this, wide8_nodes, wide8_leaves, packet);
 #endif
         unsigned visible = 0u;
         for (unsigned h = 0; h < 2u; ++h) {

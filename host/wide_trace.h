@@ -382,34 +382,27 @@ __attribute__((target("avx2,avx512f,avx512vl"))) bool trace_any_wide8_avx512(Ker
     return wide8_walk(kernel, nodes, leaves, org, dir, t_max);
 }
 
-// wide8_walk_packet for AVX2 and for AVX-512VL CPUs, four rays and eight.
-template <class Kernel>
-__attribute__((target("avx2"))) unsigned trace_any_wide8x4_avx2(Kernel& kernel, const WideBvhNode8* nodes,
-                                                                 const WideLeaf* leaves, const RayPacket4& packet) {
+// wide8_walk_packet for AVX2 and for AVX-512VL CPUs (a packet of four
+// rays or of eight).
+template <class Kernel, unsigned R>
+__attribute__((target("avx2"))) unsigned trace_any_wide8_packet_avx2(Kernel& kernel, const WideBvhNode8* nodes,
+                                                                      const WideLeaf* leaves,
+                                                                      const RayPacket<R>& packet) {
     return wide8_walk_packet(kernel, nodes, leaves, packet);
 }
 
-template <class Kernel>
-__attribute__((target("avx2,avx512f,avx512vl"))) unsigned trace_any_wide8x4_avx512(Kernel& kernel,
-                                                                                    const WideBvhNode8* nodes,
-                                                                                    const WideLeaf* leaves,
-                                                                                    const RayPacket4& packet) {
+template <class Kernel, unsigned R>
+__attribute__((target("avx2,avx512f,avx512vl"))) unsigned trace_any_wide8_packet_avx512(
+    Kernel& kernel, const WideBvhNode8* nodes, const WideLeaf* leaves, const RayPacket<R>& packet) {
     return wide8_walk_packet(kernel, nodes, leaves, packet);
 }
 
-// The same for up to eight rays (an octet's points to one light).
-template <class Kernel>
-__attribute__((target("avx2"))) unsigned trace_any_wide8x8_avx2(Kernel& kernel, const WideBvhNode8* nodes,
-                                                                 const WideLeaf* leaves, const RayPacket8& packet) {
-    return wide8_walk_packet(kernel, nodes, leaves, packet);
-}
-
-template <class Kernel>
-__attribute__((target("avx2,avx512f,avx512vl"))) unsigned trace_any_wide8x8_avx512(Kernel& kernel,
-                                                                                    const WideBvhNode8* nodes,
-                                                                                    const WideLeaf* leaves,
-                                                                                    const RayPacket8& packet) {
-    return wide8_walk_packet(kernel, nodes, leaves, packet);
+// The packets' 8-wide walk for this CPU: only where cpu_has_avx2().
+template <class Kernel, unsigned R>
+unsigned trace_any_wide8_packet(Kernel& kernel, const WideBvhNode8* nodes, const WideLeaf* leaves,
+                                const RayPacket<R>& packet) {
+    return cpu_has_avx512vl() ? trace_any_wide8_packet_avx512(kernel, nodes, leaves, packet)
+                              : trace_any_wide8_packet_avx2(kernel, nodes, leaves, packet);
 }
 
 // The 8-wide walk for this CPU: only where cpu_has_avx2().

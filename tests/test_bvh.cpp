@@ -566,7 +566,7 @@ TEST(Bvh, PacketsOfFourGiveEachRaysAnswer) {
 }
 
 #if defined(LC_WIDE8_TRACE)
-// trace_any_wide8x4 and trace_any_wide8x8: R rays from R points (a quad's
+// trace_any_wide8_packet: R rays from R points (a quad's
 // or an octet's points to one light, or anywhere), some of them not in the
 // packet, each answered as its own walk would, in both builds this CPU runs.
 template <unsigned R>
@@ -611,13 +611,9 @@ void expect_packets_from_points_give_each_rays_answer() {
         };
         const lc::WideBvhNode8* nodes = scene.bvh.wide8_nodes.data();
         const lc::WideLeaf* leaves = scene.bvh.wide8_leaves.data();
-        if constexpr (R == 4u) {
-            check("AVX2", lc::cpu::trace_any_wide8x4_avx2(k, nodes, leaves, packet));
-            if (lc::cpu::cpu_has_avx512vl()) check("AVX-512", lc::cpu::trace_any_wide8x4_avx512(k, nodes, leaves, packet));
-        } else {
-            check("AVX2", lc::cpu::trace_any_wide8x8_avx2(k, nodes, leaves, packet));
-            if (lc::cpu::cpu_has_avx512vl()) check("AVX-512", lc::cpu::trace_any_wide8x8_avx512(k, nodes, leaves, packet));
-        }
+        check("AVX2", lc::cpu::trace_any_wide8_packet_avx2(k, nodes, leaves, packet));
+        if (lc::cpu::cpu_has_avx512vl())
+            check("AVX-512", lc::cpu::trace_any_wide8_packet_avx512(k, nodes, leaves, packet));
     }
     EXPECT_EQ(failures, 0) << "first: " << first_failure;
     EXPECT_GT(blocked, rays / 10);
