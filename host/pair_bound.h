@@ -497,18 +497,34 @@ inline void widen(const quad8::QuadLanes& q, QuadLanes& w) {
     w.disney = q.disney;
 }
 
-// Two pairs' quad8::QuadNodes as one: (a, b) in lanes 0-7, (c, d) in 8-15.
-// A pair without emission cones gets the fields of clusters that emit
-// everywhere (cone zero), where the other has some.
-inline QuadNodes join(const quad8::QuadNodes& x, const quad8::QuadNodes& y) {
+// How two pairs' lanes make sixteen: x's in lanes 0-7 and y's in 8-15
+// (Join), or x's pair (a in 0-3, b in 4-7) spread as (a, a, b, b) (Spread).
+struct Join {
+    static V combine(__m256 x, __m256 y) { return join(x, y); }
+};
+struct Spread {
+    static V combine(__m256 x, __m256) {
+        const V w = join(x, x);
+        // (The zero-masked form: GCC 12 warns of the plain one's undefined
+        // pass-through, as for quad16's v_sqrt.)
+        return _mm512_maskz_shuffle_f32x4(__mmask16(0xFFFF), w, w, _MM_SHUFFLE(1, 1, 0, 0));
+    }
+};
+
+// Two pairs' quad8::QuadNodes as one, each field Combine::combine(x's,
+// y's). A pair without emission cones gets the fields of clusters that
+// emit everywhere (cone zero), where the other has some.
+template <class Combine>
+inline QuadNodes combine(const quad8::QuadNodes& x, const quad8::QuadNodes& y) {
+    const auto combine = Combine::combine;
     QuadNodes n;
-    n.min_x = join(x.min_x, y.min_x), n.min_y = join(x.min_y, y.min_y), n.min_z = join(x.min_z, y.min_z);
-    n.max_x = join(x.max_x, y.max_x), n.max_y = join(x.max_y, y.max_y), n.max_z = join(x.max_z, y.max_z);
-    n.radius = join(x.radius, y.radius);
-    n.intensity_r = join(x.intensity_r, y.intensity_r);
-    n.intensity_g = join(x.intensity_g, y.intensity_g);
-    n.intensity_b = join(x.intensity_b, y.intensity_b);
-    n.clamp = join(x.clamp, y.clamp);
+    n.min_x = combine(x.min_x, y.min_x), n.min_y = combine(x.min_y, y.min_y), n.min_z = combine(x.min_z, y.min_z);
+    n.max_x = combine(x.max_x, y.max_x), n.max_y = combine(x.max_y, y.max_y), n.max_z = combine(x.max_z, y.max_z);
+    n.radius = combine(x.radius, y.radius);
+    n.intensity_r = combine(x.intensity_r, y.intensity_r);
+    n.intensity_g = combine(x.intensity_g, y.intensity_g);
+    n.intensity_b = combine(x.intensity_b, y.intensity_b);
+    n.clamp = combine(x.clamp, y.clamp);
     n.any_cone = x.any_cone || y.any_cone;
     if (!n.any_cone) return n;
     const __m256 none = _mm256_setzero_ps();
@@ -527,9 +543,12 @@ inline QuadNodes join(const quad8::QuadNodes& x, const quad8::QuadNodes& y) {
                             &QuadNodes::spot};
     static_assert(sizeof fields / sizeof fields[0] == sizeof wide / sizeof wide[0]);
     for (std::size_t i = 0; i < sizeof wide / sizeof wide[0]; ++i)
-        n.*wide[i] = join(cones(x, fields[i]), cones(y, fields[i]));
+        n.*wide[i] = combine(cones(x, fields[i]), cones(y, fields[i]));
     return n;
 }
+
+// Two pairs' quad8::QuadNodes as one: (a, b) in lanes 0-7, (c, d) in 8-15.
+inline QuadNodes join(const quad8::QuadNodes& x, const quad8::QuadNodes& y) { return combine<Join>(x, y); }
 
 // lc_cluster_error of nodes[k] into errors[k][p] at the quad's points (zero
 // in inactive lanes). For clusters that quad_errors covers (the caller
@@ -546,6 +565,21 @@ void quad_four_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode* 
     _mm512_store_ps(out, e);
     for (unsigned k = 0; k < 4u; ++k)
         for (unsigned p = 0; p < 4u; ++p) errors[k][p] = out[4u * k + p];
+}
+
+// lc_cluster_error of `a` and `b` at an octet's eight points (the two
+// quads' lanes side by side, widened: quad8::join, then widen) into
+// errors_a[p] and errors_b[p]: the pair's lanes built once and spread as
+// (a, a, b, b). For clusters that quad_errors covers (the caller checks).
+template <class Kernel>
+void octet_pair_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode& a, const gpu::LightNode& b,
+                       float min_distance2, float errors_a[8], float errors_b[8]) {
+    const quad8::QuadNodes pair = quad8::quad_nodes(kernel, a, b, min_distance2, q.specular != 0u || q.disney != 0u);
+    V e;
+    cluster_errors<Kernel>(q, combine<Spread>(pair, pair), e);
+    alignas(64) float out[16];
+    _mm512_store_ps(out, e);
+    for (unsigned p = 0; p < 8u; ++p) errors_a[p] = out[p], errors_b[p] = out[8u + p];
 }
 }  // namespace quad16
 #if defined(__clang__)

@@ -509,13 +509,7 @@ private:
             } else if (wide16_) {
                 // Both children at both quads: (a, a, b, b) over lanes16_'s
                 // (quad 0, quad 1, quad 0, quad 1).
-                const LightNode* nodes[4] = {&a, &a, &b, &b};
-                float e[4][kQuadLanes];
-                quad16::quad_four_errors(k_, lanes16_, nodes, f_.min_distance2, e);
-                for (uint p = 0; p < kQuadLanes; ++p) {
-                    errors_a[p] = e[0][p], errors_a[p + 4u] = e[1][p];
-                    errors_b[p] = e[2][p], errors_b[p + 4u] = e[3][p];
-                }
+                quad16::octet_pair_errors(k_, lanes16_, a, b, f_.min_distance2, errors_a, errors_b);
                 return;
             }
         }

@@ -331,9 +331,10 @@ TEST(QuadCut, LightUnitsAreTheScalarOnesBitForBit) {
 
 #if defined(__SSE2__)
 // An octet's lanes (quad8::join, the two quads' points side by side): one
-// cluster given twice to quad_pair_errors, a refinement's two children
-// given as (a, a, b, b) to quad16::quad_four_errors over the joined lanes
-// widened, and a light given twice to quad_light_units_pair give the
+// cluster given twice to quad_pair_errors, a refinement's two children to
+// quad16::octet_pair_errors over the joined lanes widened (the pair's
+// lanes spread as a, a, b, b), and a light given twice to
+// quad_light_units_pair give the
 // scalar bounds and units at all eight points, bit for bit, over random
 // clusters with and without emission cones, lights, materials (Lambert,
 // GGX, Disney) and active points (a quad with none among them).
@@ -392,13 +393,12 @@ TEST(OctetCut, LanesAreTheScalarOnesBitForBit) {
         if (cpu::cpu_has_avx512dq()) {
             cpu::quad16::QuadLanes wider;
             cpu::quad16::widen(octet, wider);
-            const gpu::LightNode* nodes[4] = {&a, &a, &b, &b};
-            float four[4][4];
-            cpu::quad16::quad_four_errors(k, wider, nodes, md2, four);
-            for (unsigned c = 0; c < 4u; ++c)
-                for (unsigned p = 0; p < 4u; ++p)
-                    ASSERT_TRUE(same(four[c][p], scalar_error(*nodes[c], 4u * (c & 1u) + p)))
-                        << "trial " << trial << " cluster " << c << " lane " << p;
+            float errors_a[8], errors_b[8];
+            cpu::quad16::octet_pair_errors(k, wider, a, b, md2, errors_a, errors_b);
+            for (unsigned p = 0; p < 8u; ++p) {
+                ASSERT_TRUE(same(errors_a[p], scalar_error(a, p))) << "trial " << trial << " point " << p << " (a)";
+                ASSERT_TRUE(same(errors_b[p], scalar_error(b, p))) << "trial " << trial << " point " << p << " (b)";
+            }
         }
         glm::vec3 units[2][4], wi[2][4];
         float t_max[2][4];
