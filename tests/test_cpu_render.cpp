@@ -1,5 +1,6 @@
 // The CPU reference renderer against analytic answers.
 #include <cmath>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -145,14 +146,20 @@ TEST(CpuRender, BlockerCastsShadowWhereGeometrySays) {
     EXPECT_GT(lit, 500);
 }
 
+// Lightcuts also with max_cut 40, where some octets reach it and the
+// blocks after them in their tiles are cut as quads (shade_tile_by_octets).
 TEST(CpuRender, SameImageBitForBitWhateverTheThreadCount) {
     Scene s = test::room_scene(test::random_point_lights(200, {-0.9f, 1.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 20.0f, 7), 40);
     PreparedScene p = prepare_scene(std::move(s), 3);
-    for (const char* method : {"brute", "lightcuts"}) {
+    for (const auto& [method, max_cut] : {std::pair{"brute", 1000u}, {"lightcuts", 1000u}, {"lightcuts", 40u}}) {
         RenderOptions o = test::options(method, 40);
         o.spp = 2;
+        o.max_cut = max_cut;
         o.threads = 1;
         RenderResult one = render_cpu(p, o);
+        if (max_cut == 40u) {
+            EXPECT_GT(one.stats.max_cut_pixels, 0u);
+        }
         for (unsigned threads : {2u, 3u, 7u}) {
             o.threads = threads;
             RenderResult many = render_cpu(p, o);
