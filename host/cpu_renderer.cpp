@@ -153,7 +153,7 @@ bool shade_block(cpu::ShadeKernel& k, const gpu::FrameParams& frame, std::uint32
 // cut alike, relative RMSE against brute force 0.0384 -> 0.0425 and 17.6%
 // -> 22.1% of its pixels above 5% (128x128). So after an octet whose cut
 // reached max_cut the tile's next blocks are cut as two quads, until both
-// stay below it (0.0403 and 18.5%, at 81% of the quads' time). Tiles are
+// stay below it (0.0403 and 18.5%, at 0.80 of the quads' time). Tiles are
 // shaded in a fixed order, so the image does not depend on the threads.
 // store(x, y, result) takes each pixel's result.
 template <class Store>
