@@ -617,7 +617,7 @@ private:
         Entry& fresh = entries_[fresh_slot];
         kept.node = kept_index;
         fresh.node = fresh_index;
-        const Ahead* ahead = take_ahead(parent, kept.error, fresh.error);
+        const Ahead* ahead = N == 4u ? take_ahead(parent, kept.error, fresh.error) : nullptr;  // look_ahead is a quad's
         if (ahead == nullptr) child_errors(kept_node, fresh_node, kept.error, fresh.error);
         const bool fresh_leaf = (fresh_node.flags & kNodeLeaf) != 0u;
         // The new representative's shadow ray from each point, all traced
