@@ -404,19 +404,31 @@ void quad_pair_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode& 
     _mm_storeu_ps(errors_a, _mm256_castps256_ps128(e));
     _mm_storeu_ps(errors_b, _mm256_extractf128_ps(e, 1));
 }
+// quad_light_units of `a` (lanes 0-3) and `b` (4-7) at once, as lanes:
+// rows 0-2 of v the units' red, green and blue, 3-5 the directions to the
+// light, 6 the rays' lengths; bit l of `lit` set where lane l's unit is
+// not zero (elsewhere the lane's values are zeros or not meaningful).
+// false (nothing written) where quad_light_units does not cover both.
+template <class Kernel>
+bool quad_light_unit_lanes(Kernel& kernel, const QuadLanes& q, const gpu::Light& a, const gpu::Light& b,
+                           float min_distance2, float v[7][8], unsigned& lit) {
+    if (!q.covered || !quad_units_cover(a) || !quad_units_cover(b)) return false;
+    V r, g, bl, wx, wy, wz, length;
+    lit = unsigned(
+        _mm256_movemask_ps(light_values<Kernel>(q, light_lanes(kernel, a, b, min_distance2), r, g, bl, wx, wy, wz, length)));
+    const V rows[7] = {r, g, bl, wx, wy, wz, length};
+    for (unsigned k = 0; k < 7u; ++k) _mm256_storeu_ps(v[k], rows[k]);
+    return true;
+}
 // quad_light_units of `a` and `b` at once, in the eight lanes of AVX2, into
 // unit[0], wi[0], t_max[0] and unit[1], wi[1], t_max[1]; false (nothing
 // written) where quad_light_units does not cover both.
 template <class Kernel>
 bool quad_light_units_pair(Kernel& kernel, const QuadLanes& q, const gpu::Light& a, const gpu::Light& b,
                            float min_distance2, glm::vec3 unit[2][4], glm::vec3 wi[2][4], float t_max[2][4]) {
-    if (!q.covered || !quad_units_cover(a) || !quad_units_cover(b)) return false;
     alignas(32) float v[7][8];
-    V r, g, bl, wx, wy, wz, length;
-    const unsigned lit = unsigned(
-        _mm256_movemask_ps(light_values<Kernel>(q, light_lanes(kernel, a, b, min_distance2), r, g, bl, wx, wy, wz, length)));
-    const V rows[7] = {r, g, bl, wx, wy, wz, length};
-    for (unsigned k = 0; k < 7u; ++k) _mm256_store_ps(v[k], rows[k]);
+    unsigned lit;
+    if (!quad_light_unit_lanes(kernel, q, a, b, min_distance2, v, lit)) return false;
     for (unsigned h = 0; h < 2u; ++h)
         for (unsigned p = 0; p < 4u; ++p) {
             const unsigned lane = 4u * h + p;

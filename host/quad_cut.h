@@ -626,58 +626,54 @@ private:
         // once; a packet bounding the four rays with one box test ran
         // slower, as the points' spread widens its bounds).
         const Light& rep = k_.lights[fresh_node.rep_light];
-        vec3 units[N], wi[N];
-        float t_max[N];
-        bool lanes_done = false;
-        if (ahead != nullptr && ahead->has_units) {
-            for (uint p = 0; p < N; ++p) {
-                units[p] = ahead->units[p];
-                if (units[p] != vec3(0.0f)) wi[p] = ahead->wi[p], t_max[p] = ahead->t_max[p];
-            }
-            lanes_done = true;
-        }
-#if defined(__SSE2__)
-        if constexpr (N == 4u) {
-            if (!lanes_done) lanes_done = quad_light_units(k_, lanes_[0], rep, f_.min_distance2, units, wi, t_max);
-        } else if (!wide_) {
-            lanes_done = quad_light_units(k_, lanes_[0], rep, f_.min_distance2, units, wi, t_max) &&
-                         quad_light_units(k_, lanes_[1], rep, f_.min_distance2, units + 4, wi + 4, t_max + 4);
-        } else {
-            // The light twice, over both quads' points.
-            vec3 u2[2][kQuadLanes], w2[2][kQuadLanes];
-            float t2[2][kQuadLanes];
-            lanes_done = quad8::quad_light_units_pair(k_, lanes8_, rep, rep, f_.min_distance2, u2, w2, t2);
-            if (lanes_done)
-                for (uint g = 0; g < 2u; ++g)
-                    for (uint p = 0; p < kQuadLanes; ++p) {
-                        units[4u * g + p] = u2[g][p];
-                        if (u2[g][p] != vec3(0.0f)) wi[4u * g + p] = w2[g][p], t_max[4u * g + p] = t2[g][p];
-                    }
-        }
-#endif
-        // The new representative's rays, a point's in its lane: a quad's
-        // four in a packet of four, an octet's eight in one of eight.
         std::conditional_t<N == 4u, RayPacket4, RayPacket8> rays;
-        for (uint p = 0; p < N; ++p) {
-            fresh.unit.set(p, vec3(0.0f));
-            if (!lane(p) || !(fresh_leaf || fresh.error[p] > 0.0f)) continue;
-            // lc_rep_unit, on the unit found for the points at once where
-            // quad_light_units covers the light.
-            if (!lanes_done) units[p] = k_.lc_light_unit(sp_[p], rep, f_.min_distance2, wi[p], t_max[p]);
-            if (!(units[p].x + units[p].y + units[p].z > 0.0f)) continue;
-            stats_[p].shadow_rays += 1u;
-            rays.org[p] = sp_[p].p;
-            rays.dir[p] = wi[p];
-            rays.t_max[p] = t_max[p];
-            rays.valid |= 1u << p;
+        bool traced = false;
+#if defined(__SSE2__)
+        if constexpr (N == 8u) traced = wide_ && octet_rays(rep, fresh_leaf, fresh, rays);
+#endif
+        if (!traced) {
+            vec3 units[N], wi[N];
+            float t_max[N];
+            bool lanes_done = false;
+            if (ahead != nullptr && ahead->has_units) {
+                for (uint p = 0; p < N; ++p) {
+                    units[p] = ahead->units[p];
+                    if (units[p] != vec3(0.0f)) wi[p] = ahead->wi[p], t_max[p] = ahead->t_max[p];
+                }
+                lanes_done = true;
+            }
+#if defined(__SSE2__)
+            if constexpr (N == 4u) {
+                if (!lanes_done) lanes_done = quad_light_units(k_, lanes_[0], rep, f_.min_distance2, units, wi, t_max);
+            } else {
+                lanes_done = quad_light_units(k_, lanes_[0], rep, f_.min_distance2, units, wi, t_max) &&
+                             quad_light_units(k_, lanes_[1], rep, f_.min_distance2, units + 4, wi + 4, t_max + 4);
+            }
+#endif
+            // The new representative's rays, a point's in its lane: a
+            // quad's four in a packet of four, an octet's eight in one of
+            // eight.
+            for (uint p = 0; p < N; ++p) {
+                fresh.unit.set(p, vec3(0.0f));
+                if (!lane(p) || !(fresh_leaf || fresh.error[p] > 0.0f)) continue;
+                // lc_rep_unit, on the unit found for the points at once
+                // where quad_light_units covers the light.
+                if (!lanes_done) units[p] = k_.lc_light_unit(sp_[p], rep, f_.min_distance2, wi[p], t_max[p]);
+                if (!(units[p].x + units[p].y + units[p].z > 0.0f)) continue;
+                stats_[p].shadow_rays += 1u;
+                rays.org[p] = sp_[p].p;
+                rays.dir[p] = wi[p];
+                rays.t_max[p] = t_max[p];
+                rays.valid |= 1u << p;
+            }
+            unsigned visible = 0u;
+            if (rays.valid != 0u) {
+                if constexpr (N == 4u) visible = k_.lc_visible4(rays);
+                else visible = k_.lc_visible8(rays);
+            }
+            for (uint p = 0; p < N; ++p)
+                if ((visible >> p & 1u) != 0u) fresh.unit.set(p, units[p]);
         }
-        unsigned visible = 0u;
-        if (rays.valid != 0u) {
-            if constexpr (N == 4u) visible = k_.lc_visible4(rays);
-            else visible = k_.lc_visible8(rays);
-        }
-        for (uint p = 0; p < N; ++p)
-            if ((visible >> p & 1u) != 0u) fresh.unit.set(p, units[p]);
         const bool has_kept = enter(kept_node, kept);
         const bool has_fresh = enter(fresh_node, fresh);
         if (!has_kept) free_[free_count_++] = kept_slot;
@@ -686,6 +682,49 @@ private:
         if (k_.lc_node_type(node) == kLightVpl) cut_indirect_ += 1u;
         return {fresh_slot, has_kept, has_fresh};
     }
+
+#if defined(__SSE2__)
+    // split's new representative at an octet's points where quad8 covers
+    // it (false, nothing done, where not): the units at the eight points in
+    // the lanes of AVX2 (the light twice, over both quads' points), the
+    // rays traced as one packet of eight, and the visible units into
+    // fresh.unit, straight from the lanes.
+    bool octet_rays(const Light& rep, bool fresh_leaf, Entry& fresh, RayPacket8& rays) {
+        alignas(32) float v[7][8];
+        unsigned lit;
+        if (!quad8::quad_light_unit_lanes(k_, lanes8_, rep, rep, f_.min_distance2, v, lit)) return false;
+        // A ray where the point is active, the child's bound there is above
+        // zero (or the child is a leaf) and the unit is (lc_rep_unit's
+        // sum test).
+        const __m128 zero = _mm_setzero_ps();
+        const __m128 leaf = fresh_leaf ? _mm_castsi128_ps(_mm_set1_epi32(-1)) : zero;
+        unsigned want = 0u;
+        for (uint h = 0; h < 2u; ++h) {
+            const __m128 sum = _mm_add_ps(_mm_add_ps(_mm_loadu_ps(v[0] + 4u * h), _mm_loadu_ps(v[1] + 4u * h)),
+                                          _mm_loadu_ps(v[2] + 4u * h));
+            const __m128 bound = _mm_or_ps(leaf, _mm_cmpgt_ps(_mm_loadu_ps(fresh.error + 4u * h), zero));
+            want |= unsigned(_mm_movemask_ps(_mm_and_ps(bound, _mm_cmpgt_ps(sum, zero)))) << 4u * h;
+        }
+        want &= active_ & lit;
+        for (unsigned todo = want; todo != 0u; todo &= todo - 1u) {
+            const uint p = uint(__builtin_ctz(todo));
+            stats_[p].shadow_rays += 1u;
+            rays.org[p] = sp_[p].p;
+            rays.dir[p] = vec3(v[3][p], v[4][p], v[5][p]);
+            rays.t_max[p] = v[6][p];
+        }
+        rays.valid = want;
+        const unsigned visible = want != 0u ? k_.lc_visible8(rays) : 0u;
+        const __m128i bits = _mm_setr_epi32(1, 2, 4, 8);
+        for (uint h = 0; h < 2u; ++h) {
+            const __m128 shown = _mm_castsi128_ps(
+                _mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(int(visible >> 4u * h)), bits), bits));
+            for (uint k = 0; k < 3u; ++k)
+                _mm_storeu_ps(fresh.unit.c[k] + 4u * h, _mm_and_ps(_mm_loadu_ps(v[k] + 4u * h), shown));
+        }
+        return true;
+    }
+#endif
 
     // Replaces the cluster at place `at` of the list by its children
     // (split): the kept child keeps the place (unmarked), the other one is
