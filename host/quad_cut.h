@@ -133,6 +133,9 @@ public:
         }
         wide16_ = wide_ && cpu_has_avx512dq();
         if (wide16_) quad16::widen(lanes8_, lanes16_);
+        if constexpr (N == 8u)
+            for (uint p = 0; p < N; ++p)
+                if (lane(p)) octet_packet_.org[p] = sp[p].p;
 #endif
         for (Ahead& c : ahead_) c.parent = kInvalidIndex;
         stats_ = stats;
@@ -629,7 +632,7 @@ private:
         std::conditional_t<N == 4u, RayPacket4, RayPacket8> rays;
         bool traced = false;
 #if defined(__SSE2__)
-        if constexpr (N == 8u) traced = wide_ && octet_rays(rep, fresh_leaf, fresh, rays);
+        if constexpr (N == 8u) traced = wide_ && octet_rays(rep, fresh_leaf, fresh);
 #endif
         if (!traced) {
             vec3 units[N], wi[N];
@@ -689,7 +692,7 @@ private:
     // the lanes of AVX2 (the light twice, over both quads' points), the
     // rays traced as one packet of eight, and the visible units into
     // fresh.unit, straight from the lanes.
-    bool octet_rays(const Light& rep, bool fresh_leaf, Entry& fresh, RayPacket8& rays) {
+    bool octet_rays(const Light& rep, bool fresh_leaf, Entry& fresh) {
         alignas(32) float v[7][8];
         unsigned lit;
         if (!quad8::quad_light_unit_lanes(k_, lanes8_, rep, rep, f_.min_distance2, v, lit)) return false;
@@ -706,10 +709,10 @@ private:
             want |= unsigned(_mm_movemask_ps(_mm_and_ps(bound, _mm_cmpgt_ps(sum, zero)))) << 4u * h;
         }
         want &= active_ & lit;
+        RayPacket8& rays = octet_packet_;  // its origins set by shade()
         for (unsigned todo = want; todo != 0u; todo &= todo - 1u) {
             const uint p = uint(__builtin_ctz(todo));
             stats_[p].shadow_rays += 1u;
-            rays.org[p] = sp_[p].p;
             rays.dir[p] = vec3(v[3][p], v[4][p], v[5][p]);
             rays.t_max[p] = v[6][p];
         }
@@ -790,6 +793,7 @@ private:
     bool wide16_ = false;        // lanes16_ is set and used
 #endif
     Ahead ahead_[2];  // look_ahead
+    RayPacket8 octet_packet_;  // octet_rays' rays, from the points (set by shade)
     ShadeStats* stats_ = nullptr;
     Color fixed_;     // each point's final estimates: leaves and frozen clusters
     Color heap_sum_;  // ... and the running sum of the heap's
