@@ -383,7 +383,7 @@ inline void widen(const quad4::QuadLanes& q, QuadLanes& w) {
 // Two quads' lanes side by side: the first's points in lanes 0-3, the
 // second's in 4-7 (a block of eight points, host/quad_cut.h). Given the
 // same cluster twice, quad_pair_errors then gives its bound at the eight
-// points, and quad_light_units_pair a light's units there.
+// points, and quad_light_unit_lanes a light's units there.
 inline void join(const quad4::QuadLanes& a, const quad4::QuadLanes& b, QuadLanes& w) {
 #define LC_JOIN(field) w.field = _mm256_insertf128_ps(_mm256_castps128_ps256(a.field), b.field, 1);
     LC_QUAD_LANE_VECTORS(LC_JOIN)
