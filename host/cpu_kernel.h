@@ -247,6 +247,7 @@ struct BasicShadeKernel {
     if constexpr (kRecordRays) ray_log->push_back({o, d, t})
 #define LC_SEED_LOBE_BOUND seed_lobe_bound
 #define LC_TRACE_ANY(o, d, t) lc_trace_shadow(o, d, t)
+#define LC_TRACE_CLOSEST(o, d, t_max, t, b1, b2) lc_trace_first_hit(o, d, t_max, t, b1, b2)
 #define LC_CHILD_ERRORS(sp, m, left, right, d2) lc_child_errors(sp, m, left, right, d2)
 #include "shared/trace.h"
 #include "shared/textures.h"
@@ -274,6 +275,7 @@ struct BasicShadeKernel {
 #undef LC_ON_SHADOW_RAY
 #undef LC_SEED_LOBE_BOUND
 #undef LC_TRACE_ANY
+#undef LC_TRACE_CLOSEST
 #undef LC_CHILD_ERRORS
 
     HeapEntry heap_load(uint i) const { return HeapEntry{heap_payload[i].node, heap_error[i], heap_payload[i].unit}; }
@@ -402,6 +404,18 @@ struct BasicShadeKernel {
 #endif
         return wide_nodes != nullptr ? trace_any_wide(*this, wide_nodes, wide_leaves, org, dir, t_max)
                                      : lc_trace_any(org, dir, t_max);
+    }
+
+    // lc_trace_closest's hit (its triangle, distance and barycentric
+    // weights), from the 8-wide tree where one is bound (AVX2:
+    // trace_closest_wide8; where two triangles tie at exactly the same
+    // distance it may name the other one), else from the binary tree.
+    // The camera rays, the path tracer's and the VPLs' paths take it.
+    uint lc_trace_first_hit(vec3 org, vec3 dir, float t_max, float& t, float& b1, float& b2) {
+#if defined(LC_WIDE8_TRACE)
+        if (wide8_nodes != nullptr) return trace_closest_wide8(*this, wide8_nodes, wide8_leaves, org, dir, t_max, t, b1, b2);
+#endif
+        return lc_trace_closest(org, dir, t_max, t, b1, b2);
     }
 
     // lc_visible for up to four rays (bit r of packet.valid): bit r of the

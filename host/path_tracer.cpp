@@ -220,7 +220,7 @@ glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, 
         if (!(b.pdf > 0.0f)) break;
         throughput *= b.weight;
         float t, b1, b2;
-        const std::uint32_t tri = k.lc_trace_closest(sp.p, b.wi, Kernel::kRayInfinity, t, b1, b2);
+        const std::uint32_t tri = k.lc_trace_first_hit(sp.p, b.wi, Kernel::kRayInfinity, t, b1, b2);
         // Emission the BRDF ray finds, weighted against NEE's chance of
         // having found the same light.
         if (tri == gpu::kInvalidIndex) {

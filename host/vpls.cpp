@@ -151,7 +151,7 @@ void trace_path(cpu::ShadeKernel& kernel, const Emitters& emitters, std::uint32_
     if (!emitters.start(kernel, rng, org, dir, flux)) return;
     for (std::uint32_t bounce = 1;; ++bounce) {
         float t, b1, b2;
-        const std::uint32_t tri = kernel.lc_trace_closest(org, dir, cpu::ShadeKernel::kRayInfinity, t, b1, b2);
+        const std::uint32_t tri = kernel.lc_trace_first_hit(org, dir, cpu::ShadeKernel::kRayInfinity, t, b1, b2);
         if (tri == gpu::kInvalidIndex) return;
         const auto sp = kernel.lc_surface_point(tri, b1, b2, dir);
         const gpu::Material& m = sp.mat;

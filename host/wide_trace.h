@@ -92,9 +92,12 @@ inline unsigned wide_hit_boxes(const WideBvhNode& node, const WideRay& r) {
     return unsigned(_mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(t_near, t_far), _mm_castsi128_ps(present))));
 }
 
-// lc_intersect_sheared on a leaf's `count` triangles, lane by lane: true if
-// the ray hits one.
-inline bool wide_hit_leaf(const WideLeaf& leaf, std::int32_t count, const WideRay& r) {
+// lc_intersect_sheared on a leaf's `count` triangles, lane by lane: bit l
+// set where the ray hits triangle l at t[l] in (0, far_limit); v and w over
+// det are its barycentric weights b1 and b2 (as there, divided only for the
+// triangle kept).
+inline unsigned wide_leaf_hits(const WideLeaf& leaf, std::int32_t count, const WideRay& r, __m128& t, __m128& v,
+                               __m128& w, __m128& det) {
     const __m128 zero = _mm_setzero_ps();
     const int kx = r.kx, ky = r.ky, kz = r.kz;
     const __m128 a_kz = _mm_sub_ps(_mm_load_ps(leaf.v0[kz]), r.o_kz);
@@ -107,20 +110,27 @@ inline bool wide_hit_leaf(const WideLeaf& leaf, std::int32_t count, const WideRa
     const __m128 cx = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(leaf.v2[kx]), r.o_kx), _mm_mul_ps(r.sx, c_kz));
     const __m128 cy = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(leaf.v2[ky]), r.o_ky), _mm_mul_ps(r.sy, c_kz));
     const __m128 u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
-    const __m128 v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
-    const __m128 w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
+    v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
+    w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
     const __m128 negative =
         _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)), _mm_cmplt_ps(w, zero));
     const __m128 positive =
         _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)), _mm_cmpgt_ps(w, zero));
-    const __m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
+    det = _mm_add_ps(_mm_add_ps(u, v), w);
     const __m128 t_scaled =
         _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(u, a_kz), _mm_mul_ps(v, b_kz)), _mm_mul_ps(w, c_kz)), r.sz);
-    const __m128 t = _mm_div_ps(t_scaled, det);
+    t = _mm_div_ps(t_scaled, det);
     const __m128 outside = _mm_or_ps(_mm_and_ps(negative, positive), _mm_cmpeq_ps(det, zero));
     const __m128 in_range = _mm_and_ps(_mm_cmpgt_ps(t, zero), _mm_cmplt_ps(t, r.far_limit));
     const __m128 used = _mm_castsi128_ps(_mm_cmplt_epi32(_mm_set_epi32(3, 2, 1, 0), _mm_set1_epi32(count)));
-    return _mm_movemask_ps(_mm_and_ps(_mm_andnot_ps(outside, in_range), used)) != 0;
+    return unsigned(_mm_movemask_ps(_mm_and_ps(_mm_andnot_ps(outside, in_range), used)));
+}
+
+// lc_intersect_sheared on a leaf's `count` triangles, lane by lane: true if
+// the ray hits one.
+inline bool wide_hit_leaf(const WideLeaf& leaf, std::int32_t count, const WideRay& r) {
+    __m128 t, v, w, det;
+    return wide_leaf_hits(leaf, count, r, t, v, w, det) != 0u;
 }
 #endif
 
@@ -214,9 +224,10 @@ __attribute__((target("avx2"), always_inline)) inline Wide8Ray wide8_ray(Kernel&
                     _mm256_set1_ps(inv.y),  _mm256_set1_ps(inv.z),  _mm256_set1_ps(t_max)};
 }
 
-// lc_hit_box on a node's eight boxes: bit s set where the ray enters child s.
+// lc_hit_box on a node's eight boxes: bit s set where the ray enters child
+// s, at the distance in lane s of t_entry.
 __attribute__((target("avx2"), always_inline)) inline unsigned wide8_hit_boxes(const WideBvhNode8& node,
-                                                                               const Wide8Ray& r) {
+                                                                               const Wide8Ray& r, __m256& t_entry) {
     const __m256 zero = _mm256_setzero_ps();
     const __m256 widen = _mm256_set1_ps(1.0000004f);  // lc_hit_box's robust far distance
     const __m256 t0x = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(node.lo_x), r.ox), r.ix);
@@ -232,8 +243,15 @@ __attribute__((target("avx2"), always_inline)) inline unsigned wide8_hit_boxes(c
                                        widen);
     const __m256i present = _mm256_cmpgt_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(node.count)),
                                                _mm256_set1_epi32(-1));
+    t_entry = t_near;
     return unsigned(
         _mm256_movemask_ps(_mm256_and_ps(_mm256_cmp_ps(t_near, t_far, _CMP_LE_OQ), _mm256_castsi256_ps(present))));
+}
+
+__attribute__((target("avx2"), always_inline)) inline unsigned wide8_hit_boxes(const WideBvhNode8& node,
+                                                                               const Wide8Ray& r) {
+    __m256 t_entry;
+    return wide8_hit_boxes(node, r, t_entry);
 }
 
 // trace_any_wide's answer from the 8-wide tree (lc::WideBvhNode8,
@@ -369,6 +387,83 @@ __attribute__((target("avx2"), always_inline)) inline unsigned wide8_walk_packet
     return blocked;
 }
 
+// lc_trace_closest's hit from the 8-wide tree: the triangle (in the binary
+// tree's order) whose own test (lc_intersect_sheared, lane by lane) gives
+// the smallest t in (0, t_max), with that t and its barycentric weights,
+// bit for bit; kInvalidIndex where none. The binary walk keeps the first
+// of triangles hit at exactly the same distance that it meets, this one
+// the first it meets (within a leaf the lowest, as there), so where two tie
+// the two walks may name different ones. A node's leaves are tested when
+// it is popped, its inner children pushed farthest first; a popped node
+// the closest hit has passed is skipped.
+template <class Kernel>
+__attribute__((target("avx2"), always_inline)) inline std::uint32_t wide8_walk_closest(
+    Kernel& kernel, const WideBvhNode8* nodes, const WideLeaf* leaves, glm::vec3 org, glm::vec3 dir, float t_max,
+    float& t_hit, float& b1, float& b2) {
+    std::uint32_t stack[7u * gpu::kBvhStackSize + 8u];
+    float stack_entry[7u * gpu::kBvhStackSize + 8u];
+    std::uint32_t sp = 0;
+    stack[sp] = 0u;
+    stack_entry[sp++] = 0.0f;
+    std::uint32_t hit = gpu::kInvalidIndex;
+    t_hit = t_max;
+    b1 = 0.0f;
+    b2 = 0.0f;
+    Wide8Ray r = wide8_ray(kernel, org, dir, t_max);
+    WideRay sheared;
+    bool has_shear = false;
+    while (sp > 0u) {
+        --sp;
+        // lc_hit_box would refuse it at the closest hit's distance.
+        if (stack_entry[sp] > t_hit * 1.0000004f) continue;
+        const WideBvhNode8& node = nodes[stack[sp]];
+        __m256 entry;
+        const unsigned mask = wide8_hit_boxes(node, r, entry);
+        alignas(32) float entries[8];
+        _mm256_store_ps(entries, entry);
+        std::uint32_t inner[8];
+        unsigned inner_count = 0u;
+        for (unsigned todo = mask; todo != 0u; todo &= todo - 1u) {
+            const unsigned s = unsigned(__builtin_ctz(todo));
+            const std::int32_t count = node.count[s];
+            if (count == 0) {
+                // Kept in order of decreasing entry distance, so that the
+                // nearest is pushed last and popped first.
+                unsigned at = inner_count++;
+                while (at > 0u && entries[inner[at - 1u]] < entries[s]) {
+                    inner[at] = inner[at - 1u];
+                    --at;
+                }
+                inner[at] = s;
+                continue;
+            }
+            if (!has_shear) {
+                wide_ray_shear(kernel, org, dir, t_hit, sheared);
+                has_shear = true;
+            }
+            sheared.far_limit = _mm_set1_ps(t_hit);
+            __m128 t, v, w, det;
+            const unsigned lanes = wide_leaf_hits(leaves[node.child[s]], count, sheared, t, v, w, det);
+            if (lanes == 0u) continue;
+            alignas(16) float ts[4], vs[4], ws[4], dets[4];
+            _mm_store_ps(ts, t), _mm_store_ps(vs, v), _mm_store_ps(ws, w), _mm_store_ps(dets, det);
+            int best = -1;
+            for (unsigned l = 0; l < 4u; ++l)
+                if ((lanes >> l & 1u) != 0u && (best < 0 || ts[l] < ts[best])) best = int(l);
+            t_hit = ts[best];
+            b1 = vs[best] / dets[best];
+            b2 = ws[best] / dets[best];
+            hit = leaves[node.child[s]].first + std::uint32_t(best);
+            r.far_limit = _mm256_set1_ps(t_hit);
+        }
+        for (unsigned k = 0; k < inner_count; ++k) {
+            stack[sp] = node.child[inner[k]];
+            stack_entry[sp++] = entries[inner[k]];
+        }
+    }
+    return hit;
+}
+
 // The walk for AVX2 CPUs.
 template <class Kernel>
 __attribute__((target("avx2"))) bool trace_any_wide8_avx2(Kernel& kernel, const WideBvhNode8* nodes,
@@ -409,6 +504,31 @@ template <class Kernel, unsigned R>
 __attribute__((target("avx2,avx512f,avx512vl"))) unsigned trace_any_wide8_packet_avx512(
     Kernel& kernel, const WideBvhNode8* nodes, const WideLeaf* leaves, const RayPacket<R>& packet) {
     return wide8_walk_packet(kernel, nodes, leaves, packet);
+}
+
+// wide8_walk_closest for AVX2 and for AVX-512VL CPUs.
+template <class Kernel>
+__attribute__((target("avx2"))) std::uint32_t trace_closest_wide8_avx2(Kernel& kernel, const WideBvhNode8* nodes,
+                                                                         const WideLeaf* leaves, glm::vec3 org,
+                                                                         glm::vec3 dir, float t_max, float& t,
+                                                                         float& b1, float& b2) {
+    return wide8_walk_closest(kernel, nodes, leaves, org, dir, t_max, t, b1, b2);
+}
+
+template <class Kernel>
+__attribute__((target("avx2,avx512f,avx512vl"))) std::uint32_t trace_closest_wide8_avx512(
+    Kernel& kernel, const WideBvhNode8* nodes, const WideLeaf* leaves, glm::vec3 org, glm::vec3 dir, float t_max,
+    float& t, float& b1, float& b2) {
+    return wide8_walk_closest(kernel, nodes, leaves, org, dir, t_max, t, b1, b2);
+}
+
+// The closest hit through the 8-wide tree for this CPU: only where
+// cpu_has_avx2().
+template <class Kernel>
+std::uint32_t trace_closest_wide8(Kernel& kernel, const WideBvhNode8* nodes, const WideLeaf* leaves, glm::vec3 org,
+                                  glm::vec3 dir, float t_max, float& t, float& b1, float& b2) {
+    return cpu_has_avx512vl() ? trace_closest_wide8_avx512(kernel, nodes, leaves, org, dir, t_max, t, b1, b2)
+                              : trace_closest_wide8_avx2(kernel, nodes, leaves, org, dir, t_max, t, b1, b2);
 }
 
 // The packets' 8-wide walk for this CPU: only where cpu_has_avx2().

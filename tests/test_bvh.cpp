@@ -3,6 +3,7 @@
 // triangle with the same intersection routine.
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cfloat>
 #include <cmath>
 #include <limits>
@@ -105,6 +106,7 @@ std::string check_ray(const Scene& s, vec3 org, vec3 dir, float t_max) {
     lc::cpu::TraceKernel k = s.kernel();
     float t, b1, b2;
     const std::uint32_t index = k.lc_trace_closest(org, dir, t_max, t, b1, b2);
+    const float binary_t = t, binary_b1 = b1, binary_b2 = b2;  // (b1, b2 are reused below)
     const Hit expected = brute_closest(s, org, dir, t_max);
     if (index == kInvalidIndex || expected.index == kInvalidIndex) {
         if (index != expected.index)
@@ -129,6 +131,39 @@ std::string check_ray(const Scene& s, vec3 org, vec3 dir, float t_max) {
     if (k4.lc_trace_any(org, dir, t_max) != any)
         return "the kernels' 4-wide any-hit disagrees with brute force for " + describe(org, dir, t_max);
 #if defined(LC_WIDE8_TRACE)
+    // The 8-wide closest hit, both builds that this CPU runs: the binary
+    // walk's distance, triangle and weights bit for bit, or where it names
+    // another triangle, one hit at exactly the same distance.
+    const auto closest8 = [&](auto walk, const char* name) -> std::string {
+        float t8, b1_8, b2_8;
+        const std::uint32_t index8 = walk(k, s.bvh.wide8_nodes.data(), s.bvh.wide8_leaves.data(), org, dir, t_max, t8,
+                                          b1_8, b2_8);
+        const std::string at = std::string(name) + " for " + describe(org, dir, t_max);
+        if ((index8 == kInvalidIndex) != (index == kInvalidIndex)) return "8-wide closest hit or miss differs " + at;
+        if (index == kInvalidIndex) return {};
+        if (std::bit_cast<std::uint32_t>(t8) != std::bit_cast<std::uint32_t>(binary_t))
+            return "8-wide closest t " + std::to_string(t8) + " vs " + std::to_string(binary_t) + " " + at;
+        if (index8 == index) {
+            if (std::bit_cast<std::uint32_t>(b1_8) != std::bit_cast<std::uint32_t>(binary_b1) ||
+                std::bit_cast<std::uint32_t>(b2_8) != std::bit_cast<std::uint32_t>(binary_b2))
+                return "8-wide closest weights differ " + at;
+            return {};
+        }
+        float own_b1, own_b2;
+        const float own = k.lc_intersect_triangle(org, dir, s.triangles[index8], kRayInfinity, own_b1, own_b2);
+        if (std::bit_cast<std::uint32_t>(own) != std::bit_cast<std::uint32_t>(binary_t))
+            return "8-wide closest picked a triangle that is not an exact tie " + at;
+        return {};
+    };
+    std::string closest_problem;
+    if (lc::cpu::cpu_has_avx2())
+        closest_problem = closest8(
+            [](auto&&... a) { return lc::cpu::trace_closest_wide8_avx2(std::forward<decltype(a)>(a)...); }, "(AVX2)");
+    if (closest_problem.empty() && lc::cpu::cpu_has_avx512vl())
+        closest_problem = closest8(
+            [](auto&&... a) { return lc::cpu::trace_closest_wide8_avx512(std::forward<decltype(a)>(a)...); },
+            "(AVX-512)");
+    if (!closest_problem.empty()) return closest_problem;
     // Both builds of the 8-wide walk that this CPU runs.
     if (lc::cpu::cpu_has_avx2() &&
         lc::cpu::trace_any_wide8_avx2(k, s.bvh.wide8_nodes.data(), s.bvh.wide8_leaves.data(), org, dir, t_max) != any)
@@ -662,6 +697,9 @@ TEST(Bvh, EmptySceneMissesEverything) {
         if (lc::cpu::cpu_has_avx2()) {
             EXPECT_FALSE(lc::cpu::trace_any_wide8_avx2(k, bvh.wide8_nodes.data(), bvh.wide8_leaves.data(), org, dir,
                                                        kRayInfinity));
+            EXPECT_EQ(lc::cpu::trace_closest_wide8(k, bvh.wide8_nodes.data(), bvh.wide8_leaves.data(), org, dir,
+                                                   kRayInfinity, t, b1, b2),
+                      kInvalidIndex);
         }
         if (lc::cpu::cpu_has_avx512vl()) {
             EXPECT_FALSE(lc::cpu::trace_any_wide8_avx512(k, bvh.wide8_nodes.data(), bvh.wide8_leaves.data(), org, dir,

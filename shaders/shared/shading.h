@@ -156,7 +156,12 @@ uint lc_camera_trace(LC_IN(FrameParams) f, uint x, uint y, uint s, LC_OUT(vec3) 
     dir = lc_camera_ray_dir(f, lc_pixel_sample(x, y, s, f.spp, f.seed));
     vec3 org = vec3(f.cam_pos_x, f.cam_pos_y, f.cam_pos_z);
     float t;
+#ifdef LC_TRACE_CLOSEST
+    // The includer's own closest-hit query (the CPU's 8-wide BVH).
+    return LC_TRACE_CLOSEST(org, dir, kRayInfinity, t, b1, b2);
+#else
     return lc_trace_closest(org, dir, kRayInfinity, t, b1, b2);
+#endif
 }
 
 // A camera sample's first hit as a shaded point; false when the ray leaves
