@@ -413,7 +413,8 @@ struct BasicShadeKernel {
     // The camera rays, the path tracer's and the VPLs' paths take it.
     uint lc_trace_first_hit(vec3 org, vec3 dir, float t_max, float& t, float& b1, float& b2) {
 #if defined(LC_WIDE8_TRACE)
-        if (wide8_nodes != nullptr) return trace_closest_wide8(*this, wide8_nodes, wide8_leaves, org, dir, t_max, t, b1, b2);
+        if (wide8_nodes != nullptr)
+            return trace_closest_wide8(*this, wide8_nodes, wide8_leaves, org, dir, t_max, t, b1, b2);
 #endif
         return lc_trace_closest(org, dir, t_max, t, b1, b2);
     }
