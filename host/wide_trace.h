@@ -1,4 +1,6 @@
-// The CPU path's shadow rays through the 4-wide copy of the BVH
+// The CPU path's rays through wide copies of the BVH: shadow rays (any hit)
+// and, through the 8-wide one, closest hits (trace_closest_wide8). The
+// shadow rays through the 4-wide copy of the BVH
 // (lc::WideBvhNode and lc::WideLeaf, collapse_bvh): one SSE slab test checks
 // a node's four children at once, one SSE triangle test a leaf's (up to)
 // four triangles. Both are the kernels' own tests (lc_hit_box and the
