@@ -15,6 +15,13 @@
 # before trusting the names on another Mesa. Loops without a bounds check
 # are shared memory or an invocation's own arrays with a dynamic index.
 #
+# On today's kernels few such loops are left (the heap is in private
+# memory, the walk's stack touched once a trip): nearly every sample falls
+# under arithmetic and control, and the split by function is what is left
+# to read. docs/results/lavapipe.md §24 measures the accesses another way,
+# by doubling each kind. Set LC_PROFILE_DELAY so that the copy is taken
+# after the kernels are compiled.
+#
 # Needs perf, objdump, python3 and permission to read the process's memory
 # (root, or ptrace_scope 0).
 #
