@@ -673,6 +673,39 @@ TEST(Bvh, EightWidePacketsFromEightPointsGiveEachRaysAnswer) {
 #endif
 }
 
+// lc_bvh4_take (the kernels' walk takes a group's next node and leaf with
+// it) against the loop over the slots that defines it, in every case: each
+// set of children left, each mix of leaves and inner nodes, a node or a
+// leaf already taken or not.
+TEST(Bvh, KernelWalkTakesTheFirstInnerChildAndTheFirstLeaf) {
+    lc::cpu::Trace4Kernel k4{nullptr, nullptr, nullptr};
+    for (std::uint32_t left = 0; left < 16u; ++left)
+        for (std::uint32_t leaf_slots = 0; leaf_slots < 16u; ++leaf_slots)
+            for (int held = 0; held < 4; ++held) {
+                glm::uvec4 entries;
+                for (std::uint32_t s = 0; s < 4u; ++s)
+                    entries[int(s)] = (leaf_slots >> s & 1u) != 0u ? lc::gpu::kBvh4LeafEntry | (100u + s) : 200u + s;
+                const std::uint32_t node_in = (held & 1) != 0 ? 7u : kInvalidIndex;
+                const std::uint32_t leaf_in = (held & 2) != 0 ? 9u : kInvalidIndex;
+                std::uint32_t node = node_in, leaf = leaf_in, expect_node = node_in, expect_leaf = leaf_in;
+                std::uint32_t expect_left = left;
+                for (std::uint32_t s = 0; s < 4u; ++s) {
+                    const bool live = (expect_left >> s & 1u) != 0u, is_leaf = (leaf_slots >> s & 1u) != 0u;
+                    if (live && !is_leaf && expect_node == kInvalidIndex) {
+                        expect_node = entries[int(s)];
+                        expect_left &= ~(1u << s);
+                    } else if (live && is_leaf && expect_leaf == kInvalidIndex) {
+                        expect_leaf = entries[int(s)];
+                        expect_left &= ~(1u << s);
+                    }
+                }
+                const std::uint32_t got_left = k4.lc_bvh4_take(entries, left, node, leaf);
+                EXPECT_EQ(got_left, expect_left) << "left " << left << " leaves " << leaf_slots << " held " << held;
+                EXPECT_EQ(node, expect_node) << "left " << left << " leaves " << leaf_slots << " held " << held;
+                EXPECT_EQ(leaf, expect_leaf) << "left " << left << " leaves " << leaf_slots << " held " << held;
+            }
+}
+
 TEST(Bvh, EmptySceneMissesEverything) {
     std::vector<Triangle> tris;
     std::vector<TriangleNormals> normals;
