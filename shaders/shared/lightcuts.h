@@ -157,27 +157,29 @@ uint lc_heap_smallest(uint from, uint to, float bound) {
 // moves from heap_sum into the frozen part of the sum, `fixed_sum`, and is
 // never refined. The smallest entry of a max-heap is one of its leaves,
 // slots size/2 and up; the new entry takes its slot and rises.
+// One sift for both cases, after them: llvmpipe runs every branch for all
+// the lanes of a SIMD group, so a sift in each would be two loops a push.
 void lc_heap_push(LC_IN(SurfacePoint) sp, float min_distance2, LC_INOUT(uint) size, HeapEntry e, vec3 estimate,
                   LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
+    uint slot = size;  // where e rises from; kInvalidIndex where e is frozen
     if (size < uint(LC_HEAP_CAPACITY)) {
         size += 1u;
-        lc_heap_sift_up(size - 1u, e);
         heap_sum += estimate;
-        return;
+    } else {
+        stats.frozen += 1u;
+        slot = lc_heap_smallest(size / 2u, size, e.error);
+        if (slot == kInvalidIndex) {
+            stats.frozen_error += e.error;
+            fixed_sum += estimate;
+        } else {
+            HeapEntry leaving = LC_HEAP_LOAD(slot);
+            stats.frozen_error += leaving.error;
+            vec3 frozen = lc_entry_estimate(sp, leaving, min_distance2);
+            fixed_sum += frozen;
+            heap_sum += estimate - frozen;
+        }
     }
-    stats.frozen += 1u;
-    uint smallest = lc_heap_smallest(size / 2u, size, e.error);
-    if (smallest == kInvalidIndex) {
-        stats.frozen_error += e.error;
-        fixed_sum += estimate;
-        return;
-    }
-    HeapEntry leaving = LC_HEAP_LOAD(smallest);
-    stats.frozen_error += leaving.error;
-    vec3 frozen = lc_entry_estimate(sp, leaving, min_distance2);
-    fixed_sum += frozen;
-    heap_sum += estimate - frozen;
-    lc_heap_sift_up(smallest, e);
+    if (slot != kInvalidIndex) lc_heap_sift_up(slot, e);
 }
 
 // A cluster's error bound at the point: the luminance of its bound on
@@ -339,12 +341,15 @@ bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) he
         has_a = true;
         has_b = false;
     }
+    // A pop where neither child enters (the last entry sinks from the top
+    // instead), in the same sift: one loop on llvmpipe, not one a case.
     if (has_a) {
-        lc_heap_replace_top(heap_size, a);
         heap_sum += estimate_a;
     } else {
-        lc_heap_pop(heap_size);
+        heap_size -= 1u;
+        a = LC_HEAP_LOAD(heap_size);
     }
+    if (heap_size > 0u) lc_heap_replace_top(heap_size, a);
     if (has_b) lc_heap_push(sp, f.min_distance2, heap_size, b, estimate_b, fixed_sum, heap_sum, stats);
     stats.cut_size += 1u;
     if (lc_node_type(node) == kLightVpl) stats.cut_indirect += 1u;
