@@ -119,20 +119,21 @@ bool lc_quad_enter(uint index, LightNode node, float error, vec3 unit, bool visi
 
 // QuadCut::push: into a full heap, the entry with the smallest key (this
 // one included) is frozen.
+// One sift after both cases, as in lc_heap_push.
 void lc_quad_push(QuadCutEntry e) {
+    uint slot = q_size;  // where e rises from; kInvalidIndex where e is frozen
     if (q_size < kHeapSlots) {
         q_size += 1u;
-        lc_heap_sift_up(q_size - 1u, e);
-        return;
+    } else {
+        q_frozen += 1u;
+        slot = lc_heap_smallest(q_size / 2u, q_size, e.key);
+        QuadCutEntry leaving = slot == kInvalidIndex ? e : LC_HEAP_LOAD(slot);
+        q_stats.frozen_error += leaving.error;
+        vec3 estimate = lc_entry_estimate(q_sp, leaving, frame.min_distance2);
+        q_heap_sum -= estimate;
+        q_fixed += estimate;
     }
-    q_frozen += 1u;
-    uint smallest = lc_heap_smallest(q_size / 2u, q_size, e.key);
-    QuadCutEntry leaving = smallest == kInvalidIndex ? e : LC_HEAP_LOAD(smallest);
-    q_stats.frozen_error += leaving.error;
-    vec3 estimate = lc_entry_estimate(q_sp, leaving, frame.min_distance2);
-    q_heap_sum -= estimate;
-    q_fixed += estimate;
-    if (smallest != kInvalidIndex) lc_heap_sift_up(smallest, e);
+    if (slot != kInvalidIndex) lc_heap_sift_up(slot, e);
 }
 
 // Every key again from the current estimates, and the heap rebuilt.
@@ -273,12 +274,14 @@ void lc_quad_refine_top() {
         has_a = has_b;
         has_b = swap_has;
     }
-    if (has_a) {
-        lc_heap_sift_down(0u, q_size, a);
-    } else {
+    // Where neither child enters, the last entry sinks from the top
+    // instead: one sift for both cases (llvmpipe runs both sides of a
+    // branch, loops included, for all the lanes).
+    if (!has_a) {
         q_size -= 1u;
-        if (q_size > 0u) lc_heap_sift_down(0u, q_size, LC_HEAP_LOAD(q_size));
+        a = LC_HEAP_LOAD(q_size);
     }
+    if (q_size > 0u) lc_heap_sift_down(0u, q_size, a);
     if (has_b) lc_quad_push(b);
 }
 
