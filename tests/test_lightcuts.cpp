@@ -607,7 +607,8 @@ struct ShippedCase {
 // can exceed 2%; the limits sit about 1.5x above the measurement.
 // With the default heap of 64 slots, measured relative RMSE: room 0.0082,
 // bunny 0.0077, panels 0.0013, gallery 0.114 (its loose spot cones make cuts
-// of 700 clusters, which a heap of 64 cannot refine: docs/results/heap.md),
+// of 700 clusters, which a heap of 64 cannot refine: docs/results/speed.md,
+// section 2),
 // sky 0.0121, materials 0.0113; the limit is the last field.
 // Those are a cut per pixel's (cut_sharing "pixel", the Vulkan kernels'
 // cuts). Cuts shared by 2x2 quads and by 4x2 octets (the CPU's default),

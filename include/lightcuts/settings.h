@@ -21,7 +21,8 @@ inline constexpr std::uint32_t kMaxBounces = 1024;     // max_bounces (path and 
 // light tree and cut_heap, never by max_cut (a cut cannot outgrow the tree).
 // The default capacity K of the cut heap per shaded point (cut_heap): a cut
 // that would need more freezes its clusters of smallest bound
-// (docs/lightcuts.md, "The bounded heap"; the choice: docs/results/heap.md).
+// (docs/lightcuts.md, "The bounded heap"; the choice: docs/results/speed.md,
+// section 2, "The default, K = 64").
 inline constexpr std::uint32_t kDefaultCutHeap = 64;
 
 // Names of the settings as the scene file's render block spells them (the

@@ -1,7 +1,7 @@
 // Unit vectors packed into 32 bits, octahedral (Cigolle et al., "A Survey of
 // Efficient Representations for Independent Unit Vectors", JCGT 2014).
 // Decoded identically by the host and the kernels; only the host encodes
-// (host/emission_cone.cpp), and it widens every cone by the angle its axis
+// (host/light_bounds.cpp), and it widens every cone by the angle its axis
 // moved, so bounds stay conservative. Compiles as GLSL and as C++ (free
 // inline functions in lc::gpu, over glm).
 #ifndef LC_SHARED_OCTAHEDRAL_H
