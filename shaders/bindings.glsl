@@ -36,7 +36,7 @@ LC_CONST uint kBindingHeapSave = 15u;     // cut heaps paused between dispatches
 LC_CONST uint kBindingCutState = 16u;     // CutState per tile pixel, between Lightcuts dispatches
 LC_CONST uint kBindingChunkTable = 17u;   // ChunkTable: where the chunks of a split scene array are
 LC_CONST uint kBindingCount = 18u;        // storage-buffer bindings: 0 .. kBindingCount - 1
-// Uniform texel buffers (RGBA32UI views) over five of the scene arrays
+// Storage texel buffers (RGBA32UI views, read only) over five of the scene arrays
 // above: the arrays the shadow rays and cut selection read most, read
 // through these instead where kSpecTexelReads is set (docs/vulkan.md).
 LC_CONST uint kBindingBvhNodeTexels = 18u;

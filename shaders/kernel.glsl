@@ -64,22 +64,25 @@ layout(std430, binding = kBindingGBuffer) buffer GBuffer { GBufferTexel gbuffer[
 layout(std430, binding = kBindingRadiance) buffer Radiance { float radiance[]; };
 layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_stats[]; };
 
-// The same five arrays as 16-byte texels (kBindingBvhNodeTexels ..). On
-// llvmpipe a storage-buffer load whose address differs between lanes is a
-// loop over the lanes, a texel fetch one gather (docs/results/lavapipe.md);
+// The same five arrays as 16-byte texels (kBindingBvhNodeTexels ..),
+// storage texel buffers read with imageLoad. On llvmpipe a storage-buffer
+// load whose address differs between lanes is a loop over the lanes, an
+// image load one gather in the kernel's own code (a texelFetch from a
+// uniform texel buffer was the same gather in a function of the driver's,
+// called once per fetch: 5 to 11% slower; docs/results/lavapipe.md, §26);
 // the host sets kTexelReads where it measured that to pay and every array
 // fits a texel buffer's limit. The fields are unpacked in struct order.
 layout(constant_id = kSpecTexelReads) const bool kTexelReads = false;
-layout(binding = kBindingBvhNodeTexels) uniform usamplerBuffer bvh_node_texels;
-layout(binding = kBindingTriangleTexels) uniform usamplerBuffer triangle_texels;
-layout(binding = kBindingLightTexels) uniform usamplerBuffer light_texels;
-layout(binding = kBindingLightNodeTexels) uniform usamplerBuffer light_node_texels;
-layout(binding = kBindingWideBvhNodeTexels) uniform usamplerBuffer wide_bvh_node_texels;
+layout(binding = kBindingBvhNodeTexels, rgba32ui) uniform readonly restrict uimageBuffer bvh_node_texels;
+layout(binding = kBindingTriangleTexels, rgba32ui) uniform readonly restrict uimageBuffer triangle_texels;
+layout(binding = kBindingLightTexels, rgba32ui) uniform readonly restrict uimageBuffer light_texels;
+layout(binding = kBindingLightNodeTexels, rgba32ui) uniform readonly restrict uimageBuffer light_node_texels;
+layout(binding = kBindingWideBvhNodeTexels, rgba32ui) uniform readonly restrict uimageBuffer wide_bvh_node_texels;
 
 BvhNode lc_bvh_node(uint i) {
     if (!kTexelReads) return lc_bvh_nodes(i);
-    const uvec4 a = texelFetch(bvh_node_texels, int(2u * i));
-    const uvec4 b = texelFetch(bvh_node_texels, int(2u * i + 1u));
+    const uvec4 a = imageLoad(bvh_node_texels, int(2u * i));
+    const uvec4 b = imageLoad(bvh_node_texels, int(2u * i + 1u));
     return BvhNode(uintBitsToFloat(a.x), uintBitsToFloat(a.y), uintBitsToFloat(a.z), a.w,
                    uintBitsToFloat(b.x), uintBitsToFloat(b.y), uintBitsToFloat(b.z), b.w);
 }
@@ -87,32 +90,32 @@ BvhNode lc_bvh_node(uint i) {
 // Word k (16 bytes) of Bvh4Node i.
 uvec4 lc_bvh4_word(uint i, uint k) {
     if (!kTexelReads) return lc_wide_bvh_nodes(kBvh4NodeWords * i + k);
-    return texelFetch(wide_bvh_node_texels, int(kBvh4NodeWords * i + k));
+    return imageLoad(wide_bvh_node_texels, int(kBvh4NodeWords * i + k));
 }
 
 Triangle lc_triangle(uint i) {
     if (!kTexelReads) return lc_triangles(i);
-    const vec4 a = uintBitsToFloat(texelFetch(triangle_texels, int(3u * i)));
-    const vec4 b = uintBitsToFloat(texelFetch(triangle_texels, int(3u * i + 1u)));
-    const uvec4 c = texelFetch(triangle_texels, int(3u * i + 2u));
+    const vec4 a = uintBitsToFloat(imageLoad(triangle_texels, int(3u * i)));
+    const vec4 b = uintBitsToFloat(imageLoad(triangle_texels, int(3u * i + 1u)));
+    const uvec4 c = imageLoad(triangle_texels, int(3u * i + 2u));
     return Triangle(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, uintBitsToFloat(c.x), c.y, c.z, c.w);
 }
 
 Light lc_light(uint i) {
     if (!kTexelReads) return lc_lights(i);
-    const vec4 a = uintBitsToFloat(texelFetch(light_texels, int(3u * i)));
-    const vec4 b = uintBitsToFloat(texelFetch(light_texels, int(3u * i + 1u)));
-    const uvec4 c = texelFetch(light_texels, int(3u * i + 2u));
+    const vec4 a = uintBitsToFloat(imageLoad(light_texels, int(3u * i)));
+    const vec4 b = uintBitsToFloat(imageLoad(light_texels, int(3u * i + 1u)));
+    const uvec4 c = imageLoad(light_texels, int(3u * i + 2u));
     return Light(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, uintBitsToFloat(c.x), uintBitsToFloat(c.y),
                  uintBitsToFloat(c.z), c.w);
 }
 
 LightNode lc_light_node(uint i) {
     if (!kTexelReads) return lc_light_nodes(i);
-    const vec4 a = uintBitsToFloat(texelFetch(light_node_texels, int(4u * i)));
-    const vec4 b = uintBitsToFloat(texelFetch(light_node_texels, int(4u * i + 1u)));
-    const uvec4 c = texelFetch(light_node_texels, int(4u * i + 2u));
-    const uvec4 d = texelFetch(light_node_texels, int(4u * i + 3u));
+    const vec4 a = uintBitsToFloat(imageLoad(light_node_texels, int(4u * i)));
+    const vec4 b = uintBitsToFloat(imageLoad(light_node_texels, int(4u * i + 1u)));
+    const uvec4 c = imageLoad(light_node_texels, int(4u * i + 2u));
+    const uvec4 d = imageLoad(light_node_texels, int(4u * i + 3u));
     return LightNode(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, uintBitsToFloat(c.x), c.y, c.z, c.w, d.x,
                      uintBitsToFloat(d.y), uintBitsToFloat(d.z), uintBitsToFloat(d.w));
 }

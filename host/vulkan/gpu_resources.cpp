@@ -224,7 +224,7 @@ std::vector<Buffer> GpuResources::upload_chunks(const SceneArray& array, std::ui
     const VkBufferUsageFlags usage =
         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
         VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT |
-        (has_texel_view(binding) ? VkBufferUsageFlags(VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT) : VkBufferUsageFlags(0));
+        (has_texel_view(binding) ? VkBufferUsageFlags(VK_BUFFER_USAGE_STORAGE_TEXEL_BUFFER_BIT) : VkBufferUsageFlags(0));
     std::vector<Buffer> buffers;
     // The allocation may round the buffer's size up to its alignment: keep
     // a margin below maxMemoryAllocationSize.
@@ -298,14 +298,14 @@ void GpuResources::create_chunk_table() {
 
 // Texel views can cover the four arrays: each is in one buffer (a view sees
 // one buffer; chunks that are windows of one buffer are fine), each is
-// within maxTexelBufferElements, and the format can be a uniform texel
-// buffer (the spec makes RGBA32UI's support mandatory).
+// within maxTexelBufferElements, and the format can be a storage texel
+// buffer (a device without it is refused: descriptor_refusal).
 bool GpuResources::texel_views_fit() const {
     for (const TexelArray& a : kTexelArrays)
         if (scene_[a.binding].size() > 1) return false;
     VkFormatProperties format{};
     vkGetPhysicalDeviceFormatProperties(ctx_.physical(), kTexelFormat, &format);
-    if (!(format.bufferFeatures & VK_FORMAT_FEATURE_UNIFORM_TEXEL_BUFFER_BIT)) return false;
+    if (!(format.bufferFeatures & VK_FORMAT_FEATURE_STORAGE_TEXEL_BUFFER_BIT)) return false;
     const VkDeviceSize max_texels = ctx_.properties().limits.maxTexelBufferElements;
     for (const TexelArray& a : kTexelArrays)
         if (scene_[a.binding][0].size() / kTexelBytes > max_texels) return false;
@@ -402,7 +402,7 @@ void GpuResources::create_descriptors() {
     for (std::uint32_t b = 0; b < kAllBindings; ++b)
         bindings[b] = {b,
                        b < gpu::kBindingCount ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
-                                              : VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER,
+                                              : VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER,
                        1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
     auto layout_info = vk_struct<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
     layout_info.bindingCount = kAllBindings;
@@ -413,7 +413,7 @@ void GpuResources::create_descriptors() {
 
     const VkDescriptorPoolSize pool_sizes[] = {
         {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, gpu::kBindingCount},
-        {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, gpu::kTexelBindingCount}};
+        {VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER, gpu::kTexelBindingCount}};
     auto pool_info = vk_struct<VkDescriptorPoolCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO);
     pool_info.maxSets = 1;
     pool_info.poolSizeCount = std::uint32_t(std::size(pool_sizes));
@@ -452,7 +452,7 @@ void GpuResources::create_descriptors() {
     for (std::uint32_t t = 0; t < gpu::kTexelBindingCount; ++t) {
         const std::uint32_t b = kTexelArrays[t].texel_binding;
         views[t] = texel_views_[t].get();
-        writes[b] = write(b, VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER);
+        writes[b] = write(b, VK_DESCRIPTOR_TYPE_STORAGE_TEXEL_BUFFER);
         writes[b].pTexelBufferView = &views[t];
     }
     vkd.vkUpdateDescriptorSets(device, kAllBindings, writes, 0, nullptr);

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "bindings.glsl"
 #include "vk_check.h"
 #include "vulkan_renderer.h"
 
@@ -164,6 +165,11 @@ std::vector<PhysicalDeviceInfo> physical_devices(VkInstance instance) {
         else if (!has_buffer_device_address(handle))
             d.refusal = "has no bufferDeviceAddress (a Vulkan 1.2 feature, needed for scene arrays "
                         "larger than one buffer)";
+        if (d.refusal.empty()) {
+            VkFormatProperties texel{};
+            vkGetPhysicalDeviceFormatProperties(handle, VK_FORMAT_R32G32B32A32_UINT, &texel);
+            d.refusal = descriptor_refusal(d.properties.limits, texel.bufferFeatures);
+        }
         devices.push_back(std::move(d));
     }
     return devices;
@@ -230,6 +236,28 @@ PhysicalDeviceInfo choose_device(std::vector<PhysicalDeviceInfo> devices, const 
 }
 
 }  // namespace
+
+std::string descriptor_refusal(const VkPhysicalDeviceLimits& limits, VkFormatFeatureFlags texel_features) {
+    const auto lacks = [](std::uint32_t offered, std::uint32_t needed, const char* what) {
+        return "allows " + std::to_string(offered) + " " + what + ", the kernels bind " + std::to_string(needed);
+    };
+    const std::uint32_t buffers = gpu::kBindingCount, images = gpu::kTexelBindingCount;
+    if (limits.maxPerStageDescriptorStorageBuffers < buffers)
+        return lacks(limits.maxPerStageDescriptorStorageBuffers, buffers, "storage buffers per shader stage");
+    if (limits.maxDescriptorSetStorageBuffers < buffers)
+        return lacks(limits.maxDescriptorSetStorageBuffers, buffers, "storage buffers per descriptor set");
+    if (limits.maxPerStageDescriptorStorageImages < images)
+        return lacks(limits.maxPerStageDescriptorStorageImages, images,
+                     "storage images (storage texel buffers among them) per shader stage");
+    if (limits.maxDescriptorSetStorageImages < images)
+        return lacks(limits.maxDescriptorSetStorageImages, images,
+                     "storage images (storage texel buffers among them) per descriptor set");
+    if (limits.maxPerStageResources < buffers + images)
+        return lacks(limits.maxPerStageResources, buffers + images, "resources per shader stage");
+    if ((texel_features & VK_FORMAT_FEATURE_STORAGE_TEXEL_BUFFER_BIT) == 0)
+        return "has no storage texel buffers of format R32G32B32A32_UINT";
+    return "";
+}
 
 void MessageLog::add(std::string message) {
     std::lock_guard lock(mutex_);

@@ -33,6 +33,14 @@ struct PhysicalDeviceInfo {
     std::string refusal;                        // why it cannot run the kernels ("" if it can)
 };
 
+// Why a device whose limits are `limits` and whose RGBA32UI buffer
+// features are `texel_features` cannot hold the kernels' descriptor set
+// (bindings.glsl: kBindingCount storage buffers and kTexelBindingCount
+// storage texel buffers, which count as storage images, in one set for
+// the compute stage); "" if it can. Vulkan's minimum limits allow four of
+// each.
+std::string descriptor_refusal(const VkPhysicalDeviceLimits& limits, VkFormatFeatureFlags texel_features);
+
 // Loads the loader once per process. Throws "no Vulkan device: ..." if
 // libvulkan cannot be loaded.
 void load_vulkan_loader();

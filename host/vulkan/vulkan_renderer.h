@@ -85,7 +85,7 @@ struct Tuning {
     bool host_import = true;
 
     // Read the BVH nodes, triangles, lights, light-tree nodes and the 4-wide
-    // BVH through uniform texel buffers instead of storage buffers. kAuto: on CPU
+    // BVH through storage texel buffers instead of storage buffers. kAuto: on CPU
     // devices (lavapipe), where it measured faster (docs/results/lavapipe.md);
     // GPUs keep storage buffers until it is measured there. Either way only
     // where each of the five arrays is in one buffer (split or not) and

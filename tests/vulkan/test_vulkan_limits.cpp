@@ -273,7 +273,7 @@ TEST_F(Vulkan, LargeArraysAreReadInPlaceOnCpuDevices) {
 }
 
 // The BVH nodes, triangles, lights, light-tree nodes and the 4-wide BVH can
-// be read through uniform texel buffers instead of storage buffers (Tuning::texel_reads;
+// be read through storage texel buffers instead of storage buffers (Tuning::texel_reads;
 // the default on CPU devices). The same kernels read the same bits: the
 // images are identical for every method. A split scene keeps the texel
 // reads while each array's chunks are windows of one buffer, and falls
@@ -299,6 +299,31 @@ TEST_F(Vulkan, TexelReadsGiveTheImagesOfStorageBufferReads) {
         EXPECT_EQ(max_relative_difference(a.image, b.image, std::string("texel reads ") + method, 0.0), 0.0);
         EXPECT_EQ(a.stats.shadow_rays, b.stats.shadow_rays);
     }
+}
+
+// A device is refused, with the limit named, where the kernels' one
+// descriptor set does not fit: Vulkan's minimum limits allow four storage
+// buffers and four storage images (texel buffers among them) per stage.
+TEST(DescriptorRefusal, NamesTheLimitTheKernelsExceed) {
+    VkPhysicalDeviceLimits limits{};
+    limits.maxPerStageDescriptorStorageBuffers = limits.maxDescriptorSetStorageBuffers = gpu::kBindingCount;
+    limits.maxPerStageDescriptorStorageImages = limits.maxDescriptorSetStorageImages = gpu::kTexelBindingCount;
+    limits.maxPerStageResources = gpu::kBindingCount + gpu::kTexelBindingCount;
+    const VkFormatFeatureFlags texels = VK_FORMAT_FEATURE_STORAGE_TEXEL_BUFFER_BIT;
+    EXPECT_EQ(vk::descriptor_refusal(limits, texels), "");
+    EXPECT_EQ(vk::descriptor_refusal(limits, VK_FORMAT_FEATURE_UNIFORM_TEXEL_BUFFER_BIT),
+              "has no storage texel buffers of format R32G32B32A32_UINT");
+    VkPhysicalDeviceLimits minimum = limits;
+    minimum.maxPerStageDescriptorStorageImages = 4;
+    EXPECT_EQ(vk::descriptor_refusal(minimum, texels),
+              "allows 4 storage images (storage texel buffers among them) per shader stage, the kernels bind 5");
+    minimum = limits;
+    minimum.maxDescriptorSetStorageBuffers = 4;
+    EXPECT_EQ(vk::descriptor_refusal(minimum, texels),
+              "allows 4 storage buffers per descriptor set, the kernels bind 18");
+    minimum = limits;
+    minimum.maxPerStageResources = gpu::kBindingCount + gpu::kTexelBindingCount - 1u;
+    EXPECT_EQ(vk::descriptor_refusal(minimum, texels), "allows 22 resources per shader stage, the kernels bind 23");
 }
 
 // The kernels' order of a tile's pixels (lc_tile_column, lc_tile_row):
