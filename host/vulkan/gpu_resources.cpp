@@ -296,16 +296,13 @@ void GpuResources::create_chunk_table() {
     upload("chunk addresses", words.data(), bytes, chunk_table_);
 }
 
-// Texel views can cover the four arrays: each is in one buffer (a view sees
-// one buffer; chunks that are windows of one buffer are fine), each is
-// within maxTexelBufferElements, and the format can be a storage texel
-// buffer (a device without it is refused: descriptor_refusal).
+// Texel views can cover the five arrays: each is in one buffer (a view sees
+// one buffer; chunks that are windows of one buffer are fine) and within
+// maxTexelBufferElements. (RGBA32UI storage texel buffers themselves are
+// there on every device the context takes: descriptor_refusal.)
 bool GpuResources::texel_views_fit() const {
     for (const TexelArray& a : kTexelArrays)
         if (scene_[a.binding].size() > 1) return false;
-    VkFormatProperties format{};
-    vkGetPhysicalDeviceFormatProperties(ctx_.physical(), kTexelFormat, &format);
-    if (!(format.bufferFeatures & VK_FORMAT_FEATURE_STORAGE_TEXEL_BUFFER_BIT)) return false;
     const VkDeviceSize max_texels = ctx_.properties().limits.maxTexelBufferElements;
     for (const TexelArray& a : kTexelArrays)
         if (scene_[a.binding][0].size() / kTexelBytes > max_texels) return false;
