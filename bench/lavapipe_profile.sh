@@ -115,9 +115,11 @@ for kind, n in split.most_common():
 
 # The same samples by function of the generated code (a function ends at a
 # ret). The kernels are one large function each; llvmpipe 22.3 reads a
-# texel buffer through small functions of its own (about 46 instructions:
-# the eight lanes' addresses extracted, eight 16-byte loads, a transpose),
-# called through a pointer once per texelFetch.
+# uniform texel buffer through small functions of its own (about 46
+# instructions: the eight lanes' addresses extracted, eight 16-byte loads, a
+# transpose), called through a pointer once per texelFetch. The kernels now
+# read storage texel buffers with imageLoad, which llvmpipe writes into the
+# kernel (docs/results/lavapipe.md, §26), so such functions no longer show.
 starts = [0] + [j + 1 for j, (_, text) in enumerate(code) if text.startswith("ret") and j + 1 < len(code)]
 by_function = collections.Counter()
 for ip in inside:
