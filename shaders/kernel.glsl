@@ -69,7 +69,8 @@ layout(std430, binding = kBindingPixelStats) buffer Stats { PixelStats pixel_sta
 // load whose address differs between lanes is a loop over the lanes, an
 // image load one gather in the kernel's own code (a texelFetch from a
 // uniform texel buffer was the same gather in a function of the driver's,
-// called once per fetch: 5 to 11% slower; docs/results/lavapipe.md, §26);
+// called once per fetch: 1.00 to 1.13 times the time;
+// docs/results/lavapipe.md, §26);
 // the host sets kTexelReads where it measured that to pay and every array
 // fits a texel buffer's limit. The fields are unpacked in struct order.
 layout(constant_id = kSpecTexelReads) const bool kTexelReads = false;

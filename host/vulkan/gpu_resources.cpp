@@ -71,7 +71,6 @@ constexpr TexelArray kTexelArrays[] = {
     {gpu::kBindingLightNodes, gpu::kBindingLightNodeTexels},
     {gpu::kBindingWideBvhNodes, gpu::kBindingWideBvhNodeTexels},
 };
-constexpr VkFormat kTexelFormat = VK_FORMAT_R32G32B32A32_UINT;
 constexpr VkDeviceSize kTexelBytes = 16;
 static_assert(std::size(kTexelArrays) == gpu::kTexelBindingCount &&
               gpu::kBindingBvhNodeTexels == gpu::kBindingCount &&

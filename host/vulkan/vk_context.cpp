@@ -167,7 +167,7 @@ std::vector<PhysicalDeviceInfo> physical_devices(VkInstance instance) {
                         "larger than one buffer)";
         if (d.refusal.empty()) {
             VkFormatProperties texel{};
-            vkGetPhysicalDeviceFormatProperties(handle, VK_FORMAT_R32G32B32A32_UINT, &texel);
+            vkGetPhysicalDeviceFormatProperties(handle, kTexelFormat, &texel);
             d.refusal = descriptor_refusal(d.properties.limits, texel.bufferFeatures);
         }
         devices.push_back(std::move(d));

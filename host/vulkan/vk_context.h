@@ -33,7 +33,10 @@ struct PhysicalDeviceInfo {
     std::string refusal;                        // why it cannot run the kernels ("" if it can)
 };
 
-// Why a device whose limits are `limits` and whose RGBA32UI buffer
+// The format of the kernels' texel views (16-byte texels, bindings.glsl).
+inline constexpr VkFormat kTexelFormat = VK_FORMAT_R32G32B32A32_UINT;
+
+// Why a device whose limits are `limits` and whose kTexelFormat buffer
 // features are `texel_features` cannot hold the kernels' descriptor set
 // (bindings.glsl: kBindingCount storage buffers and kTexelBindingCount
 // storage texel buffers, which count as storage images, in one set for
