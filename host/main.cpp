@@ -130,10 +130,26 @@ int run_render(RenderArgs a) {
     return 0;
 }
 
+// A metric for compare --json: a number where finite, else the text the
+// plain output prints ("inf", "-inf", "nan"; JSON has no such numbers, and
+// a null would read as "no value").
+nlohmann::json metric_json(double v) {
+    if (std::isfinite(v)) return v;
+    return std::isnan(v) ? "nan" : v > 0.0 ? "inf" : "-inf";
+}
+
 int run_compare(const std::string& image, const std::string& reference, const std::string& heatmap,
                 bool as_json) {
-    if (!heatmap.empty() && std::filesystem::path(heatmap).extension() != ".png")
-        throw std::invalid_argument("heatmap " + heatmap + ": must end in .png");
+    // The heatmap is refused before anything is read or printed where it
+    // could not be written, or would replace one of the images compared.
+    lc::OutputSet outputs;
+    if (!heatmap.empty()) {
+        if (std::filesystem::path(heatmap).extension() != ".png")
+            throw std::invalid_argument("heatmap " + heatmap + ": must end in .png");
+        outputs.add_input(image, "image compared");
+        outputs.add_input(reference, "reference");
+        outputs.add(heatmap, "heatmap");
+    }
     lc::Image a = lc::read_exr(image);
     lc::Image r = lc::read_exr(reference);
     if (a.width != r.width || a.height != r.height)
@@ -156,12 +172,12 @@ int run_compare(const std::string& image, const std::string& reference, const st
     }
     lc::CompareResult c = lc::compare_images(a, r);
     if (as_json) {
-        nlohmann::json j = {{"relative_rmse", c.relative_rmse},
-                            {"fraction_above_1pct", c.fraction_above_1pct},
-                            {"fraction_above_2pct", c.fraction_above_2pct},
-                            {"fraction_above_5pct", c.fraction_above_5pct},
-                            {"max_relative_error", c.max_relative_error},
-                            {"mean_difference", c.mean_difference}};
+        nlohmann::json j = {{"relative_rmse", metric_json(c.relative_rmse)},
+                            {"fraction_above_1pct", metric_json(c.fraction_above_1pct)},
+                            {"fraction_above_2pct", metric_json(c.fraction_above_2pct)},
+                            {"fraction_above_5pct", metric_json(c.fraction_above_5pct)},
+                            {"max_relative_error", metric_json(c.max_relative_error)},
+                            {"mean_difference", metric_json(c.mean_difference)}};
         std::printf("%s\n", j.dump(2).c_str());
     } else {
         std::printf("relative RMSE        %.6g\n", c.relative_rmse);
@@ -173,7 +189,11 @@ int run_compare(const std::string& image, const std::string& reference, const st
                     100.0 * c.mean_difference);
     }
     // The heatmap's scale runs from 0 to 10% relative luminance error.
-    if (!heatmap.empty()) lc::write_heatmap_png(heatmap, a.width, a.height, c.per_pixel, 0.1f);
+    if (!heatmap.empty()) {
+        lc::write_file(outputs.temporary(heatmap), lc::encode_heatmap_png(a.width, a.height, c.per_pixel, 0.1f, heatmap),
+                       heatmap);
+        outputs.commit();
+    }
     return 0;
 }
 
@@ -203,14 +223,21 @@ int run_info(const std::string& file, const lc::SceneOptions& options, std::opti
     return 0;
 }
 
+// A file option given as "" (--stats "", say) names no file: refused, not
+// taken for the option's absence.
+const CLI::Validator kFileName(
+    [](std::string& name) { return name.empty() ? std::string("the file name is empty") : std::string(); }, "FILE",
+    "file name");
+
 CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
     auto* render = app.add_subcommand("render", "Render a scene to a linear OpenEXR image and a PNG preview");
-    render->add_option("scene", r.scene, "Scene file (JSON, or glTF 2.0: .gltf or .glb)")->required();
+    render->add_option("scene", r.scene, "Scene file (JSON, or glTF 2.0: .gltf or .glb)")->required()->check(kFileName);
     render->add_option("--camera", r.scene_options.camera,
                        "glTF scenes: the perspective camera of this name (default: the first in node order; "
                        "none in the file: a default framing of the scene)");
     render->add_option("-o,--output", r.outputs.image, "Output .exr (a tone-mapped .png is written beside it)")
-        ->required();
+        ->required()
+        ->check(kFileName);
     render->add_option("--method", r.method,
                        "brute (exact), lightcuts, sampled (lights drawn through the light tree), "
                        "stochastic (Stochastic Lightcuts) or path (the path tracer, CPU only)")
@@ -266,8 +293,9 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
         ->check(ask(lc::device_problem));
     render->add_option("--gpu", r.device.vulkan.gpu, "Vulkan device index or name substring");
     render->add_flag("--validation", r.device.vulkan.validation, "Enable the Vulkan validation layer");
-    render->add_option("--stats", r.outputs.stats, "Write statistics as JSON");
-    render->add_option("--cut-heatmap", r.outputs.cut_heatmap, "Write per-pixel cut size as a false-colour PNG");
+    render->add_option("--stats", r.outputs.stats, "Write statistics as JSON")->check(kFileName);
+    render->add_option("--cut-heatmap", r.outputs.cut_heatmap, "Write per-pixel cut size as a false-colour PNG")
+        ->check(kFileName);
     render->add_flag_callback("--no-png", [&r] { r.outputs.png_preview = false; }, "Do not write the PNG preview");
     return render;
 }
@@ -284,15 +312,16 @@ int main(int argc, char** argv) {
     std::string cmp_image, cmp_ref, cmp_heatmap;
     bool cmp_json = false;
     auto* compare = app.add_subcommand("compare", "Error metrics of an EXR image against a reference EXR");
-    compare->add_option("image", cmp_image, "Image (EXR)")->required();
-    compare->add_option("reference", cmp_ref, "Reference (EXR)")->required();
-    compare->add_option("--heatmap", cmp_heatmap, "Write per-pixel relative error as a PNG (scale 0 to 10%)");
+    compare->add_option("image", cmp_image, "Image (EXR)")->required()->check(kFileName);
+    compare->add_option("reference", cmp_ref, "Reference (EXR)")->required()->check(kFileName);
+    compare->add_option("--heatmap", cmp_heatmap, "Write per-pixel relative error as a PNG (scale 0 to 10%)")
+        ->check(kFileName);
     compare->add_flag("--json", cmp_json, "Print the metrics as JSON");
 
     std::string info_scene;
     lc::SceneOptions info_options;
     auto* info = app.add_subcommand("info", "Print what a scene holds and the memory it needs");
-    info->add_option("scene", info_scene, "Scene file (JSON, or glTF 2.0: .gltf or .glb)")->required();
+    info->add_option("scene", info_scene, "Scene file (JSON, or glTF 2.0: .gltf or .glb)")->required()->check(kFileName);
     info->add_option("--camera", info_options.camera, "glTF scenes: the perspective camera of this name");
     std::optional<std::uint32_t> info_area_samples;
     info->add_option("--area-samples", info_area_samples, "Point lights the emissive surfaces become, as render's")

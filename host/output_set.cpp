@@ -95,6 +95,7 @@ void OutputSet::add_input(const fs::path& file, std::string_view what) {
 }
 
 fs::path OutputSet::add(const fs::path& file, std::string_view what) {
+    if (file.empty()) throw std::invalid_argument(std::string(what) + ": the file name is empty");
     const std::string label = std::string(what) + " " + file.string();
     fs::path folder = file.parent_path();
     if (folder.empty()) folder = ".";
@@ -107,6 +108,19 @@ fs::path OutputSet::add(const fs::path& file, std::string_view what) {
     for (const Output& out : outputs_)
         if (same_file(name.identity, out.name.identity))
             throw std::invalid_argument(label + ": is also the " + out.name.what);
+    // An output is written to a temporary and renamed into place. Renamed
+    // onto a symbolic link (/dev/stdout is one), that would replace the
+    // link, not write where it points; onto a device or a pipe, replace its
+    // name with a plain file. Both are refused.
+    std::error_code ec;
+    const fs::file_status link = fs::symlink_status(file, ec);
+    if (fs::is_symlink(link))
+        throw std::invalid_argument(label + ": is a symbolic link (to " + fs::read_symlink(file, ec).string() +
+                                    "); outputs are written whole and renamed into place, which would replace the "
+                                    "link: name the file itself");
+    if (fs::exists(link) && !fs::is_regular_file(link))
+        throw std::invalid_argument(label + ": is not a regular file (a device, a pipe or a socket); outputs are "
+                                            "written whole and renamed into place");
     fs::path temporary = temporary_path_for(file);
     // Tracked before it exists, so no signal can come between the two.
     const int tracked = track_temporary(temporary);

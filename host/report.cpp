@@ -254,7 +254,9 @@ std::string report_json(const RenderReport& r) {
         j["sampling"] = {{"light_samples", r.sampling->light_samples}};
         if (!r.sampling->light_pick.empty()) j["sampling"]["light_pick"] = r.sampling->light_pick;
     }
-    return j.dump(2) + "\n";
+    // A path that is not UTF-8 (Linux allows any bytes but '/' and NUL)
+    // is written with U+FFFD for the bytes JSON cannot hold.
+    return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 std::string buffer_table(const std::vector<BufferBytes>& buffers) {

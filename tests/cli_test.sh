@@ -70,6 +70,51 @@ expect_error "must end in .exr" render "$root/scenes/room/room.json" -o "$tmp/c.
 expect_error "nope.exr" compare "$tmp/a.exr" "$tmp/nope.exr"
 expect_error "heatmap $tmp/err.exr: must end in .png" compare "$tmp/a.exr" "$tmp/a.exr" --heatmap "$tmp/err.exr"
 expect_error "bad_env_nan.exr: pixel (1, 0)" compare "$root/tests/data/scenes/bad_env_nan.exr" "$root/tests/data/scenes/bad_env_nan.exr"
+# compare's heatmap is checked before anything is read or printed: not into
+# a missing folder, not over one of the images compared.
+"$exe" compare "$tmp/a.exr" "$tmp/a.exr" --heatmap "$tmp/nowhere/h.png" >"$tmp/cmp_out.txt" 2>"$tmp/cmp_err.txt" &&
+  fail "compare wrote a heatmap into a missing folder"
+grep -qF "heatmap $tmp/nowhere/h.png: folder $tmp/nowhere does not exist" "$tmp/cmp_err.txt" &&
+  [ ! -s "$tmp/cmp_out.txt" ] || fail "compare --heatmap into a missing folder: $(cat "$tmp/cmp_out.txt" "$tmp/cmp_err.txt")"
+cp "$tmp/a.exr" "$tmp/a_copy.png"
+expect_error "heatmap $tmp/a_copy.png: is the image compared" compare "$tmp/a_copy.png" "$tmp/a.exr" --heatmap "$tmp/a_copy.png"
+cmp -s "$tmp/a.exr" "$tmp/a_copy.png" || fail "compare --heatmap replaced the image it compared"
+rm -f "$tmp/a_copy.png"
+# A file option given as "" names no file; it is refused, not ignored.
+expect_error "--stats: the file name is empty" render "$root/scenes/room/room.json" -o "$tmp/c.exr" --stats ""
+expect_error "--heatmap: the file name is empty" compare "$tmp/a.exr" "$tmp/a.exr" --heatmap ""
+# Outputs are renamed into place, which would replace a symbolic link
+# (/dev/stdout is one) or a device's name: both refused.
+ln -s "$tmp/linked.json" "$tmp/link.json"
+expect_error "stats file $tmp/link.json: is a symbolic link" render "$root/scenes/room/room.json" -o "$tmp/c.exr" \
+  --stats "$tmp/link.json"
+[ -L "$tmp/link.json" ] || fail "a refused render replaced the symbolic link"
+rm -f "$tmp/link.json"
+# (A pipe of our own, not /dev/null: a build that took the rename would
+# replace the system's /dev/null when the tests run as root.)
+mkfifo "$tmp/pipe.json"
+expect_error "stats file $tmp/pipe.json: is not a regular file" render "$root/scenes/room/room.json" -o "$tmp/c.exr" \
+  --stats "$tmp/pipe.json"
+[ -p "$tmp/pipe.json" ] || fail "a refused render replaced the pipe"
+rm -f "$tmp/pipe.json"
+expect_error "$root/scenes: is a folder, not a file" render "$root/scenes" -o "$tmp/c.exr"
+# A relative error against a black reference is infinite: compare --json
+# says "inf" (JSON has no infinite number; null would read as no value).
+sed 's/"look_at": \[0, 0.5, 0\]/"look_at": [0, 0.5, 10]/' "$root/tests/data/scenes/minimal.json" >"$tmp/black.json"
+cp "$root/tests/data/scenes/tri.obj" "$tmp/"
+"$exe" render "$tmp/black.json" -o "$tmp/black.exr" --no-png --device cpu >/dev/null 2>&1 &&
+  "$exe" render "$root/tests/data/scenes/minimal.json" -o "$tmp/lit.exr" --no-png --device cpu >/dev/null 2>&1 ||
+  fail "rendering the black and the lit triangle"
+"$exe" compare "$tmp/lit.exr" "$tmp/black.exr" --json >"$tmp/inf.json" || fail "compare against a black reference failed"
+grep -q '"relative_rmse": "inf"' "$tmp/inf.json" || fail "compare --json against black: $(cat "$tmp/inf.json")"
+# A scene in a folder whose name is not UTF-8 (Linux allows any byte but
+# '/' and NUL) renders, and its stats name it with U+FFFD for the odd byte.
+odd="$tmp/$(printf 'odd\377')"
+mkdir "$odd" && cp "$root/tests/data/scenes/minimal.json" "$root/tests/data/scenes/tri.obj" "$odd/"
+"$exe" render "$odd/minimal.json" -o "$tmp/odd.exr" --no-png --device cpu --width 4 --height 4 \
+  --stats "$tmp/odd.json" >"$tmp/odd_log.txt" 2>&1 || fail "a scene under a non-UTF-8 folder: $(cat "$tmp/odd_log.txt")"
+grep -q "odd$(printf '\357\277\275')/minimal.json" "$tmp/odd.json" || fail "its stats: $(grep scene "$tmp/odd.json")"
+rm -rf "$odd" "$tmp"/{odd.exr,odd.json,black.json,black.exr,lit.exr,tri.obj,inf.json}
 [ -e "$tmp/c.exr" ] && fail "a failed render left c.exr behind"
 
 # No output may replace a file the scene reads (on a copy of the room, so

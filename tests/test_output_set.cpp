@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <gmock/gmock.h>
@@ -154,6 +155,25 @@ TEST_F(OutputSetTest, RefusesWhatCannotBeWrittenBeforeTheWork) {
     for (const char* kept : {"folder", "hardlink.json", "scene.json", "symlink.json"}) EXPECT_TRUE(now.count(kept));
     auto temporary = [](const std::string& name) { return name.starts_with("a.png.tmp-"); };
     EXPECT_EQ(std::count_if(now.begin(), now.end(), temporary), 1);
+}
+
+// Outputs are renamed into place: onto a symbolic link that would replace
+// the link instead of writing where it points, onto a device or a pipe it
+// would replace their names with plain files. Each is refused, as is an
+// empty name, and nothing is created or changed.
+TEST_F(OutputSetTest, RefusesLinksDevicesPipesAndEmptyNames) {
+    write(at("target.json"), "kept");
+    fs::create_symlink(at("target.json"), at("link.json"));
+    ASSERT_EQ(::mkfifo(at("pipe").c_str(), 0600), 0);
+    OutputSet set;
+    EXPECT_THAT(error_of([&] { set.add(at("link.json"), "stats file"); }),
+                HasSubstr("stats file " + at("link.json").string() + ": is a symbolic link (to " +
+                          at("target.json").string() + ")"));
+    EXPECT_THAT(error_of([&] { set.add(at("pipe"), "stats file"); }), HasSubstr(": is not a regular file"));
+    EXPECT_THAT(error_of([&] { set.add("", "stats file"); }), HasSubstr("stats file: the file name is empty"));
+    EXPECT_EQ(entries(), (std::set<std::string>{"link.json", "pipe", "target.json"}));
+    EXPECT_TRUE(fs::is_symlink(at("link.json")));
+    EXPECT_EQ(read(at("target.json")), "kept");
 }
 
 // The rename of the last output fails (its path became a folder during the

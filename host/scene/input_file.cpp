@@ -27,11 +27,19 @@ void note_input_file(const fs::path& path) {
         g_input_files->push_back(normal);
 }
 
+std::string input_file_problem(const fs::path& path) {
+    std::error_code ec;
+    const fs::file_status status = fs::status(path, ec);
+    if (fs::is_regular_file(status)) return "";
+    if (fs::is_directory(status)) return "is a folder, not a file";
+    if (fs::exists(status)) return "is not a regular file (a device, a pipe or a socket)";
+    return "file not found";
+}
+
 // One read is much faster than line-wise streams for the million-line CSV case.
 std::string read_input_file(const fs::path& path) {
     const std::string name = display(path);
-    std::error_code ec;
-    if (!fs::is_regular_file(path, ec)) throw InputError(name, "", "file not found");
+    if (const std::string problem = input_file_problem(path); !problem.empty()) throw InputError(name, "", problem);
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(name, "", "cannot read file");
     in.seekg(0, std::ios::end);

@@ -10,8 +10,14 @@ namespace lc::loader {
 // A path as error messages show it: as given, with "a/./b" and "a/../b" folded.
 std::string display(const std::filesystem::path& path);
 
-// The whole file in memory. Throws InputError "FILE: file not found" or
-// "FILE: cannot read file". Notes the file (note_input_file).
+// Why `path` cannot be read as an input: "file not found", "is a folder,
+// not a file" or "is not a regular file (a device, a pipe or a socket)";
+// "" where it is a regular file (symbolic links followed).
+std::string input_file_problem(const std::filesystem::path& path);
+
+// The whole file in memory. Throws InputError "FILE: " and
+// input_file_problem's words, or "FILE: cannot read file". Notes the file
+// (note_input_file).
 std::string read_input_file(const std::filesystem::path& path);
 
 // While an InputFileLog lives, every file read_input_file reads, and every

@@ -280,8 +280,8 @@ private:
             override_material = parse_material_override(*m, path + ".material");
         }
 
-        std::error_code ec;
-        if (!fs::is_regular_file(obj_path, ec)) in_.fail(obj_field, "file not found: " + display(obj_path));
+        if (const std::string problem = input_file_problem(obj_path); !problem.empty())
+            in_.fail(obj_field, problem + ": " + display(obj_path));
         load_obj(obj_path, transform, override_material, meshes_);
     }
 
@@ -375,8 +375,8 @@ private:
     fs::path existing_file(const json& j, const std::string& path, const char* key) const {
         const std::string field = path + "." + key;
         const fs::path file = resolve(in_.string(in_.require(j, path, key), field));
-        std::error_code ec;
-        if (!fs::is_regular_file(file, ec)) in_.fail(field, "file not found: " + display(file));
+        if (const std::string problem = input_file_problem(file); !problem.empty())
+            in_.fail(field, problem + ": " + display(file));
         return file;
     }
 

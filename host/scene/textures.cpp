@@ -65,8 +65,8 @@ std::string encoded_image_problem(const unsigned char* bytes, std::size_t size) 
 std::uint32_t load_texture(Scene& scene, const std::filesystem::path& image, const std::string& referrer,
                            const std::string& field) {
     const std::string name = "texture '" + display(image) + "'";
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(image, ec)) throw InputError(referrer, field, name + " not found");
+    if (const std::string problem = input_file_problem(image); !problem.empty())
+        throw InputError(referrer, field, name + (problem == "file not found" ? " not found" : ": " + problem));
     std::string bytes;
     try {
         bytes = read_input_file(image);

@@ -33,10 +33,14 @@ public:
 
     // Adds an output and creates its temporary (empty) beside it, so an
     // unwritable folder shows now, not after the work. Throws
-    // std::invalid_argument, starting with `what` and the file, when its
-    // folder does not exist, it is a folder, or it is an input or an output
-    // added before (hard and symbolic links included); std::runtime_error
-    // when the temporary cannot be created. Returns the temporary to write.
+    // std::invalid_argument, starting with `what` and the file, when the
+    // name is empty, its folder does not exist, it is a folder, a symbolic
+    // link (/dev/stdout, say: the rename would replace the link) or any
+    // other file that is not a regular one (a device, a pipe), or it is an
+    // input or an output added before (under another name, a hard or a
+    // symbolic link, included);
+    // std::runtime_error when the temporary cannot be created. Returns the
+    // temporary to write.
     std::filesystem::path add(const std::filesystem::path& file, std::string_view what);
 
     // The temporary of an added output; throws std::out_of_range otherwise.
