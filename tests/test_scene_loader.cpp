@@ -908,6 +908,25 @@ TEST(SceneLoader, MissingSceneFileIsAnInputError) {
     EXPECT_NE(message.find("file not found"), std::string::npos) << message;
 }
 
+// A NUL in a file name would end it where the system reads it (so
+// "tri.obj\0garbage" opened tri.obj), and a NUL in a key or a value cut
+// the message short where it is printed: the one is refused, the other
+// written as "\0".
+TEST(SceneLoader, NulCharactersAreRefusedInFileNamesAndEscapedInMessages) {
+    TempDir dir;
+    fs::copy_file(kFixtures / "tri.obj", dir.path() / "tri.obj");
+    const fs::path named = dir.write("named.json", R"({"camera": {"position": [0, 0, 3], "look_at": [0, 0, 0]},
+ "meshes": [{"obj": "tri.obj\u0000garbage"}], "lights": [{"type": "point", "position": [0, 1, 1], "intensity": [1, 1, 1]}]})");
+    EXPECT_EQ(input_error_of([&] { load_scene(named); }),
+              named.lexically_normal().string() + ": meshes[0].obj: the file name contains a NUL character");
+    const fs::path key = dir.write("key.json", R"({"camera": {"position": [0, 0, 3], "look_at": [0, 0, 0]},
+ "meshes": [{"obj": "tri.obj"}], "lights": [{"type": "point", "position": [0, 1, 1], "intensity": [1, 1, 1]}],
+ "render": {"meth\u0000od": "x"}})");
+    const std::string message = input_error_of([&] { load_scene(key); });
+    EXPECT_NE(message.find("render.meth\\0od"), std::string::npos) << message;
+    EXPECT_EQ(std::string(message.c_str()), message) << "the message holds a NUL";
+}
+
 TEST(SceneLoader, ErrorMessageReadsFileFieldProblem) {
     const std::string message = input_error_of([] { load_scene(kFixtures / "bad_zero_width.json"); });
     const std::string expected_start = (kFixtures / "bad_zero_width.json").lexically_normal().string() +

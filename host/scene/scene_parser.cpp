@@ -74,7 +74,12 @@ private:
     // join the scene's lights before the "lights" list.
     std::vector<std::pair<std::string, GltfLight>> gltf_lights_;
 
-    fs::path resolve(const std::string& relative) const { return dir_ / relative; }
+    // A file the scene names, relative to the scene's folder. A NUL would
+    // end the name where the system reads it, and another file be opened.
+    fs::path resolve(const std::string& relative, const std::string& field) const {
+        if (relative.find('\0') != std::string::npos) in_.fail(field, "the file name contains a NUL character");
+        return dir_ / relative;
+    }
 
     void parse_camera(const json& j) {
         const std::string path = "camera";
@@ -272,7 +277,7 @@ private:
         }
         in_.check_keys(j, path, {"obj", "transform", "material"});
         const std::string obj_field = path + ".obj";
-        const fs::path obj_path = resolve(in_.string(in_.require(j, path, "obj"), obj_field));
+        const fs::path obj_path = resolve(in_.string(in_.require(j, path, "obj"), obj_field), obj_field);
         MeshTransform transform;
         if (const json* t = JsonReader::find(j, "transform")) transform = parse_transform(*t, path + ".transform");
         std::optional<gpu::Material> override_material;
@@ -374,7 +379,7 @@ private:
 
     fs::path existing_file(const json& j, const std::string& path, const char* key) const {
         const std::string field = path + "." + key;
-        const fs::path file = resolve(in_.string(in_.require(j, path, key), field));
+        const fs::path file = resolve(in_.string(in_.require(j, path, key), field), field);
         if (const std::string problem = input_file_problem(file); !problem.empty())
             in_.fail(field, problem + ": " + display(file));
         return file;
