@@ -312,6 +312,11 @@ TEST(TextureLimits, OversizedOrTruncatedImagesAreRefusedFromTheirHeaders) {
     EXPECT_EQ(loader::encoded_image_problem(nullptr, 0), "");
     const std::string small = png_header(2, 2);
     EXPECT_EQ(loader::encoded_image_problem(reinterpret_cast<const unsigned char*>(small.data()), small.size()), "");
+    // Cut between chunks (stb_image's reason named the last chunk type it
+    // read, bytes of the file): the IHDR chunk and nothing after it.
+    const std::string headless = small.substr(0, 8 + 25);
+    EXPECT_EQ(loader::encoded_image_problem(reinterpret_cast<const unsigned char*>(headless.data()), headless.size()),
+              "is a corrupt or truncated PNG: it ends after 1 chunk without the IEND chunk that closes a PNG");
 
     TempDir dir;
     dir.write("big.png", png_header(16384, 16384));

@@ -43,15 +43,24 @@ std::string encoded_image_problem(const unsigned char* bytes, std::size_t size) 
     static constexpr unsigned char kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
     if (size >= 8 && std::equal(kPngSignature, kPngSignature + 8, bytes)) {
         std::size_t chunk = 0;
+        bool ended = false;
         for (std::size_t at = 8; at + 8 <= size; ++chunk) {
             const std::uint64_t length = std::uint64_t(bytes[at]) << 24 | std::uint64_t(bytes[at + 1]) << 16 |
                                          std::uint64_t(bytes[at + 2]) << 8 | bytes[at + 3];
             if (length + 12 > size - at)
                 return "is a corrupt or truncated PNG: chunk " + std::to_string(chunk + 1) + " claims " +
                        std::to_string(length) + " bytes, " + std::to_string(size - at) + " are left";
-            if (std::equal(bytes + at + 4, bytes + at + 8, "IEND")) break;
+            if (std::equal(bytes + at + 4, bytes + at + 8, "IEND")) {
+                ended = true;
+                break;
+            }
             at += std::size_t(length) + 12;
         }
+        // A file cut between chunks: stb_image would name the last chunk
+        // type it read, bytes of the file.
+        if (!ended)
+            return "is a corrupt or truncated PNG: it ends after " + std::to_string(chunk) +
+                   (chunk == 1 ? " chunk" : " chunks") + " without the IEND chunk that closes a PNG";
     }
     int w = 0, h = 0, channels = 0;
     if (size == 0 || size > std::size_t(std::numeric_limits<int>::max()) ||
