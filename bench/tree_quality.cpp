@@ -3,7 +3,7 @@
 // lightcuts selects with each tree on the same scene, image and settings
 // (the cut size is what a worse tree costs).
 //
-//   tree_quality SCENE [--lights N] [--size S]
+//   tree_quality SCENE [SIZE]     (SIZE x SIZE pixels, default 64; the CPU's defaults)
 #include <chrono>
 #include <cstdio>
 #include <numeric>

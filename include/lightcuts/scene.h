@@ -39,7 +39,7 @@ struct RenderSettings {
     float relative_error = 0.02f;   // lightcuts: refine while bound > this * estimate
     std::uint32_t max_cut = 1000;   // lightcuts: largest cut per shaded point
     std::uint32_t cut_heap = kDefaultCutHeap;  // lightcuts: cut-heap capacity K per shaded point
-    std::string cut_sharing = "auto";  // lightcuts: "pixel", "quad" or "auto" ("quad" on the CPU, "pixel" on Vulkan)
+    std::string cut_sharing = "auto";  // lightcuts: "pixel", "quad", "octet" or "auto" ("octet" on the CPU, "pixel" on Vulkan)
     std::uint32_t seed = 1;         // pixel jitter, light-tree representatives, light samples
     std::uint32_t light_samples = 1;  // sampled: lights per camera sample; stochastic: draws per cluster
     std::string light_pick = "tree";  // sampled: "tree", "uniform" or "power"
