@@ -89,6 +89,14 @@ std::string exr_message(const char* err, const char* fallback) {
     return message;
 }
 
+// "is truncated or corrupt (WHY)" for a file tinyexr cannot parse or decode,
+// WHY being tinyexr's message without its trailing newlines and full stop.
+std::string exr_damaged(const char* err, const char* fallback) {
+    std::string why = exr_message(err, fallback);
+    while (!why.empty() && (why.back() == '\n' || why.back() == '.' || why.back() == ' ')) why.pop_back();
+    return "is truncated or corrupt (" + why + ")";
+}
+
 struct ExrHeaderGuard {
     EXRHeader* header;
     ~ExrHeaderGuard() { FreeEXRHeader(header); }
@@ -202,12 +210,14 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
     if (version.multipart || version.non_image)
         throw InputError(name, "", "multi-part and deep OpenEXR files are not supported");
 
+    // tinyexr fills the header (channels, attributes) even when parsing
+    // fails, so the guard is in place before the parse.
     EXRHeader header;
     InitEXRHeader(&header);
+    ExrHeaderGuard header_guard{&header};
     const char* err = nullptr;
     if (ParseEXRHeaderFromFile(&header, &version, name.c_str(), &err) != TINYEXR_SUCCESS)
-        throw InputError(name, "", exr_message(err, "cannot parse the OpenEXR header"));
-    ExrHeaderGuard header_guard{&header};
+        throw InputError(name, "", exr_damaged(err, "cannot parse the OpenEXR header"));
     const EXRBox2i& window = header.data_window;
     const std::int64_t width = std::int64_t(window.max_x) - window.min_x + 1;
     const std::int64_t height = std::int64_t(window.max_y) - window.min_y + 1;
@@ -231,10 +241,16 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
     for (int c = 0; c < header.num_channels; ++c)
         if (header.pixel_types[c] == TINYEXR_PIXELTYPE_HALF) header.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
 
+    // When decoding fails, tinyexr (1.0.1) calls FreeEXRImage on the image
+    // itself, before it has set the image's channel count: it frees the
+    // array of channel planes but not the planes. With the count set here
+    // first, that call frees the planes too. It leaves the freed pointers in
+    // the image, so after a failure the image must not be freed again.
     EXRImage exr;
     InitEXRImage(&exr);
+    exr.num_channels = header.num_channels;
     if (LoadEXRImageFromFile(&exr, &header, name.c_str(), &err) != TINYEXR_SUCCESS)
-        throw InputError(name, "", exr_message(err, "cannot decode the OpenEXR pixels"));
+        throw InputError(name, "", exr_damaged(err, "cannot decode the OpenEXR pixels"));
     ExrImageGuard image_guard{&exr};
     // The size checked against max_pixels above is the one decoded.
     if (exr.width != width || exr.height != height)

@@ -129,6 +129,33 @@ TEST_F(ImageFiles, ReadExrReportsBadInputAsInputError) {
     EXPECT_THROW(lc::read_exr(text), lc::InputError);
 }
 
+// A file cut short in its header or in its pixels is an InputError naming
+// the file. tinyexr allocates in both cases before it fails; the sanitizer
+// build of the tests reports any of that left behind.
+TEST_F(ImageFiles, ReadExrReportsTruncatedFilesAsInputError) {
+    lc::Image image(64, 48);
+    for (std::size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = std::sin(float(i));
+    const fs::path whole = dir_ / "whole.exr";
+    lc::write_exr(whole, image);
+    std::string bytes;
+    {
+        std::ifstream in(whole, std::ios::binary);
+        bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    ASSERT_GT(bytes.size(), 200u);
+    for (const std::size_t keep : {std::size_t(100), bytes.size() / 2, bytes.size() - 1}) {
+        const fs::path cut = dir_ / ("cut_" + std::to_string(keep) + ".exr");
+        std::ofstream(cut, std::ios::binary) << bytes.substr(0, keep);
+        try {
+            lc::read_exr(cut);
+            ADD_FAILURE() << "expected InputError for " << keep << " bytes";
+        } catch (const lc::InputError& e) {
+            const std::string message = e.what();
+            EXPECT_EQ(message.rfind(cut.string() + ": is truncated or corrupt (", 0), 0u) << message;
+        }
+    }
+}
+
 // An OpenEXR header's data window is checked against the limit before
 // tinyexr allocates the pixels it declares. The file here is a 2 x 2 image
 // whose header claims 30000 x 30000 (10.8 GB of RGB floats); without the
