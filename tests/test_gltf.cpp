@@ -4,7 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
+#include <utility>
+
+#include <sys/stat.h>
 
 #include <gtest/gtest.h>
 
@@ -298,6 +303,36 @@ TEST(Gltf, CameraOptionIsRefusedForAJsonScene) {
     EXPECT_NE(e.find("--camera picks a camera of a glTF scene"), std::string::npos) << e;
 }
 
+// A buffer read from a device or a pipe could go on for ever: such URIs are
+// refused before tinygltf opens them (it reads a pipe until its writer
+// closes it, which here is never).
+TEST(Gltf, BufferAndImageUrisMustNameRegularFiles) {
+    test::TempDir dir;
+    std::ifstream in(kData / "bad_missing_buffer.gltf", std::ios::binary);
+    const std::string doc{std::istreambuf_iterator<char>(in), {}};
+    const std::size_t at = doc.find("missing.bin");
+    ASSERT_NE(at, std::string::npos);
+    auto with_buffer = [&](const std::string& uri) {
+        std::string changed = doc;
+        return dir.write("scene.gltf", changed.replace(at, std::string("missing.bin").size(), uri));
+    };
+    fs::create_symlink("/dev/zero", dir.path() / "zero.bin");
+    ASSERT_EQ(::mkfifo((dir.path() / "pipe.bin").c_str(), 0600), 0);
+    for (const auto& [uri, kind] : {std::pair<std::string, std::string>{"zero.bin", "a device"},
+                                    {"pipe.bin", "a pipe"},
+                                    {"sub%20dir", "a folder"}}) {
+        fs::create_directories(dir.path() / "sub dir");
+        const fs::path file = with_buffer(uri);
+        try {
+            load_scene(file);
+            ADD_FAILURE() << uri << ": loaded, expected lc::InputError";
+        } catch (const InputError& e) {
+            EXPECT_EQ(std::string(e.what()), file.string() + ": buffers[0].uri: '" + uri +
+                                                 "' is not a regular file (it is " + kind + ")");
+        }
+    }
+}
+
 struct BadCase {
     const char* file;
     const char* message;  // after "FILE: "
@@ -323,6 +358,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_view_past_buffer.gltf", "bufferViews[0]: bytes 8 + 36 run past the end of buffer 0"},
         BadCase{"bad_nan_position.gltf", "meshes[0].primitives[0].attributes.POSITION: element 1 of accessors[0] is not a finite"},
         BadCase{"bad_missing_buffer.gltf", "tinygltf: File not found : missing.bin"},
+        BadCase{"bad_buffer_folder.gltf", "buffers[0].uri: '.' is not a regular file (it is a folder)"},
+        BadCase{"bad_image_folder.gltf", "images[0].uri: '..' is not a regular file (it is a folder)"},
         BadCase{"bad_data_uri.gltf", "tinygltf: Failed to decode 'uri'"},
         BadCase{"bad_no_position.gltf", "meshes[0].primitives[0].attributes.POSITION: missing"},
         BadCase{"bad_no_light.gltf", "the scene has no light"},

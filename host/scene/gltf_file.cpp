@@ -5,6 +5,9 @@
 #include <array>
 #include <limits>
 #include <string_view>
+#include <system_error>
+
+#include <nlohmann/json.hpp>
 
 #include "gltf_types.h"
 #include "input_file.h"
@@ -77,6 +80,52 @@ std::string decoded_uri(const std::string& uri) {
     return out;
 }
 
+// The file tinygltf 2.7 opens for a buffer's or an image's URI: the decoded
+// URI after the base folder and a '/', even when the URI is absolute.
+fs::path uri_file(const std::string& base, const std::string& uri) {
+    return fs::path(base + "/" + decoded_uri(uri));
+}
+
+// What a file that is not a regular one is, in words.
+std::string kind_of(fs::file_type type) {
+    switch (type) {
+        case fs::file_type::directory: return "a folder";
+        case fs::file_type::character:
+        case fs::file_type::block: return "a device";
+        case fs::file_type::fifo: return "a pipe";
+        case fs::file_type::socket: return "a socket";
+        default: return "a special file";
+    }
+}
+
+// tinygltf reads a buffer's or an image's file whole, taking its size from a
+// seek to its end: a folder's "size" makes it ask for about 2^63 bytes
+// (std::bad_alloc), and a device or a pipe may never end. So every URI that
+// tinygltf would open must name a regular file, checked in the file's JSON
+// before tinygltf reads it. A missing file is left to tinygltf's
+// "File not found"; JSON that does not parse, to tinygltf's message.
+void check_uri_files(std::string_view json, const std::string& base, const std::string& name) {
+    const nlohmann::json doc = nlohmann::json::parse(json.begin(), json.end(), nullptr, false);
+    if (doc.is_discarded() || !doc.is_object()) return;
+    for (const char* list : {"buffers", "images"}) {
+        const auto entries = doc.find(list);
+        if (entries == doc.end() || !entries->is_array()) continue;
+        for (std::size_t i = 0; i < entries->size(); ++i) {
+            const nlohmann::json& entry = (*entries)[i];
+            if (!entry.is_object()) continue;
+            const auto uri = entry.find("uri");
+            if (uri == entry.end() || !uri->is_string()) continue;
+            const std::string& text = uri->get_ref<const std::string&>();
+            if (text.empty() || tinygltf::IsDataURI(text)) continue;
+            std::error_code ec;
+            const fs::file_status status = fs::status(uri_file(base, text), ec);
+            if (ec || status.type() == fs::file_type::not_found || status.type() == fs::file_type::regular) continue;
+            throw InputError(name, std::string(list) + "[" + std::to_string(i) + "].uri",
+                             "'" + text + "' is not a regular file (it is " + kind_of(status.type()) + ")");
+        }
+    }
+}
+
 // tinygltf's own image loader (stb_image) after a look at the image's
 // header: one larger than the scene's textures may hold is refused before
 // its pixels are allocated (encoded_image_problem).
@@ -104,12 +153,13 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
         json = json.substr(20, length);
     }
     if (too_deep(json)) throw InputError(name, "", "JSON nested more than " + std::to_string(kMaxJsonDepth) + " levels deep");
+    const std::string base = file.parent_path().empty() ? std::string(".") : file.parent_path().string();
+    check_uri_files(json, base, name);
 
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(load_image_checked, nullptr);
     tinygltf::Model model;
     std::string err, warn;
-    const std::string base = file.parent_path().empty() ? std::string(".") : file.parent_path().string();
     bool ok = false;
     try {
         const auto size = static_cast<unsigned int>(bytes.size());
@@ -125,7 +175,7 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
     // The buffers and images tinygltf read from files beside this one, by
     // their URIs decoded as tinygltf decodes them.
     auto note_uri = [&](const std::string& uri) {
-        if (!uri.empty() && uri.rfind("data:", 0) != 0) note_input_file(fs::path(base) / decoded_uri(uri));
+        if (!uri.empty() && uri.rfind("data:", 0) != 0) note_input_file(uri_file(base, uri));
     };
     for (const tinygltf::Buffer& b : model.buffers) note_uri(b.uri);
     for (const tinygltf::Image& i : model.images) note_uri(i.uri);

@@ -320,6 +320,9 @@ def bad_cases():
         d["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(bytes(data)).decode()
     variant("bad_nan_position", nan_position)
     variant("bad_missing_buffer", lambda d: d["buffers"][0].update(uri="missing.bin"))
+    # URIs naming a folder: tinygltf would take the folder's "size" as about 2^63 bytes.
+    variant("bad_buffer_folder", lambda d: d["buffers"][0].update(uri="."))
+    variant("bad_image_folder", lambda d: d.update(images=[{"uri": ".."}]))
     variant("bad_data_uri", lambda d: d["buffers"][0].update(uri="data:application/octet-stream;base64,@@@@"))
     variant("bad_no_position", lambda d: d["meshes"][0]["primitives"][0].update(attributes={"NORMAL": 0}))
     variant("bad_no_light", lambda d: (d.pop("extensions"), d["nodes"].pop(), d["scenes"][0]["nodes"].pop()))
