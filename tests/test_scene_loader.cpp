@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
+
 #include <glm/glm.hpp>
 
 #include "lightcuts/error.h"
@@ -258,6 +260,50 @@ TEST(SceneLoader, ObjAndMtlNumbersThatAreNotNumbersAreRefused) {
     ASSERT_EQ(loaded.triangles.size(), 1u);
     EXPECT_EQ(loaded.triangles[0].v2_y, 1.0f);
     EXPECT_NEAR(loaded.materials.at(loaded.triangles[0].material).kd_g, 0.5f, 1e-6f);
+}
+
+// Some editors start a file with a UTF-8 byte order mark. tinyobjloader
+// read it as part of line 1's keyword and dropped the line without a word:
+// here the OBJ's first vertex (shifting every face index by one, so the
+// triangle came out as vertices 2, 3, 4) and the MTL's newmtl (so usemtl
+// named an unknown material).
+TEST(SceneLoader, ObjAndMtlByteOrderMarksAreSkipped) {
+    TempDir dir;
+    dir.write("m.obj", "\xEF\xBB\xBF" "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 5 5 5\nmtllib m.mtl\nusemtl red\nf 1 2 3\n");
+    dir.write("m.mtl", "\xEF\xBB\xBF" "newmtl red\nKd 0.9 0.1 0.1\n");
+    const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "m.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+    const Scene loaded = load_scene(scene);
+    ASSERT_EQ(loaded.triangles.size(), 1u);
+    expect_near(vertex(loaded.triangles[0], 0), {0, 0, 0});
+    expect_near(vertex(loaded.triangles[0], 1), {1, 0, 0});
+    expect_near(vertex(loaded.triangles[0], 2), {0, 1, 0});
+    EXPECT_NEAR(loaded.materials.at(loaded.triangles[0].material).kd_r, 0.9f, 1e-6f);
+    // The number check counts lines as before: the mark is not a line.
+    dir.write("m.obj", "\xEF\xBB\xBF" "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n");
+    const std::string message = input_error_of([&] { load_scene(scene); });
+    EXPECT_NE(message.find("m.obj: line 2 (v): 'nan' is not a number"), std::string::npos) << message;
+}
+
+// A material library must be a regular file: tinyobjloader read a folder as
+// an empty library and /dev/zero until memory ran out (and a pipe until its
+// writer closes it). Refused with or without a material override.
+TEST(SceneLoader, MtllibMustNameARegularFile) {
+    TempDir dir;
+    fs::create_directories(dir.path() / "sub");
+    fs::create_symlink("/dev/zero", dir.path() / "zero.mtl");
+    ASSERT_EQ(::mkfifo((dir.path() / "pipe.mtl").c_str(), 0600), 0);
+    for (const char* library : {".", "sub", "zero.mtl", "pipe.mtl"}) {
+        for (const char* material : {"", R"(, "material": {"kd": [0.5, 0.5, 0.5]})"}) {
+            dir.write("m.obj", std::string("mtllib ") + library + "\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+            const fs::path scene = dir.write("s.json", std::string(R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "m.obj")") + material + R"(}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+            const std::string message = input_error_of([&] { load_scene(scene); });
+            EXPECT_EQ(message, (dir.path() / "m.obj").lexically_normal().string() + ": mtllib: '" + library +
+                                   "' is not a regular file")
+                << library << material;
+        }
+    }
 }
 
 // Scene::input_files lists every file the loader read, so that no render

@@ -3,8 +3,14 @@
 
 #include <array>
 #include <cmath>
+#include <exception>
+#include <istream>
 #include <map>
+#include <streambuf>
 #include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
 
 #include <tiny_obj_loader.h>
 
@@ -20,19 +26,84 @@ namespace {
 using Corners = std::array<tinyobj::index_t, 3>;
 
 
-// tinyobj treats a missing .mtl or an unknown usemtl name as a warning and
-// falls back to "no material"; silently grey walls are worse than an error.
-void check_material_warnings(const std::string& warning, const std::string& obj_name) {
-    if (warning.find("Failed to load material file") != std::string::npos ||
-        warning.find("Material file [") != std::string::npos) {
-        // tinyobj's warning reads "Material file [ NAME ] not found ...".
-        std::string library = "material library";
-        if (const auto open = warning.find("[ "), close = warning.find(" ]");
-            open != std::string::npos && close != std::string::npos && close > open) {
-            library = "'" + warning.substr(open + 2, close - open - 2) + "'";
-        }
-        throw InputError(obj_name, "mtllib", library + " not found next to the OBJ");
+// What tinyobjloader makes of an OBJ and its material libraries.
+struct ObjData {
+    tinyobj::attrib_t attrib;
+    std::vector<tinyobj::shape_t> shapes;
+    std::vector<tinyobj::material_t> materials;
+};
+
+// A std::istream over text that stays where it is (an OBJ may be hundreds
+// of MB: no copy).
+class TextBuffer : public std::streambuf {
+public:
+    explicit TextBuffer(std::string_view text) {
+        char* begin = const_cast<char*>(text.data());  // only read
+        setg(begin, begin, begin + text.size());
     }
+};
+
+// tinyobjloader's material reader for the `mtllib` lines, so that
+// tinyobjloader opens no file itself: each library is found beside the OBJ
+// (or at its absolute path), read by read_input_file (it is one of the
+// scene's inputs, with or without a material override), its numbers checked
+// when its materials are used, a byte order mark skipped, and its text
+// handed to tinyobjloader's MTL parser. A library must be a regular file:
+// tinyobjloader would read /dev/zero until memory runs out and take a folder
+// for an empty library. Problems are kept, not thrown through
+// tinyobjloader, and raised by rethrow() after it returns.
+class MtlLibraries : public tinyobj::MaterialReader {
+public:
+    MtlLibraries(std::filesystem::path folder, const std::string& obj_name, bool uses_mtl)
+        : folder_(std::move(folder)), obj_name_(obj_name), uses_mtl_(uses_mtl) {}
+
+    bool operator()(const std::string& library, std::vector<tinyobj::material_t>* materials,
+                    std::map<std::string, int>* material_map, std::string* warn, std::string* err) override {
+        if (problem_) return false;
+        try {
+            const std::filesystem::path file = folder_ / library;
+            std::error_code ec;
+            const std::filesystem::file_type type = std::filesystem::status(file, ec).type();
+            if (type == std::filesystem::file_type::not_found) {
+                if (missing_.empty()) missing_ = library;
+                return false;  // tinyobjloader tries the line's next file name
+            }
+            if (!ec && type != std::filesystem::file_type::regular)
+                throw InputError(obj_name_, "mtllib", "'" + library + "' is not a regular file");
+            const std::string text = read_input_file(file);
+            const std::string_view mtl = without_bom(text);
+            if (uses_mtl_) check_mtl_numbers(mtl, display(file));
+            TextBuffer buffer(mtl);
+            std::istream in(&buffer);
+            tinyobj::LoadMtl(material_map, materials, &in, warn, err);
+            return true;
+        } catch (...) {
+            problem_ = std::current_exception();
+            return false;
+        }
+    }
+
+    // Throws the first problem met, if any; else, when the materials are
+    // used and a `mtllib` line found none of its files, InputError naming it.
+    void rethrow(const std::string& warning) const {
+        if (problem_) std::rethrow_exception(problem_);
+        if (uses_mtl_ && warning.find("Failed to load material file") != std::string::npos)
+            throw InputError(obj_name_, "mtllib",
+                             (missing_.empty() ? std::string("material library") : "'" + missing_ + "'") +
+                                 " not found next to the OBJ");
+    }
+
+private:
+    std::filesystem::path folder_;
+    const std::string& obj_name_;
+    bool uses_mtl_;
+    std::string missing_;  // the first library not found
+    std::exception_ptr problem_;
+};
+
+// tinyobj treats an unknown usemtl name as a warning and falls back to "no
+// material"; silently grey walls are worse than an error.
+void check_usemtl_warnings(const std::string& warning, const std::string& obj_name) {
     if (const auto at = warning.find("not found in .mtl"); at != std::string::npos) {
         const auto begin = warning.rfind('\n', at);
         const auto from = begin == std::string::npos ? 0 : begin + 1;
@@ -41,26 +112,25 @@ void check_material_warnings(const std::string& warning, const std::string& obj_
     }
 }
 
-void read_obj(const std::filesystem::path& file, const std::string& obj_name, bool uses_mtl,
-              tinyobj::ObjReader& reader) {
-    // tinyobjloader reads a number it cannot parse as 0: checked first.
-    const std::string text = read_input_file(file);
+void read_obj(const std::filesystem::path& file, const std::string& obj_name, bool uses_mtl, ObjData& obj) {
+    // tinyobjloader reads a number it cannot parse as 0: checked first. It
+    // reads a byte order mark as part of the first line's keyword, losing
+    // that line (and shifting every later vertex index): skipped here.
+    const std::string bytes = read_input_file(file);
+    const std::string_view text = without_bom(bytes);
     check_obj_numbers(text, obj_name);
-    // tinyobjloader reads the material libraries with or without a
-    // material override: they are the scene's inputs either way.
-    for (const std::filesystem::path& library : material_libraries(text, file.parent_path())) {
-        const std::string mtl = read_input_file(library);
-        if (uses_mtl) check_mtl_numbers(mtl, display(library));
-    }
-    tinyobj::ObjReaderConfig config;
-    config.triangulate = true;
-    config.vertex_color = false;
-    if (!reader.ParseFromFile(file.string(), config)) {
-        std::string err = reader.Error();
+    TextBuffer buffer(text);
+    std::istream in(&buffer);
+    MtlLibraries libraries(file.parent_path(), obj_name, uses_mtl);
+    std::string warning, err;
+    const bool ok = tinyobj::LoadObj(&obj.attrib, &obj.shapes, &obj.materials, &warning, &err, &in, &libraries,
+                                     /*triangulate=*/true, /*default_vcols_fallback=*/false);
+    libraries.rethrow(warning);
+    if (!ok) {
         while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
         throw InputError(obj_name, "", "tinyobjloader: " + (err.empty() ? "parse failed" : err));
     }
-    if (uses_mtl) check_material_warnings(reader.Warning(), obj_name);
+    if (uses_mtl) check_usemtl_warnings(warning, obj_name);
 }
 
 // Built only on error: the face loop runs once per triangle.
@@ -74,19 +144,19 @@ std::string face_name(std::size_t face, const tinyobj::shape_t& shape) {
 // adds the OBJ's materials: either the one override or every MTL material.
 class FaceConverter {
 public:
-    FaceConverter(const tinyobj::ObjReader& reader, const MeshTransform& transform,
+    FaceConverter(const ObjData& obj, const MeshTransform& transform,
                   const std::optional<gpu::Material>& override_material, MeshTarget& target,
                   const std::filesystem::path& file, const std::string& obj_name)
-        : attrib_(reader.GetAttrib()), transform_(transform), target_(target), obj_name_(obj_name),
+        : attrib_(obj.attrib), transform_(transform), target_(target), obj_name_(obj_name),
           override_(override_material.has_value()),
-          mtl_count_(override_ ? 0 : reader.GetMaterials().size()),
+          mtl_count_(override_ ? 0 : obj.materials.size()),
           material_base_(static_cast<std::uint32_t>(target.scene.materials.size())) {
         if (override_material) {
             target_.scene.materials.push_back(*override_material);
             return;
         }
         std::map<std::string, std::uint32_t> loaded;  // texture file -> index
-        for (const tinyobj::material_t& m : reader.GetMaterials()) {
+        for (const tinyobj::material_t& m : obj.materials) {
             gpu::Material material = convert_mtl(m, obj_name_);
             add_textures(material, m, file.parent_path(), loaded);
             target_.scene.materials.push_back(material);
@@ -273,12 +343,12 @@ private:
 void load_obj(const std::filesystem::path& file, const MeshTransform& transform,
               const std::optional<gpu::Material>& override_material, MeshTarget& target) {
     const std::string obj_name = display(file);
-    tinyobj::ObjReader reader;
-    read_obj(file, obj_name, !override_material, reader);
+    ObjData obj;
+    read_obj(file, obj_name, !override_material, obj);
 
-    FaceConverter faces(reader, transform, override_material, target, file, obj_name);
+    FaceConverter faces(obj, transform, override_material, target, file, obj_name);
     std::size_t kept = 0;
-    for (const tinyobj::shape_t& shape : reader.GetShapes()) kept += faces.add_shape(shape);
+    for (const tinyobj::shape_t& shape : obj.shapes) kept += faces.add_shape(shape);
     if (kept == 0 && faces.degenerate_by_transform() > 0 && !transform.field.empty())
         throw InputError(transform.scene_file, transform.field,
                          "makes every triangle of " + obj_name + " degenerate (a scale too small for floats?)");

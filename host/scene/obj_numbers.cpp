@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <vector>
 
 #include "lightcuts/error.h"
 
@@ -17,9 +18,11 @@ struct Line {
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
 
 // Calls visit(Line) for each line that has a word. Lines end as
-// tinyobjloader ends them: at "\n", "\r\n" or a lone "\r".
+// tinyobjloader ends them: at "\n", "\r\n" or a lone "\r". A byte order
+// mark before line 1 is skipped.
 template <class Visit>
 void for_each_line(std::string_view text, Visit&& visit) {
+    text = without_bom(text);
     Line line{0, {}};
     std::size_t at = 0;
     while (at <= text.size()) {
@@ -159,20 +162,8 @@ void check_mtl_numbers(std::string_view text, const std::string& name) {
     });
 }
 
-std::vector<std::filesystem::path> material_libraries(std::string_view text, const std::filesystem::path& folder) {
-    std::vector<std::filesystem::path> found;
-    for_each_line(text, [&](const Line& line) {
-        if (line.words[0] != "mtllib") return;
-        for (std::size_t k = 1; k < line.words.size(); ++k) {
-            const std::filesystem::path file = folder / std::string(line.words[k]);
-            std::error_code ec;
-            if (std::filesystem::is_regular_file(file, ec)) {
-                found.push_back(file);
-                break;
-            }
-        }
-    });
-    return found;
+std::string_view without_bom(std::string_view text) {
+    return text.substr(0, 3) == "\xEF\xBB\xBF" ? text.substr(3) : text;
 }
 
 }  // namespace lc::loader

@@ -4,10 +4,8 @@
 // line, as a bad CSV line is.
 #pragma once
 
-#include <filesystem>
 #include <string>
 #include <string_view>
-#include <vector>
 
 namespace lc::loader {
 
@@ -17,15 +15,15 @@ namespace lc::loader {
 // spelt out (the loader falls back to the face normal). Every index of an
 // `f` line, and the vertex and joints of a `vw` line, are whole numbers
 // within int's range. Throws InputError "NAME: line N (v): 'nan' is not a
-// number".
+// number". A byte order mark before line 1 is skipped (without_bom).
 void check_obj_numbers(std::string_view text, const std::string& name);
 
 // The same for the MTL values the loader reads: the colours Kd, Ks and Ke
 // (three numbers each) and the scalars Ns, Pr, Pm, Ps, Pc and Pcr.
 void check_mtl_numbers(std::string_view text, const std::string& name);
 
-// The material libraries tinyobjloader reads for this OBJ text: of each
-// `mtllib` line, the first of its files that exists in `folder`.
-std::vector<std::filesystem::path> material_libraries(std::string_view text, const std::filesystem::path& folder);
+// `text` without the UTF-8 byte order mark some editors write first.
+// tinyobjloader would read it as part of line 1's keyword and drop the line.
+std::string_view without_bom(std::string_view text);
 
 }  // namespace lc::loader
