@@ -333,6 +333,21 @@ TEST(Gltf, BufferAndImageUrisMustNameRegularFiles) {
     }
 }
 
+// A finite normal scale past the limit is named with the limit.
+TEST(Gltf, NormalTextureScaleOutOfRangeNamesTheLimit) {
+    test::TempDir dir;
+    std::ifstream in(kData / "materials.gltf", std::ios::binary);
+    std::string doc{std::istreambuf_iterator<char>(in), {}};
+    const std::size_t at = doc.find("\"scale\": 0.5");
+    ASSERT_NE(at, std::string::npos);
+    for (const char* scale : {"1e30", "-2e6"}) {
+        std::string changed = doc;
+        const fs::path file = dir.write("scale.gltf", changed.replace(at, 12, std::string("\"scale\": ") + scale));
+        EXPECT_EQ(error_of(file.string()),
+                  file.string() + ": materials[0].normalTexture.scale: must be a number from -1e6 to 1e6");
+    }
+}
+
 struct BadCase {
     const char* file;
     const char* message;  // after "FILE: "

@@ -173,8 +173,8 @@ void GltfMaterials::add_textures(gpu::Material& m, const tinygltf::Material& g, 
          pbr_name + ".metallicRoughnessTexture");
     slot(&gpu::Material::normal_texture, g.normalTexture, name + ".normalTexture");
     if (g.normalTexture.index >= 0) {
-        if (!std::isfinite(g.normalTexture.scale) || std::abs(g.normalTexture.scale) > 1e6)
-            throw InputError(notes_.file(), name + ".normalTexture.scale", "must be a finite number");
+        if (!(std::abs(g.normalTexture.scale) <= 1e6))  // also NaN
+            throw InputError(notes_.file(), name + ".normalTexture.scale", "must be a number from -1e6 to 1e6");
         m.normal_scale = float(g.normalTexture.scale);
     }
     // A texture only scales the factor: with black emission it cannot emit.
