@@ -40,7 +40,7 @@ std::string setting_problem(std::string_view key, double value) {
     if (key == kSettingMaxBounces) return integer_problem(value, 0, kMaxBounces);
     if (key == kSettingTimeLimit || key == kSettingClamp) {
         if (!(value >= 0.0 && value <= double(std::numeric_limits<float>::max())))
-            return "must be a finite number, 0 or more";
+            return "must be a number from 0 to 3.4e38 (the largest float)";
         return "";
     }
     if (key == kSettingRelativeError) {

@@ -198,8 +198,8 @@ for bad in "--vpls=-1" "--vpls=16777217" "--vpls=2.5"; do
   expect_error "--vpls: $integer 0 to 16777216" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
 for bad in "--max-bounces=1025" "--vpl-bounces=-1"; do
   expect_error "$integer 0 to 1024" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
-for bad in "--vpl-clamp=-0.5" "--time-limit=nan" "--time-limit=-1"; do
-  expect_error "must be a finite number, 0 or more" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
+for bad in "--vpl-clamp=-0.5" "--time-limit=nan" "--time-limit=-1" "--time-limit=1e308" "--vpl-clamp=1e300"; do
+  expect_error "must be a number from 0 to 3.4e38 (the largest float)" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
 expect_error "method path (the path tracer) runs on the CPU only" render "$mini" -o "$tmp/edge2.exr" --method path --device vulkan
 # Cuts shared by quads on Vulkan (quadcuts.comp), and the message where
 # the quad's heap cannot fit the device's shared memory. In a sanitizer

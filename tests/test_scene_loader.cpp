@@ -860,6 +860,20 @@ INSTANTIATE_TEST_SUITE_P(Cases, RenderSettingRange, ::testing::ValuesIn(kBadSett
                              return std::string(info.param.key) + "_" + std::to_string(info.index);
                          });
 
+// A finite value past the limit is named with the limit, not called
+// "not a finite number".
+TEST(SceneLoader, TimeLimitAndClampPastTheFloatRangeNameTheLimit) {
+    TempDir dir;
+    for (const auto& [json, field] : {std::pair<const char*, const char*>{R"({"time_limit": 1e308})", "render.time_limit"},
+                                      {R"({"indirect": {"clamp": 1e300}})", "render.indirect.clamp"},
+                                      {R"({"time_limit": -1})", "render.time_limit"}}) {
+        const fs::path file = scene_with_render(dir, json);
+        EXPECT_EQ(input_error_of([&] { load_scene(file); }),
+                  file.lexically_normal().string() + ": " + field +
+                      ": must be a number from 0 to 3.4e38 (the largest float)");
+    }
+}
+
 TEST(SceneLoader, RenderSettingsAcceptTheFullRange) {
     TempDir dir;
     const Scene scene = load_scene(scene_with_render(
