@@ -306,6 +306,23 @@ TEST(SceneLoader, MtllibMustNameARegularFile) {
     }
 }
 
+// camera.up only gives a direction: one whose float length under- or
+// overflows (its square is out of float range) is used, as a unit vector;
+// only zero is refused.
+TEST(SceneLoader, CameraUpOfAnyNonZeroLengthIsUsed) {
+    TempDir dir;
+    fs::copy_file(kFixtures / "tri.obj", dir.path() / "tri.obj");
+    auto with_up = [&](const char* up) {
+        return dir.write("s.json", std::string(R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0], "up": )") +
+                                       up + R"(}, "meshes": [{"obj": "tri.obj"}],
+ "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+    };
+    for (const char* up : {"[0, 1e-30, 0]", "[0, 1e30, 0]", "[0, 3e38, 0]", "[0, 1e-45, 0]", "[0, 2, 0]"})
+        expect_near(load_scene(with_up(up)).camera.up, {0, 1, 0});
+    const fs::path zero = with_up("[0, 0, 0]");
+    EXPECT_EQ(input_error_of([&] { load_scene(zero); }), zero.lexically_normal().string() + ": camera.up: must not be zero");
+}
+
 // Scene::input_files lists every file the loader read, so that no render
 // output can replace one of them (reserve_render_outputs).
 TEST(SceneLoader, InputFilesListEveryFileRead) {

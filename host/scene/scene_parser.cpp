@@ -106,10 +106,16 @@ private:
             in_.fail("camera.look_at", "is too far from camera.position (the square of their distance overflows "
                                        "a float: at most about 1.8e19 apart)");
         if (!(forward_len > 0.0f)) in_.fail("camera.look_at", "must differ from camera.position");
-        const float up_len = glm::length(cam.up);
-        if (!(up_len > 0.0f) || !std::isfinite(up_len)) in_.fail("camera.up", "must not be zero");
-        const float sin_angle = glm::length(glm::cross(forward / forward_len, cam.up / up_len));
-        if (!(sin_angle > 1e-6f)) in_.fail("camera.up", "must not be parallel to the view direction");
+        // In double: the square of a float as small as 1e-30 (or as large
+        // as 1e30) is out of float range, and up's length only sets its
+        // direction. Kept as a unit vector, so the camera's basis
+        // (prepare.cpp) is computed from floats of ordinary size.
+        const glm::dvec3 up(cam.up);
+        const double up_len = glm::length(up);
+        if (!(up_len > 0.0)) in_.fail("camera.up", "must not be zero");
+        const double sin_angle = glm::length(glm::cross(glm::dvec3(forward) / double(forward_len), up / up_len));
+        if (!(sin_angle > 1e-6)) in_.fail("camera.up", "must not be parallel to the view direction");
+        cam.up = glm::vec3(up / up_len);
     }
 
     // Ranges and problem texts come from lightcuts/settings.h, so a value is
