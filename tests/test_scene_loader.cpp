@@ -293,14 +293,17 @@ TEST(SceneLoader, MtllibMustNameARegularFile) {
     fs::create_directories(dir.path() / "sub");
     fs::create_symlink("/dev/zero", dir.path() / "zero.mtl");
     ASSERT_EQ(::mkfifo((dir.path() / "pipe.mtl").c_str(), 0600), 0);
-    for (const char* library : {".", "sub", "zero.mtl", "pipe.mtl"}) {
+    for (const auto& [library, problem] : {std::pair<const char*, const char*>{".", "is a folder, not a file"},
+                                           {"sub", "is a folder, not a file"},
+                                           {"zero.mtl", "is a device, not a regular file"},
+                                           {"pipe.mtl", "is a pipe, not a regular file"}}) {
         for (const char* material : {"", R"(, "material": {"kd": [0.5, 0.5, 0.5]})"}) {
             dir.write("m.obj", std::string("mtllib ") + library + "\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
             const fs::path scene = dir.write("s.json", std::string(R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
  "meshes": [{"obj": "m.obj")") + material + R"(}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
             const std::string message = input_error_of([&] { load_scene(scene); });
-            EXPECT_EQ(message, (dir.path() / "m.obj").lexically_normal().string() + ": mtllib: '" + library +
-                                   "' is not a regular file")
+            EXPECT_EQ(message,
+                      (dir.path() / "m.obj").lexically_normal().string() + ": mtllib: '" + library + "' " + problem)
                 << library << material;
         }
     }

@@ -86,18 +86,6 @@ fs::path uri_file(const std::string& base, const std::string& uri) {
     return fs::path(base + "/" + decoded_uri(uri));
 }
 
-// What a file that is not a regular one is, in words.
-std::string kind_of(fs::file_type type) {
-    switch (type) {
-        case fs::file_type::directory: return "a folder";
-        case fs::file_type::character:
-        case fs::file_type::block: return "a device";
-        case fs::file_type::fifo: return "a pipe";
-        case fs::file_type::socket: return "a socket";
-        default: return "a special file";
-    }
-}
-
 // tinygltf reads a buffer's or an image's file whole, taking its size from a
 // seek to its end: a folder's "size" makes it ask for about 2^63 bytes
 // (std::bad_alloc), and a device or a pipe may never end. So every URI that
@@ -117,11 +105,9 @@ void check_uri_files(std::string_view json, const std::string& base, const std::
             if (uri == entry.end() || !uri->is_string()) continue;
             const std::string& text = uri->get_ref<const std::string&>();
             if (text.empty() || tinygltf::IsDataURI(text)) continue;
-            std::error_code ec;
-            const fs::file_status status = fs::status(uri_file(base, text), ec);
-            if (ec || status.type() == fs::file_type::not_found || status.type() == fs::file_type::regular) continue;
-            throw InputError(name, std::string(list) + "[" + std::to_string(i) + "].uri",
-                             "'" + text + "' is not a regular file (it is " + kind_of(status.type()) + ")");
+            const std::string problem = input_file_problem(uri_file(base, text));
+            if (problem.empty() || problem == "file not found") continue;
+            throw InputError(name, std::string(list) + "[" + std::to_string(i) + "].uri", "'" + text + "' " + problem);
         }
     }
 }

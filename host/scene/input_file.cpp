@@ -31,9 +31,16 @@ std::string input_file_problem(const fs::path& path) {
     std::error_code ec;
     const fs::file_status status = fs::status(path, ec);
     if (fs::is_regular_file(status)) return "";
-    if (fs::is_directory(status)) return "is a folder, not a file";
-    if (fs::exists(status)) return "is not a regular file (a device, a pipe or a socket)";
-    return "file not found";
+    switch (status.type()) {
+        case fs::file_type::not_found:
+        case fs::file_type::none: return "file not found";
+        case fs::file_type::directory: return "is a folder, not a file";
+        case fs::file_type::character:
+        case fs::file_type::block: return "is a device, not a regular file";
+        case fs::file_type::fifo: return "is a pipe, not a regular file";
+        case fs::file_type::socket: return "is a socket, not a regular file";
+        default: return "is not a regular file";
+    }
 }
 
 // One read is much faster than line-wise streams for the million-line CSV case.

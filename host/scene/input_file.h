@@ -11,8 +11,8 @@ namespace lc::loader {
 std::string display(const std::filesystem::path& path);
 
 // Why `path` cannot be read as an input: "file not found", "is a folder,
-// not a file" or "is not a regular file (a device, a pipe or a socket)";
-// "" where it is a regular file (symbolic links followed).
+// not a file", "is a device, not a regular file" (a pipe, a socket); ""
+// where it is a regular file (symbolic links followed).
 std::string input_file_problem(const std::filesystem::path& path);
 
 // The whole file in memory. Throws InputError "FILE: " and

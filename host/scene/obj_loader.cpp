@@ -62,14 +62,12 @@ public:
         if (problem_) return false;
         try {
             const std::filesystem::path file = folder_ / library;
-            std::error_code ec;
-            const std::filesystem::file_type type = std::filesystem::status(file, ec).type();
-            if (type == std::filesystem::file_type::not_found) {
+            const std::string problem = input_file_problem(file);
+            if (problem == "file not found") {
                 if (missing_.empty()) missing_ = library;
                 return false;  // tinyobjloader tries the line's next file name
             }
-            if (!ec && type != std::filesystem::file_type::regular)
-                throw InputError(obj_name_, "mtllib", "'" + library + "' is not a regular file");
+            if (!problem.empty()) throw InputError(obj_name_, "mtllib", "'" + library + "' " + problem);
             const std::string text = read_input_file(file);
             const std::string_view mtl = without_bom(text);
             if (uses_mtl_) check_mtl_numbers(mtl, display(file));

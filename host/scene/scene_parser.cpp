@@ -74,6 +74,14 @@ private:
     // join the scene's lights before the "lights" list.
     std::vector<std::pair<std::string, GltfLight>> gltf_lights_;
 
+    // "FIELD: file not found: FILE", or "FIELD: 'FILE' is a folder, not a
+    // file" and so on, where `file` cannot be read (input_file_problem).
+    void check_input_file(const fs::path& file, const std::string& field) const {
+        const std::string problem = input_file_problem(file);
+        if (problem == "file not found") in_.fail(field, "file not found: " + display(file));
+        if (!problem.empty()) in_.fail(field, "'" + display(file) + "' " + problem);
+    }
+
     // A file the scene names, relative to the scene's folder. A NUL would
     // end the name where the system reads it, and another file be opened.
     fs::path resolve(const std::string& relative, const std::string& field) const {
@@ -291,8 +299,7 @@ private:
             override_material = parse_material_override(*m, path + ".material");
         }
 
-        if (const std::string problem = input_file_problem(obj_path); !problem.empty())
-            in_.fail(obj_field, problem + ": " + display(obj_path));
+        check_input_file(obj_path, obj_field);
         load_obj(obj_path, transform, override_material, meshes_);
     }
 
@@ -386,8 +393,7 @@ private:
     fs::path existing_file(const json& j, const std::string& path, const char* key) const {
         const std::string field = path + "." + key;
         const fs::path file = resolve(in_.string(in_.require(j, path, key), field), field);
-        if (const std::string problem = input_file_problem(file); !problem.empty())
-            in_.fail(field, problem + ": " + display(file));
+        check_input_file(file, field);
         return file;
     }
 
