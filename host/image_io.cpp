@@ -21,6 +21,7 @@
 #include "lightcuts/error.h"
 #include "lightcuts/image.h"
 #include "lightcuts/temporaries.h"
+#include "scene/input_file.h"
 
 namespace lc {
 
@@ -204,9 +205,15 @@ void write_exr(const fs::path& file, const Image& image) {
 
 Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
     const std::string name = file.string();
+    // The file is read once and decoded from memory. tinyexr's file calls
+    // open it at each step (version, header, pixels), so a file changed in
+    // between is read as two; and its pixel step trusts its read to return
+    // every byte, and leaves the file open when it is under 16 bytes.
+    const std::string bytes = loader::read_input_file(file);
+    const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
     EXRVersion version;
-    if (ParseEXRVersionFromFile(&version, name.c_str()) != TINYEXR_SUCCESS)
-        throw InputError(name, "", "cannot be read or is not an OpenEXR file");
+    if (ParseEXRVersionFromMemory(&version, data, bytes.size()) != TINYEXR_SUCCESS)
+        throw InputError(name, "", "is not an OpenEXR file");
     if (version.multipart || version.non_image)
         throw InputError(name, "", "multi-part and deep OpenEXR files are not supported");
 
@@ -216,7 +223,7 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
     InitEXRHeader(&header);
     ExrHeaderGuard header_guard{&header};
     const char* err = nullptr;
-    if (ParseEXRHeaderFromFile(&header, &version, name.c_str(), &err) != TINYEXR_SUCCESS)
+    if (ParseEXRHeaderFromMemory(&header, &version, data, bytes.size(), &err) != TINYEXR_SUCCESS)
         throw InputError(name, "", exr_damaged(err, "cannot parse the OpenEXR header"));
     const EXRBox2i& window = header.data_window;
     const std::int64_t width = std::int64_t(window.max_x) - window.min_x + 1;
@@ -249,7 +256,7 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
     EXRImage exr;
     InitEXRImage(&exr);
     exr.num_channels = header.num_channels;
-    if (LoadEXRImageFromFile(&exr, &header, name.c_str(), &err) != TINYEXR_SUCCESS)
+    if (LoadEXRImageFromMemory(&exr, &header, data, bytes.size(), &err) != TINYEXR_SUCCESS)
         throw InputError(name, "", exr_damaged(err, "cannot decode the OpenEXR pixels"));
     ExrImageGuard image_guard{&exr};
     // The size checked against max_pixels above is the one decoded.

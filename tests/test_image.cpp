@@ -143,7 +143,9 @@ TEST_F(ImageFiles, ReadExrReportsTruncatedFilesAsInputError) {
         bytes.assign(std::istreambuf_iterator<char>(in), {});
     }
     ASSERT_GT(bytes.size(), 200u);
-    for (const std::size_t keep : {std::size_t(100), bytes.size() / 2, bytes.size() - 1}) {
+    // 8 bytes: the magic number and version only (tinyexr's file reader
+    // left such a file open).
+    for (const std::size_t keep : {std::size_t(8), std::size_t(100), bytes.size() / 2, bytes.size() - 1}) {
         const fs::path cut = dir_ / ("cut_" + std::to_string(keep) + ".exr");
         std::ofstream(cut, std::ios::binary) << bytes.substr(0, keep);
         try {
