@@ -375,6 +375,11 @@ TEST(SceneLoader, CameraDistanceBeyondFloatIsNamed) {
  "meshes": [{"obj": "tri.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
     const std::string message = input_error_of([&] { load_scene(scene); });
     EXPECT_NE(message.find("camera.look_at: is too far from camera.position"), std::string::npos) << message;
+    // And one so close that the square of their distance underflows.
+    const fs::path close = dir.write("c.json", R"({"camera": {"position": [0, 0, 1e-30], "look_at": [0, 0, 0]},
+ "meshes": [{"obj": "tri.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+    EXPECT_NE(input_error_of([&] { load_scene(close); }).find("camera.look_at: is too close to camera.position"),
+              std::string::npos);
 }
 
 // An environment map may hold 2^27 pixels (the images `compare` reads,

@@ -113,7 +113,11 @@ private:
         if (!std::isfinite(forward_len))
             in_.fail("camera.look_at", "is too far from camera.position (the square of their distance overflows "
                                        "a float: at most about 1.8e19 apart)");
-        if (!(forward_len > 0.0f)) in_.fail("camera.look_at", "must differ from camera.position");
+        if (!(forward_len > 0.0f))
+            in_.fail("camera.look_at", forward == glm::vec3(0.0f)
+                                           ? "must differ from camera.position"
+                                           : "is too close to camera.position (the square of their distance "
+                                             "underflows a float: at least about 1e-19 apart)");
         // In double: the square of a float as small as 1e-30 (or as large
         // as 1e30) is out of float range, and up's length only sets its
         // direction. Kept as a unit vector, so the camera's basis
