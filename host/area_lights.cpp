@@ -114,8 +114,9 @@ double TriangleEmission::power(std::size_t i) const {
     return 3.14159265358979323846 * area * sides * double(gpu::lc_luminance(mean(i)));
 }
 
-UninitializedVector<gpu::Light> sample_area_lights(const Scene& scene, std::uint32_t count, std::uint32_t seed) {
-    return sample_area_lights(TriangleEmission(scene), scene.triangles, scene.materials, count, seed);
+UninitializedVector<gpu::Light> sample_area_lights(const Scene& scene, std::uint32_t count, std::uint32_t seed,
+                                                   unsigned threads) {
+    return sample_area_lights(TriangleEmission(scene), scene.triangles, scene.materials, count, seed, threads);
 }
 
 UninitializedVector<gpu::Light> sample_area_lights(const TriangleEmission& emission,
@@ -163,7 +164,9 @@ UninitializedVector<gpu::Light> sample_area_lights(const TriangleEmission& emiss
     // in (10^7 samples are 480 MB).
     reserve_huge(lights, placed);
     lights.resize(placed);
-    if (threads == 0) threads = placed < 65536 ? 1u : std::max(1u, std::min(16u, std::thread::hardware_concurrency()));
+    // Below 65,536 samples one thread: starting more costs more than they save.
+    const unsigned most = threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency());
+    threads = placed < 65536 ? 1u : std::min(16u, most);
     auto run = [&](unsigned t) {
         const std::size_t begin = placed * t / threads, end = placed * (t + 1) / threads;
         auto starts_before = [](const Share& share, std::size_t at) { return share.first < at; };

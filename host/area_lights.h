@@ -59,12 +59,13 @@ glm::vec2 triangle_sample_barycentrics(std::uint32_t k, std::uint32_t m, float s
 // texture's there) and m the samples its triangle got, so the samples'
 // total power is the emitters'. Deterministic for a seed; as count grows the
 // lighting converges to the exact area-light integral. Empty when nothing
-// emits or count is 0. Made on `threads` threads (0: every core from 65,536
-// samples on), the same lights whatever their number.
+// emits or count is 0. Made on up to `threads` threads (0: every core; one
+// below 65,536 samples), the same lights whatever their number.
 UninitializedVector<gpu::Light> sample_area_lights(const TriangleEmission& emission,
                                                    std::span<const gpu::Triangle> triangles,
                                                    std::span<const gpu::Material> materials, std::uint32_t count,
                                                    std::uint32_t seed, unsigned threads = 0);
-UninitializedVector<gpu::Light> sample_area_lights(const Scene& scene, std::uint32_t count, std::uint32_t seed);
+UninitializedVector<gpu::Light> sample_area_lights(const Scene& scene, std::uint32_t count, std::uint32_t seed,
+                                                   unsigned threads = 0);
 
 }  // namespace lc

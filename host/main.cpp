@@ -121,7 +121,7 @@ int run_render(RenderArgs a) {
     // Every output is checked and reserved before the render; none is left if any fails.
     lc::OutputSet outputs = lc::reserve_render_outputs(a.outputs, a.scene, options.method, scene.input_files);
 
-    const lc::PreparedScene prepared = lc::prepare_scene(std::move(scene), options.seed);
+    const lc::PreparedScene prepared = lc::prepare_scene(std::move(scene), options.seed, options.threads);
     a.device.note = [](const std::string& line) { std::fprintf(stderr, "note: %s\n", line.c_str()); };
     const lc::RenderResult result = lc::render(prepared, options, a.device);
     const lc::RenderReport report = lc::make_report(a.scene, options, prepared, result, load_seconds);
@@ -287,7 +287,9 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
         ->transform(setting(lc::kSettingTimeLimit));
     render->add_option("--seed", r.seed, "Seed for pixel jitter, light-tree representatives and light samples")
         ->transform(setting(lc::kSettingSeed));
-    render->add_option("--threads", r.threads, "CPU threads (0 = all cores)");
+    render->add_option("--threads", r.threads,
+                       "CPU threads for the render and for what precedes it on the CPU: area-light samples, VPLs, "
+                       "the light tree (0 = all cores)");
     render->add_option("--device", r.device.device,
                        "auto (a hardware GPU through Vulkan, else the CPU path), cpu or vulkan")
         ->check(ask(lc::device_problem));

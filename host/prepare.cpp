@@ -60,7 +60,7 @@ void check_generated_totals(const Scene& scene, loader::LightLimits& limits, std
 
 }  // namespace
 
-PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
+PreparedScene prepare_scene(Scene scene, std::uint32_t seed, unsigned threads) {
     PreparedScene prepared;
     prepared.has_occluders = !all_coplanar(scene.triangles);
     // A scene without texture coordinates gets zeros: every kernel reads them.
@@ -69,7 +69,7 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
     // Walter 2005 §5: area lights and the environment become many point and
     // directional lights, in the one tree with the scene's own.
     const auto start = std::chrono::steady_clock::now();
-    UninitializedVector<gpu::Light> area = sample_area_lights(scene, scene.render.area_light_samples, seed);
+    UninitializedVector<gpu::Light> area = sample_area_lights(scene, scene.render.area_light_samples, seed, threads);
     const std::vector<gpu::Light> sky = environment_lights(scene.environment, scene.environment.directions);
     // The loader checked the scene's own lights' totals; the lights made
     // from emissive surfaces, the environment and light paths join the same
@@ -112,7 +112,7 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
         const auto vpl_start = std::chrono::steady_clock::now();
         const std::span<const gpu::Light> emitters = joined.empty() ? std::span<const gpu::Light>(scene.lights)
                                                                     : std::span<const gpu::Light>(joined);
-        VplSet vpls = trace_vpls(scene, prepared.bvh, emitters, scene.render.indirect, seed);
+        VplSet vpls = trace_vpls(scene, prepared.bvh, emitters, scene.render.indirect, seed, threads);
         check_generated(vpls.lights, "indirect light", "the virtual point lights");
         prepared.vpls = vpls.lights.size();
         prepared.vpl_paths = vpls.paths;
@@ -126,7 +126,7 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed) {
         const std::uint32_t type = l.type & gpu::kLightTypeMask;
         prepared.has_oriented |= type == gpu::kLightSpot || type == gpu::kLightOriented || type == gpu::kLightVpl;
     }
-    prepared.tree = build_light_tree(lights, seed);
+    prepared.tree = build_light_tree(lights, seed, TreeBuilder::kFast, 1.0, threads);
     release(joined);
     for (const auto& m : scene.materials) {
         prepared.has_specular |= (m.flags & gpu::kMaterialHasSpecular) != 0u;

@@ -44,8 +44,11 @@ struct PreparedScene {
     float vpl_min_distance2 = 0.0f;
 };
 
-// Takes ownership of the scene; builds the BVH and the light tree.
-PreparedScene prepare_scene(Scene scene, std::uint32_t seed);
+// Takes ownership of the scene; builds the BVH and the light tree. The
+// light sampling, the VPLs and the tree's build run on `threads` threads
+// (0: one per core), as the CPU render does (RenderOptions::threads); what
+// they make is the same for any count.
+PreparedScene prepare_scene(Scene scene, std::uint32_t seed, unsigned threads = 0);
 
 // One array the kernels read, as raw bytes. scene_arrays() is the one list
 // of them: the Vulkan renderer uploads it (in this order, which is the order
