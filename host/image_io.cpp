@@ -90,12 +90,15 @@ std::string exr_message(const char* err, const char* fallback) {
     return message;
 }
 
-// "is truncated or corrupt (WHY)" for a file tinyexr cannot parse or decode,
-// WHY being tinyexr's message without its trailing newlines and full stop.
+// "cannot be read: it is truncated or corrupt, or uses what tinyexr does not
+// support (WHY)" for a file tinyexr cannot parse or decode, WHY being
+// tinyexr's message without its trailing newlines and full stop: tinyexr
+// says "Unknown compression type" for a valid file compressed with DWAA as
+// for a damaged one.
 std::string exr_damaged(const char* err, const char* fallback) {
     std::string why = exr_message(err, fallback);
     while (!why.empty() && (why.back() == '\n' || why.back() == '.' || why.back() == ' ')) why.pop_back();
-    return "is truncated or corrupt (" + why + ")";
+    return "cannot be read: it is truncated or corrupt, or uses what tinyexr does not support (" + why + ")";
 }
 
 struct ExrHeaderGuard {

@@ -288,8 +288,8 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
     render->add_option("--seed", r.seed, "Seed for pixel jitter, light-tree representatives and light samples")
         ->transform(setting(lc::kSettingSeed));
     render->add_option("--threads", r.threads,
-                       "CPU threads for the render and for what precedes it on the CPU: area-light samples, VPLs, "
-                       "the light tree (0 = all cores)");
+                       "CPU threads of the render, the area-light sampling, the VPLs and the light tree's build "
+                       "(0 = all cores)");
     render->add_option("--device", r.device.device,
                        "auto (a hardware GPU through Vulkan, else the CPU path), cpu or vulkan")
         ->check(ask(lc::device_problem));

@@ -330,6 +330,31 @@ TEST(Gltf, BufferAndImageUrisMustNameRegularFiles) {
             EXPECT_EQ(std::string(e.what()), file.string() + ": buffers[0].uri: '" + uri + "' " + kind);
         }
     }
+    // A URI is looked for beside the glTF only: tinygltf's own search went
+    // on to the current folder, where a folder of that name asked it for
+    // 2^63 bytes. Here the current folder holds one; beside the glTF is
+    // nothing.
+    const fs::path file = with_buffer("elsewhere.bin");
+    const fs::path cwd = fs::current_path();
+    fs::create_directories(dir.path() / "cwd" / "elsewhere.bin");
+    fs::current_path(dir.path() / "cwd");
+    std::string message;
+    try {
+        load_scene(file);
+    } catch (const std::exception& e) {
+        message = e.what();
+    }
+    fs::current_path(cwd);
+    EXPECT_NE(message.find("File not found : elsewhere.bin"), std::string::npos) << message;
+    // "%00" decodes to a NUL, which would cut the name short.
+    const fs::path nul = with_buffer("missing.bin%00.txt");
+    try {
+        load_scene(nul);
+        ADD_FAILURE() << "a URI with %00 loaded";
+    } catch (const InputError& e) {
+        EXPECT_EQ(std::string(e.what()), nul.string() + ": buffers[0].uri: 'missing.bin%00.txt' decodes to a file "
+                                                        "name with a NUL character");
+    }
 }
 
 // A finite normal scale past the limit is named with the limit.

@@ -153,7 +153,7 @@ TEST_F(ImageFiles, ReadExrReportsTruncatedFilesAsInputError) {
             ADD_FAILURE() << "expected InputError for " << keep << " bytes";
         } catch (const lc::InputError& e) {
             const std::string message = e.what();
-            EXPECT_EQ(message.rfind(cut.string() + ": is truncated or corrupt (", 0), 0u) << message;
+            EXPECT_EQ(message.rfind(cut.string() + ": cannot be read: it is truncated or corrupt", 0), 0u) << message;
         }
     }
 }

@@ -288,6 +288,19 @@ TEST(SceneLoader, ObjAndMtlByteOrderMarksAreSkipped) {
 // A material library must be a regular file: tinyobjloader read a folder as
 // an empty library and /dev/zero until memory ran out (and a pipe until its
 // writer closes it). Refused with or without a material override.
+// A `mtllib` line is satisfied by the first of its files that exists; the
+// message names a file of the line that found none, not one an earlier
+// line skipped on its way to a file it found.
+TEST(SceneLoader, MissingMtllibNamesTheLineThatFoundNone) {
+    TempDir dir;
+    dir.write("b.mtl", "newmtl m\nKd 0.5 0.5 0.5\n");
+    dir.write("m.obj", "mtllib a.mtl b.mtl\nmtllib c.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "m.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+    EXPECT_EQ(input_error_of([&] { load_scene(scene); }),
+              (dir.path() / "m.obj").lexically_normal().string() + ": mtllib: 'c.mtl' not found next to the OBJ");
+}
+
 TEST(SceneLoader, MtllibMustNameARegularFile) {
     TempDir dir;
     fs::create_directories(dir.path() / "sub");

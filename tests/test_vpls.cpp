@@ -232,12 +232,6 @@ double block_rmse(const Image& image, const Image& reference, std::uint32_t b) {
     return std::sqrt(diff2 / ref2);
 }
 
-// VPLs converge: on the shipped Cornell box (diffuse only, so VPLs miss
-// nothing), lightcuts with 10^3, 10^4 and 10^5 VPLs at a small threshold
-// against the path tracer with unlimited bounces through the same pixel
-// centres (spp 1, light_samples paths per camera ray), whose noise over
-// 4 x 4 blocks is below the VPLs' error at 10^5. Measured: 1.21%, 0.57%,
-// 0.24%, the reference's noise 0.08%.
 // prepare_scene's threads (the command line's --threads) run the area-light
 // sampling, the VPL tracing and the light tree's build, whose results do
 // not depend on how many there are: one thread and three give the same
@@ -258,6 +252,12 @@ TEST(PrepareScene, SameLightsAndTreeWhateverTheThreadCount) {
                           one.tree.nodes.size() * sizeof(gpu::LightNode)), 0);
 }
 
+// VPLs converge: on the shipped Cornell box (diffuse only, so VPLs miss
+// nothing), lightcuts with 10^3, 10^4 and 10^5 VPLs at a small threshold
+// against the path tracer with unlimited bounces through the same pixel
+// centres (spp 1, light_samples paths per camera ray), whose noise over
+// 4 x 4 blocks is below the VPLs' error at 10^5. Measured: 1.21%, 0.57%,
+// 0.24%, the reference's noise 0.08%.
 TEST(VplConvergence, ErrorAgainstThePathTracerFallsWithTheVplCount) {
     Scene s = load_scene(std::string(LC_SOURCE_DIR) + "/scenes/cornell/cornell.json");
     s.render.area_light_samples = 16384;

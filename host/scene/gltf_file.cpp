@@ -6,6 +6,7 @@
 #include <limits>
 #include <string_view>
 #include <system_error>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -105,6 +106,11 @@ void check_uri_files(std::string_view json, const std::string& base, const std::
             if (uri == entry.end() || !uri->is_string()) continue;
             const std::string& text = uri->get_ref<const std::string&>();
             if (text.empty() || tinygltf::IsDataURI(text)) continue;
+            // "%00" decodes to a NUL, which would end the name where the
+            // system reads it, and another file be opened.
+            if (decoded_uri(text).find('\0') != std::string::npos)
+                throw InputError(name, std::string(list) + "[" + std::to_string(i) + "].uri",
+                                 "'" + text + "' decodes to a file name with a NUL character");
             const std::string problem = input_file_problem(uri_file(base, text));
             if (problem.empty() || problem == "file not found") continue;
             throw InputError(name, std::string(list) + "[" + std::to_string(i) + "].uri", "'" + text + "' " + problem);
@@ -123,6 +129,39 @@ bool load_image_checked(tinygltf::Image* image, const int index, std::string* er
         return false;
     }
     return tinygltf::LoadImageData(image, index, err, warn, req_width, req_height, bytes, size, user_data);
+}
+
+// tinygltf's file access, through ours (its FsCallbacks). A URI is looked
+// for in the glTF's folder only: tinygltf would try the current folder
+// next, where a file of that name would be read in its place. It must be a
+// regular file there (check_uri_files names the field where it is not),
+// is read by read_input_file, which notes it as one of the scene's inputs,
+// and its name is taken as written (tinygltf's own ExpandFilePath runs it
+// through wordexp).
+struct GltfFolder {
+    std::string prefix;  // the folder and a '/', as tinygltf joins it to a URI
+};
+
+bool gltf_file_exists(const std::string& path, void* folder) {
+    return path.rfind(static_cast<const GltfFolder*>(folder)->prefix, 0) == 0 && input_file_problem(path).empty();
+}
+
+std::string gltf_expand_path(const std::string& path, void*) { return path; }
+
+bool gltf_read_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+    try {
+        const std::string bytes = read_input_file(path);
+        out->assign(bytes.begin(), bytes.end());
+        return true;
+    } catch (const std::exception& e) {
+        if (err != nullptr) *err = e.what();
+        return false;
+    }
+}
+
+bool gltf_write_file(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    if (err != nullptr) *err = "the renderer writes no glTF files";
+    return false;
 }
 
 }  // namespace
@@ -144,6 +183,8 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
 
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(load_image_checked, nullptr);
+    GltfFolder folder{base.back() == '/' ? base : base + "/"};
+    gltf.SetFsCallbacks({gltf_file_exists, gltf_expand_path, gltf_read_file, gltf_write_file, &folder});
     tinygltf::Model model;
     std::string err, warn;
     bool ok = false;
@@ -158,13 +199,6 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
     }
     if (!ok) throw InputError(name, "", "tinygltf: " + (err.empty() ? std::string("cannot parse the file") : trimmed(err)));
     check_gltf_types(json, name);
-    // The buffers and images tinygltf read from files beside this one, by
-    // their URIs decoded as tinygltf decodes them.
-    auto note_uri = [&](const std::string& uri) {
-        if (!uri.empty() && uri.rfind("data:", 0) != 0) note_input_file(uri_file(base, uri));
-    };
-    for (const tinygltf::Buffer& b : model.buffers) note_uri(b.uri);
-    for (const tinygltf::Image& i : model.images) note_uri(i.uri);
     warn = trimmed(warn);
     for (std::size_t from = 0; from < warn.size();) {
         const std::size_t end = std::min(warn.find('\n', from), warn.size());

@@ -67,6 +67,7 @@ public:
                 if (missing_.empty()) missing_ = library;
                 return false;  // tinyobjloader tries the line's next file name
             }
+            missing_.clear();  // (see missing_)
             if (!problem.empty()) throw InputError(obj_name_, "mtllib", "'" + library + "' " + problem);
             const std::string text = read_input_file(file);
             const std::string_view mtl = without_bom(text);
@@ -95,7 +96,11 @@ private:
     std::filesystem::path folder_;
     const std::string& obj_name_;
     bool uses_mtl_;
-    std::string missing_;  // the first library not found
+    // The first of the names not found since the last one found: where the
+    // OBJ's last `mtllib` line found none of its files, that line's first.
+    // (Where an earlier line found none, a later line's found name clears
+    // it, and the message names no file rather than a wrong one.)
+    std::string missing_;
     std::exception_ptr problem_;
 };
 

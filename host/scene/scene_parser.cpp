@@ -117,7 +117,7 @@ private:
             in_.fail("camera.look_at", forward == glm::vec3(0.0f)
                                            ? "must differ from camera.position"
                                            : "is too close to camera.position (the square of their distance "
-                                             "underflows a float: at least about 1e-19 apart)");
+                                             "underflows a float: at least about 3e-23 apart)");
         // In double: the square of a float as small as 1e-30 (or as large
         // as 1e30) is out of float range, and up's length only sets its
         // direction. Kept as a unit vector, so the camera's basis
@@ -424,8 +424,7 @@ private:
         Environment env;
         if (has_file) {
             const fs::path exr = existing_file(j, path, "file");
-            const Image map = read_exr(exr, kMaxEnvironmentPixels);
-            loader::note_input_file(exr);
+            const Image map = read_exr(exr, kMaxEnvironmentPixels);  // notes the file as an input
             env.width = map.width;
             env.height = map.height;
             env.rgb = map.rgb;
