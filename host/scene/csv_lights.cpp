@@ -221,9 +221,7 @@ std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::pa
                                  std::size_t chunk_bytes) {
     const std::string name = display(file);
     const std::string text = read_input_file(file);
-    std::string_view all(text);
-    // A UTF-8 byte order mark (spreadsheets write one) is not part of line 1.
-    if (all.substr(0, 3) == "\xEF\xBB\xBF") all.remove_prefix(3);
+    std::string_view all = without_bom(text);  // spreadsheets write one
 
     // A header is only the first content line, and only if nothing in it is
     // a number, so that a typo in the first data line is still an error:

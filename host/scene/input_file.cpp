@@ -27,6 +27,10 @@ void note_input_file(const fs::path& path) {
         g_input_files->push_back(normal);
 }
 
+std::string_view without_bom(std::string_view text) {
+    return text.substr(0, 3) == "\xEF\xBB\xBF" ? text.substr(3) : text;
+}
+
 std::string input_file_problem(const fs::path& path) {
     std::error_code ec;
     const fs::file_status status = fs::status(path, ec);

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace lc::loader {
@@ -19,6 +20,11 @@ std::string input_file_problem(const std::filesystem::path& path);
 // input_file_problem's words, or "FILE: cannot read file". Notes the file
 // (note_input_file).
 std::string read_input_file(const std::filesystem::path& path);
+
+// `text` without the UTF-8 byte order mark that editors and spreadsheets
+// may write first; it is no part of line 1 (tinyobjloader read it as part
+// of the first keyword and dropped the line).
+std::string_view without_bom(std::string_view text);
 
 // While an InputFileLog lives, every file read_input_file reads, and every
 // file given to note_input_file (those read by other means: an EXR through

@@ -18,11 +18,9 @@ struct Line {
 bool is_space(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
 
 // Calls visit(Line) for each line that has a word. Lines end as
-// tinyobjloader ends them: at "\n", "\r\n" or a lone "\r". A byte order
-// mark before line 1 is skipped.
+// tinyobjloader ends them: at "\n", "\r\n" or a lone "\r".
 template <class Visit>
 void for_each_line(std::string_view text, Visit&& visit) {
-    text = without_bom(text);
     Line line{0, {}};
     std::size_t at = 0;
     while (at <= text.size()) {
@@ -162,8 +160,5 @@ void check_mtl_numbers(std::string_view text, const std::string& name) {
     });
 }
 
-std::string_view without_bom(std::string_view text) {
-    return text.substr(0, 3) == "\xEF\xBB\xBF" ? text.substr(3) : text;
-}
 
 }  // namespace lc::loader

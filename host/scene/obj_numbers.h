@@ -15,15 +15,12 @@ namespace lc::loader {
 // spelt out (the loader falls back to the face normal). Every index of an
 // `f` line, and the vertex and joints of a `vw` line, are whole numbers
 // within int's range. Throws InputError "NAME: line N (v): 'nan' is not a
-// number". A byte order mark before line 1 is skipped (without_bom).
+// number". `text` starts after any byte order mark (without_bom: the
+// loader strips it once, for these checks and tinyobjloader alike).
 void check_obj_numbers(std::string_view text, const std::string& name);
 
 // The same for the MTL values the loader reads: the colours Kd, Ks and Ke
 // (three numbers each) and the scalars Ns, Pr, Pm, Ps, Pc and Pcr.
 void check_mtl_numbers(std::string_view text, const std::string& name);
-
-// `text` without the UTF-8 byte order mark some editors write first.
-// tinyobjloader would read it as part of line 1's keyword and drop the line.
-std::string_view without_bom(std::string_view text);
 
 }  // namespace lc::loader
