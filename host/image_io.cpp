@@ -95,7 +95,7 @@ std::string exr_message(const char* err, const char* fallback) {
 // tinyexr's message without its trailing newlines and full stop: tinyexr
 // says "Unknown compression type" for a valid file compressed with DWAA as
 // for a damaged one.
-std::string exr_damaged(const char* err, const char* fallback) {
+std::string exr_unreadable(const char* err, const char* fallback) {
     std::string why = exr_message(err, fallback);
     while (!why.empty() && (why.back() == '\n' || why.back() == '.' || why.back() == ' ')) why.pop_back();
     return "cannot be read: it is truncated or corrupt, or uses what tinyexr does not support (" + why + ")";
@@ -227,7 +227,7 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
     ExrHeaderGuard header_guard{&header};
     const char* err = nullptr;
     if (ParseEXRHeaderFromMemory(&header, &version, data, bytes.size(), &err) != TINYEXR_SUCCESS)
-        throw InputError(name, "", exr_damaged(err, "cannot parse the OpenEXR header"));
+        throw InputError(name, "", exr_unreadable(err, "cannot parse the OpenEXR header"));
     const EXRBox2i& window = header.data_window;
     const std::int64_t width = std::int64_t(window.max_x) - window.min_x + 1;
     const std::int64_t height = std::int64_t(window.max_y) - window.min_y + 1;
@@ -260,7 +260,7 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
     InitEXRImage(&exr);
     exr.num_channels = header.num_channels;
     if (LoadEXRImageFromMemory(&exr, &header, data, bytes.size(), &err) != TINYEXR_SUCCESS)
-        throw InputError(name, "", exr_damaged(err, "cannot decode the OpenEXR pixels"));
+        throw InputError(name, "", exr_unreadable(err, "cannot decode the OpenEXR pixels"));
     ExrImageGuard image_guard{&exr};
     // The size checked against max_pixels above is the one decoded.
     if (exr.width != width || exr.height != height)
