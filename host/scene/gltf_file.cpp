@@ -112,7 +112,7 @@ void check_uri_files(std::string_view json, const std::string& base, const std::
                 throw InputError(name, std::string(list) + "[" + std::to_string(i) + "].uri",
                                  "'" + text + "' decodes to a file name with a NUL character");
             const std::string problem = input_file_problem(uri_file(base, text));
-            if (problem.empty() || problem == "file not found") continue;
+            if (problem.empty() || problem == kFileNotFound) continue;
             throw InputError(name, std::string(list) + "[" + std::to_string(i) + "].uri", "'" + text + "' " + problem);
         }
     }

@@ -37,7 +37,7 @@ std::string input_file_problem(const fs::path& path) {
     if (fs::is_regular_file(status)) return "";
     switch (status.type()) {
         case fs::file_type::not_found:
-        case fs::file_type::none: return "file not found";
+        case fs::file_type::none: return kFileNotFound;
         case fs::file_type::directory: return "is a folder, not a file";
         case fs::file_type::character:
         case fs::file_type::block: return "is a device, not a regular file";

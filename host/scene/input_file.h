@@ -11,6 +11,10 @@ namespace lc::loader {
 // A path as error messages show it: as given, with "a/./b" and "a/../b" folded.
 std::string display(const std::filesystem::path& path);
 
+// input_file_problem's words for a path where nothing is; callers that
+// treat a missing file apart from one of the wrong kind compare with it.
+inline constexpr const char* kFileNotFound = "file not found";
+
 // Why `path` cannot be read as an input: "file not found", "is a folder,
 // not a file", "is a device, not a regular file" (a pipe, a socket); ""
 // where it is a regular file (symbolic links followed).

@@ -63,7 +63,7 @@ public:
         try {
             const std::filesystem::path file = folder_ / library;
             const std::string problem = input_file_problem(file);
-            if (problem == "file not found") {
+            if (problem == kFileNotFound) {
                 if (missing_.empty()) missing_ = library;
                 return false;  // tinyobjloader tries the line's next file name
             }

@@ -78,7 +78,7 @@ private:
     // file" and so on, where `file` cannot be read (input_file_problem).
     void check_input_file(const fs::path& file, const std::string& field) const {
         const std::string problem = input_file_problem(file);
-        if (problem == "file not found") in_.fail(field, "file not found: " + display(file));
+        if (problem == kFileNotFound) in_.fail(field, "file not found: " + display(file));
         if (!problem.empty()) in_.fail(field, "'" + display(file) + "' " + problem);
     }
 

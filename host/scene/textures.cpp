@@ -75,7 +75,7 @@ std::uint32_t load_texture(Scene& scene, const std::filesystem::path& image, con
                            const std::string& field) {
     const std::string name = "texture '" + display(image) + "'";
     if (const std::string problem = input_file_problem(image); !problem.empty())
-        throw InputError(referrer, field, name + (problem == "file not found" ? " not found" : ": " + problem));
+        throw InputError(referrer, field, name + (problem == kFileNotFound ? " not found" : ": " + problem));
     std::string bytes;
     try {
         bytes = read_input_file(image);
