@@ -7,7 +7,7 @@
 # render, the peak resident memory of the process, and the buffer sizes that
 # grow with the light count; then the difference between the Vulkan image
 # and the CPU's with a cut per pixel, which is the same image up to rounding
-# (the CPU's default shares each cut between the pixels of a 2x2 quad).
+# (the CPU's default shares each cut between the pixels of a 4x2 octet).
 # docs/results/scale.md has the figures and how to read them.
 #
 # The light file (586 MB at 10^7) is made once with scripts/gen_lights.py
