@@ -386,21 +386,28 @@ TEST(AreaLight, SameSamplesWhateverTheThreadCount) {
 
 // A constant environment of radiance L over an upward Lambert plane of
 // albedo rho: every point has radiance rho * L (the upper hemisphere's
-// cosine-weighted solid angle is pi).
+// cosine-weighted solid angle is pi). The same from a 1 x 1 map (a scene's
+// constant "color" sky) and other maps of a few texels, whose texels get
+// many samples each, as from a 64 x 32 map, whose texels get one or two.
 TEST(EnvironmentLight, ConstantSkyGivesAlbedoTimesRadiance) {
-    Environment map;
-    map.width = 64;
-    map.height = 32;
-    map.rgb.assign(std::size_t(map.width) * map.height * 3, 1.5f);
-    const std::vector<gpu::Light> lights = environment_lights(map, 3000);
-    ASSERT_EQ(lights.size(), 3000u);
-    glm::dvec3 total(0.0);
-    for (const auto& l : lights) total += glm::dvec3(l.r, l.g, l.b);
-    EXPECT_NEAR(total.x, 4.0 * 3.14159265358979 * 1.5, 1e-4);  // the lights carry the whole map
-    const double got = plane_radiance(lights, {0, 0, 0}).x;
-    std::printf("[ measured ] constant sky: rho L = 0.75, got %.6f (relative error %.2e)\n", got,
-                std::abs(got / 0.75 - 1.0));
-    EXPECT_NEAR(got, 0.5 * 1.5, 0.005 * 0.75);
+    for (const auto& [width, height] : {std::pair{64u, 32u}, {1u, 1u}, {2u, 1u}, {4u, 2u}, {3u, 5u}}) {
+        Environment map;
+        map.width = width;
+        map.height = height;
+        map.rgb.assign(std::size_t(map.width) * map.height * 3, 1.5f);
+        const std::vector<gpu::Light> lights = environment_lights(map, 3000);
+        ASSERT_EQ(lights.size(), 3000u);
+        glm::dvec3 total(0.0);
+        for (const auto& l : lights) total += glm::dvec3(l.r, l.g, l.b);
+        EXPECT_NEAR(total.x, 4.0 * 3.14159265358979 * 1.5, 1e-4);  // the lights carry the whole map
+        for (const glm::vec3 n : {glm::vec3(0, 1, 0), glm::vec3(0, -1, 0), glm::normalize(glm::vec3(1, 1, 0.5f))}) {
+            const double got = plane_radiance(lights, {0, 0, 0}, n).x;
+            std::printf("[ measured ] constant sky, %ux%u map, normal (%.2f, %.2f, %.2f): rho L = 0.75, got %.6f "
+                        "(relative error %.2e)\n",
+                        width, height, n.x, n.y, n.z, got, std::abs(got / 0.75 - 1.0));
+            EXPECT_NEAR(got, 0.5 * 1.5, 0.005 * 0.75) << width << "x" << height;
+        }
+    }
 }
 
 // A map black but for one small texel acts as the directional light from
