@@ -200,7 +200,7 @@ std::string report_text(const RenderReport& r) {
     text += format("  render %.3f s, %.0f rays (%.2f Mrays/s), %.1f shadow rays per pixel\n", r.seconds.render,
                    double(r.camera_rays + r.shadow_rays), r.rays_per_second * 1e-6, r.shadow_rays_per_pixel);
     if (r.loop_limit_retries)
-        text += format("  %u tile(s) rendered again with the work split finer (the driver cut long loops short)\n",
+        text += format("  tiles rendered again %u time(s) with the work split finer (the driver cut long loops short)\n",
                        r.loop_limit_retries);
     if (r.lightcuts) text += lightcuts_text(r, *r.lightcuts);
     if (r.sampling && r.method == "stochastic")

@@ -236,6 +236,15 @@ no_vulkan=(env VK_DRIVER_FILES=/nonexistent.json VK_ICD_FILENAMES=/nonexistent.j
 grep -q '"device": "cpu"' "$tmp/auto.json" || fail "auto without Vulkan: $(cat "$tmp/auto.json")"
 if "${no_vulkan[@]}" "$exe" render "$mini" -o "$tmp/vk.exr" --device vulkan >"$tmp/vk.txt" 2>&1 ||
    ! grep -q "no Vulkan device" "$tmp/vk.txt"; then fail "--device vulkan without Vulkan: $(cat "$tmp/vk.txt")"; fi
+# Drivers that find no device of theirs (Mesa's Intel and AMD drivers,
+# installed beside lavapipe, on a machine without those GPUs): the same.
+for icd in /usr/share/vulkan/icd.d/intel_icd.x86_64.json /usr/share/vulkan/icd.d/radeon_icd.x86_64.json; do
+  [ -e "$icd" ] || continue
+  if VK_DRIVER_FILES="$icd" "$exe" render "$mini" -o "$tmp/vk.exr" --device vulkan >"$tmp/vk.txt" 2>&1 ||
+     ! grep -q "^error: no Vulkan device" "$tmp/vk.txt"; then
+    fail "--device vulkan with only $icd: $(cat "$tmp/vk.txt")"
+  fi
+done
 
 # Outputs are all or nothing. no_output NAME: no file of that stem and no
 # temporary is left.

@@ -133,7 +133,14 @@ bool has_buffer_device_address(VkPhysicalDevice handle) {
 
 std::vector<PhysicalDeviceInfo> physical_devices(VkInstance instance) {
     std::uint32_t count = 0;
-    VK_CHECK(vkEnumeratePhysicalDevices(instance, &count, nullptr));
+    VkResult first = vkEnumeratePhysicalDevices(instance, &count, nullptr);
+    // The loader's answer where drivers are installed but none of them
+    // finds its device (Intel's or AMD's on a machine without that GPU).
+    if (first == VK_ERROR_INITIALIZATION_FAILED)
+        throw NoVulkanDevice(
+            "no Vulkan device: no installed Vulkan driver found a device (vkEnumeratePhysicalDevices returned "
+            "VK_ERROR_INITIALIZATION_FAILED)");
+    VK_CHECK(first);
     std::vector<VkPhysicalDevice> handles(count);
     VkResult result = vkEnumeratePhysicalDevices(instance, &count, handles.data());
     if (result != VK_INCOMPLETE) VK_CHECK(result);

@@ -69,7 +69,7 @@ struct RenderReport {
     } seconds;
     std::uint64_t camera_rays = 0, shadow_rays = 0;
     double shadow_rays_per_pixel = 0.0, rays_per_second = 0.0;
-    std::uint32_t loop_limit_retries = 0;     // GPU: tiles redone with the work split finer
+    std::uint32_t loop_limit_retries = 0;     // GPU: times a tile was redone with the work split finer
     // The kernels' arrays (scene_arrays), then the device's own buffers; a
     // device buffer of the same name replaces the scene array's entry.
     std::vector<BufferBytes> buffer_bytes;
