@@ -99,7 +99,9 @@ std::string lightcuts_text(const RenderReport& r, const LightcutsReport& l) {
     return text;
 }
 
-json lightcuts_json(const LightcutsReport& l) {
+// heap_memory: where a GPU's kernels keep the heap; the CPU path's heaps
+// are each worker thread's own ("cpu").
+json lightcuts_json(const LightcutsReport& l, bool on_cpu) {
     return {{"relative_error", l.relative_error},
             {"max_cut", l.max_cut},
             {"tree_nodes", l.tree_nodes},
@@ -114,7 +116,7 @@ json lightcuts_json(const LightcutsReport& l) {
             {"cut_sharing", l.cut_points == 8u ? "octet" : l.cut_points == 4u ? "quad" : "pixel"},
             {"heap_slots", l.heap_slots},
             {"heap_bytes_per_workgroup", l.heap_bytes},
-            {"heap_memory", l.heap_private ? "private" : "shared"},
+            {"heap_memory", on_cpu ? "cpu" : l.heap_private ? "private" : "shared"},
             {"heap_frozen_samples", l.heap_frozen_samples},
             {"heap_paused_samples", l.heap_paused_samples}};
 }
@@ -243,7 +245,7 @@ std::string report_json(const RenderReport& r) {
         {"loop_limit_retries", r.loop_limit_retries},
         {"buffer_bytes", buffers},
     };
-    if (r.lightcuts) j["lightcuts"] = lightcuts_json(*r.lightcuts);
+    if (r.lightcuts) j["lightcuts"] = lightcuts_json(*r.lightcuts, r.device == "cpu");
     if (r.method == "path") j["max_bounces"] = r.max_bounces;
     if (r.indirect)
         j["indirect"] = {{"vpls", r.indirect->vpls},

@@ -50,6 +50,8 @@ TEST(Report, JsonHasEveryKeyScriptsReadAndTheBlackLights) {
     EXPECT_THAT(report_text(report), HasSubstr("cut size mean"));
     // The CPU's default: octets share cuts, and the heap is an octet's.
     EXPECT_THAT(json, HasSubstr("\"cut_sharing\": \"octet\""));
+    // A GPU's heaps are in shared or private memory; the CPU's are neither.
+    EXPECT_THAT(json, HasSubstr("\"heap_memory\": \"cpu\""));
     EXPECT_THAT(report_text(report), HasSubstr("cuts shared by the eight pixels of each 4x2 octet"));
     EXPECT_THAT(report_text(report), HasSubstr("slots per octet"));
     RenderOptions quad = o;
