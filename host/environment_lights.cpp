@@ -89,7 +89,7 @@ private:
     // the texel's irradiance. (A grid even in the map's v, which is theta,
     // put too many of a tall texel's samples near the poles, where a
     // texel's row has less solid angle: a constant sky, a 1 x 1 map, lit an
-    // upward plane 27% too brightly.)
+    // upward plane 28% too brightly.)
     void emit_texel(Region r, const Totals& t, std::uint32_t samples) {
         const auto cols = std::uint32_t(std::ceil(std::sqrt(double(samples))));
         const std::uint32_t rows = (samples + cols - 1) / cols;
