@@ -24,6 +24,7 @@ namespace {
 
 using test::normal;
 using test::vertex;
+using test::winding_normal;
 
 namespace fs = std::filesystem;
 
@@ -126,9 +127,12 @@ TEST(Gltf, NodeTransformsMultiplyDownTheHierarchyAndNormalsUseTheInverseTranspos
     expect_near(vertex(s.triangles[0], 1), {10, 2, -6}, 1e-5f, "v1");
     expect_near(vertex(s.triangles[0], 2), {10, 4, 0}, 1e-5f, "v2");
     for (int k = 0; k < 3; ++k) expect_near(normal(s.normals[0], k), {1, 0, 0}, 1e-6f, "rotated normal");
-    // Mirrored in x: the vertex normal (0, 0, 1) stays.
-    expect_near(vertex(s.triangles[1], 1), {-1, 0, 0}, 0.0f, "mirrored");
+    // Mirrored in x: the vertex normal (0, 0, 1) stays, and so does the side
+    // the winding faces (the side an emissive triangle emits from), the
+    // last two corners swapped: the file's (1, 0, 0) is the second.
+    expect_near(vertex(s.triangles[1], 2), {-1, 0, 0}, 0.0f, "mirrored");
     for (int k = 0; k < 3; ++k) expect_near(normal(s.normals[1], k), {0, 0, 1}, 1e-6f, "mirrored normal");
+    expect_near(winding_normal(s.triangles[1]), {0, 0, 1}, 1e-6f, "mirrored winding");
 }
 
 TEST(Gltf, StripsAndFansAreTriangulatedPointsAndLinesSkippedWithANote) {

@@ -33,6 +33,7 @@ namespace {
 
 using test::normal;
 using test::vertex;
+using test::winding_normal;
 
 namespace fs = std::filesystem;
 using test::TempDir;
@@ -592,8 +593,10 @@ TEST(SceneLoader, TransformAppliesScaleThenRotateXyzThenTranslate) {
 
     // A mirroring scale flips the winding; the face normal keeps the side the
     // OBJ meant: the inverse transpose of diag(-1,1,1) maps (0,0,1) to (0,0,1).
+    // The last two corners are swapped, so the winding faces that side too.
     for (int i = 0; i < 3; ++i) expect_near(normal(scene.normals[3], i), {0, 0, 1});
-    expect_near(vertex(scene.triangles[3], 1), {-1, 0, 0});
+    expect_near(vertex(scene.triangles[3], 2), {-1, 0, 0});
+    expect_near(winding_normal(scene.triangles[3]), {0, 0, 1});
 
     // A scalar scale is uniform.
     expect_near(vertex(scene.triangles[4], 2), {0, 3, 0});

@@ -95,6 +95,12 @@ inline glm::vec3 vertex(const gpu::Triangle& t, int k) {
     return {t.v2_x, t.v2_y, t.v2_z};
 }
 
+// The side its corners' winding faces, (v1 - v0) x (v2 - v0), normalised:
+// the side an emissive triangle emits from.
+inline glm::vec3 winding_normal(const gpu::Triangle& t) {
+    return glm::normalize(glm::cross(vertex(t, 1) - vertex(t, 0), vertex(t, 2) - vertex(t, 0)));
+}
+
 inline glm::vec3 normal(const gpu::TriangleNormals& n, int k) {
     if (k == 0) return {n.n0_x, n.n0_y, n.n0_z};
     if (k == 1) return {n.n1_x, n.n1_y, n.n1_z};

@@ -260,8 +260,12 @@ private:
 
     // False when the triangle is degenerate and dropped (as OBJ faces are).
     bool add_triangle(const std::vector<glm::vec3>& p, const std::vector<glm::vec3>& n,
-                      const std::vector<glm::vec2>& uv, const std::array<std::uint32_t, 3>& c,
+                      const std::vector<glm::vec2>& uv, const std::array<std::uint32_t, 3>& corners,
                       const MeshTransform& t, const std::string& field) {
+        // glTF 2.0, "Transformations": a negative determinant flips the
+        // winding; the corners are stored in the order that keeps the side
+        // the file's winding means.
+        const std::array<std::uint32_t, 3> c = t.file_winding(corners);
         std::array<glm::vec3, 3> v;
         for (int k = 0; k < 3; ++k) v[std::size_t(k)] = glm::vec3(t.position * glm::vec4(p[c[std::size_t(k)]], 1.0f));
         glm::vec3 face;
@@ -277,9 +281,6 @@ private:
         for (const glm::vec3& q : v) target_.geometry.grow(glm::dvec3(q));
         if (const std::string problem = extent_problem(target_.geometry); !problem.empty())
             fail(field, "too far from the rest of the geometry: " + problem);
-        // glTF 3.7.2.1: a negative determinant flips the winding; the face
-        // normal keeps the side the file's winding means.
-        if (t.mirrors) face = -face;
         std::array<glm::vec3, 3> sn{face, face, face};
         if (!n.empty()) {
             for (std::size_t k = 0; k < 3; ++k) {

@@ -308,7 +308,8 @@ private:
     }
 
     // False when the triangle is degenerate and dropped.
-    bool add_triangle(const Corners& idx, int mtl_id, std::size_t f, const tinyobj::shape_t& shape) {
+    bool add_triangle(const Corners& face_corners, int mtl_id, std::size_t f, const tinyobj::shape_t& shape) {
+        const Corners idx = transform_.file_winding(face_corners);
         const std::array<glm::vec3, 3> v{position(idx[0].vertex_index), position(idx[1].vertex_index),
                                          position(idx[2].vertex_index)};
         glm::vec3 face;
@@ -326,9 +327,6 @@ private:
         if (const std::string problem = extent_problem(target_.geometry); !problem.empty()) {
             throw InputError(obj_name_, face_name(f, shape), "too far from the rest of the geometry: " + problem);
         }
-        // Keep the face normal on the side the OBJ winding says, even when a
-        // mirroring scale has flipped the winding.
-        if (transform_.mirrors) face = -face;
         const std::array<glm::vec3, 3> n = shading_normals(idx, face);
         // After the degenerate check: a dropped face must not add the default material.
         const std::uint32_t material = material_of(mtl_id);

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include <glm/glm.hpp>
 
@@ -18,6 +19,16 @@ struct MeshTransform {
     glm::mat4 position{1.0f};
     glm::mat3 normal{1.0f};
     bool mirrors = false;  // odd number of negative scales flips winding
+    // A triangle's corners in the order that keeps the file's winding in
+    // world space: corners 1 and 2 swapped where the transform mirrors, so
+    // that (v1 - v0) x (v2 - v0), which decides the side an emissive
+    // surface emits from (host/area_lights.cpp, lc_surface_emission),
+    // faces the side the file meant.
+    template <class Corners>
+    Corners file_winding(Corners corners) const {
+        if (mirrors) std::swap(corners[1], corners[2]);
+        return corners;
+    }
     // Where it was written (the scene file and its field, e.g.
     // "meshes[1].transform"), for an error it causes; empty for none.
     std::string scene_file, field;
