@@ -175,7 +175,8 @@ TEST(Gltf, MetallicRoughnessAndExtensionsBecomeDisneyParameters) {
     EXPECT_EQ(noted.base_color_texture, gpu::kInvalidIndex);  // TEXCOORD_1: left out
     EXPECT_EQ(noted.flags & gpu::kMaterialEmissive, 0u);
     for (const char* note : {"texCoord: uses TEXCOORD_1", "KHR_texture_transform: not supported",
-                             "alphaMode: BLEND", "occlusionTexture", "samplers[0]"})
+                             "alphaMode: BLEND", "occlusionTexture", "samplers[0]: clamped and mirrored wrapping",
+                             "samplers[0]: nearest filtering is not supported"})
         EXPECT_TRUE(has_note(s, note)) << note;
     // The primitive without a material: the default one.
     EXPECT_EQ(s.materials[s.triangles[2].material].metallic, 1.0f);

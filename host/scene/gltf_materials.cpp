@@ -237,6 +237,15 @@ std::uint32_t GltfMaterials::texture(int index, int tex_coord, bool transformed,
         if (s.wrapS != TINYGLTF_TEXTURE_WRAP_REPEAT || s.wrapT != TINYGLTF_TEXTURE_WRAP_REPEAT)
             notes_.add("samplers[" + std::to_string(t.sampler) + "]",
                        "clamped and mirrored wrapping are not supported; textures repeat");
+        // Nearest filtering (magnification, or minification with or without
+        // nearest mipmaps): every lookup is bilinear (shared/textures.h).
+        const bool nearest = s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ||
+                             s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ||
+                             s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
+                             s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR;
+        if (nearest)
+            notes_.add("samplers[" + std::to_string(t.sampler) + "]",
+                       "nearest filtering is not supported; textures are filtered bilinearly");
     }
     return image(t.source);
 }

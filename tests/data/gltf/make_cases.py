@@ -219,7 +219,7 @@ def materials_doc():
                               {"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 1},
                               {"attributes": {"POSITION": 0}}]}]
     return gltf(b, acc, meshes, [{"mesh": 0}], images=images, textures=textures,
-                samplers=[{"wrapS": 33071, "wrapT": 10497}], materials=materials,
+                samplers=[{"wrapS": 33071, "wrapT": 10497, "magFilter": 9728}], materials=materials,
                 extensionsUsed=["KHR_materials_emissive_strength", "KHR_materials_clearcoat",
                                 "KHR_materials_sheen", "KHR_texture_transform"])
 
