@@ -183,6 +183,85 @@ TEST(TreeDescent, UniformPickGivesEveryLightTheSameProbability) {
     for (std::size_t j = 0; j < seen.size(); ++j) EXPECT_EQ(seen[j], 1) << "light " << j << " never drawn";
 }
 
+// Lights whose weights differ by more than a float's precision: two point
+// lights of 1e8 and 1 (whatever their places in the tree, one is the
+// other's sibling) and a directional light of 1e-6 beside them. Every one
+// keeps a probability, at least 2^-24 a branch, and every draw reports the
+// probability it was drawn with: the enumerated product of its branches.
+// (With a float probability against a 24-bit number the branch to the dim
+// light rounded to 0, and a light it lit the shadow of was never drawn.)
+TEST(TreeDescent, LightsFarDimmerThanTheirSiblingsKeepAProbability) {
+    for (const std::uint32_t pick : {gpu::kLightPickPower, gpu::kLightPickTree}) {
+        PreparedScene p = prepare_scene(test::room_scene({test::point_light({-0.5f, 1.0f, 0.0f}, glm::vec3(1e8f)),
+                                                          test::point_light({0.5f, 1.0f, 0.0f}, glm::vec3(1.0f)),
+                                                          test::directional_light({0.0f, -1.0f, 0.0f}, glm::vec3(1e-6f))},
+                                                         8),
+                                        1);
+        RenderOptions o = test::options("sampled", 8);
+        gpu::FrameParams f = make_frame_params(p, o);
+        f.light_pick = pick;
+        Kernel k = cpu::make_shade_kernel(p, nullptr);
+        const Kernel::SurfacePoint sp =
+            k.lc_make_surface({0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0, glm::vec2(0.0f));
+        const std::vector<double> prob = enumerate_probabilities(k, sp, f, p.tree);
+        ASSERT_EQ(prob.size(), 3u);
+        double sum = 0.0;
+        for (std::size_t j = 0; j < prob.size(); ++j) {
+            EXPECT_GE(prob[j], 0x1p-24 * 0x1p-24) << "light " << j << ", pick " << pick;
+            sum += prob[j];
+        }
+        EXPECT_NEAR(sum, 1.0, 1e-6);
+        for (std::uint32_t s = 0; s < 2000; ++s) {
+            float pdf = -1.0f;
+            const std::uint32_t light = k.lc_pick_light(sp, f, k.lc_substream(77u, s), pdf);
+            ASSERT_LT(light, prob.size());
+            ASSERT_NEAR(pdf, prob[light], 1e-6 * prob[light]) << "light " << light;
+        }
+    }
+}
+
+// A branch's steps of 2^24: in proportion to the weights, rounded, and never
+// 0 (or all) where both sides have weight.
+TEST(TreeDescent, BranchStepsGiveEverySideWithWeightAShare) {
+    Kernel k;
+    EXPECT_EQ(k.lc_branch_steps(1.0f, 1.0f), 1u << 23);
+    EXPECT_EQ(k.lc_branch_steps(1.0f, 3.0f), 1u << 22);
+    EXPECT_EQ(k.lc_branch_steps(1e-9f, 1.0f), 1u);
+    EXPECT_EQ(k.lc_branch_steps(1.0f, 1e-9f), (1u << 24) - 1u);
+    EXPECT_EQ(k.lc_branch_steps(0.0f, 1.0f), 0u);
+    EXPECT_EQ(k.lc_branch_steps(1.0f, 0.0f), 1u << 24);
+    // The draw takes the side k < n: its frequency over the 2^24 values of
+    // k is n / 2^24, the probability it reports.
+    for (const std::uint32_t n : {1u, 12345u, (1u << 24) - 1u}) {
+        float pdf_low = 1.0f, pdf_high = 1.0f;
+        EXPECT_TRUE(k.lc_branch((n - 1u) << 8, n, pdf_low));
+        EXPECT_FALSE(k.lc_branch(n << 8, n, pdf_high));
+        EXPECT_EQ(pdf_low, float(n) * 0x1p-24f);
+        EXPECT_EQ(pdf_high, float((1u << 24) - n) * 0x1p-24f);
+    }
+}
+
+// Uniform picking among more lights than a 24-bit number has values: the
+// index comes from all 32 bits of the hash (odd indices too, where u * n
+// gave multiples of n / 2^24 only), and without the modulo's bias (for n =
+// 3 * 2^30 the first third of the lights would otherwise be drawn twice as
+// often as the rest: half of the draws instead of a third).
+TEST(TreeDescent, UniformPickOfBillionsOfLightsIsUniform) {
+    Kernel k;
+    const std::uint32_t n = 3u << 30;
+    constexpr int kDraws = 30000;
+    int first_third = 0, odd = 0;
+    for (int i = 0; i < kDraws; ++i) {
+        const std::uint32_t light = k.lc_uniform_light(gpu::lc_hash(std::uint32_t(i) * 2654435761u), n);
+        ASSERT_LT(light, n);
+        first_third += light < (1u << 30) ? 1 : 0;
+        odd += light & 1u;
+    }
+    const double sigma = std::sqrt(kDraws * (1.0 / 3.0) * (2.0 / 3.0));
+    EXPECT_NEAR(first_third, kDraws / 3.0, 5.0 * sigma);
+    EXPECT_NEAR(odd, kDraws / 2.0, 5.0 * std::sqrt(kDraws * 0.25));
+}
+
 // Luminance means over the whole image and over its four quadrants.
 std::vector<double> region_means(const Image& image) {
     std::vector<double> sums(5, 0.0);

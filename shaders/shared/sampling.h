@@ -77,39 +77,96 @@ float lc_pick_weight(LC_IN(SurfacePoint) sp, uint node_index, uint pick, float m
     return lc_cluster_importance(sp, node, min_distance2);
 }
 
-// Probability that descent goes to the left of the two children `left` and
-// `left + 1`, in proportion to their weights. Where neither child has any weight
-// (the parent's bound was not zero, but both tighter ones are: no light
-// below can contribute) it goes by power instead: whatever light it reaches
+// Every draw below takes the top 24 bits of a hash, an integer k in
+// [0, 2^24), and chooses between two weights a and b by k < n, where n,
+// lc_branch_steps, is a's share of the 2^24 values, rounded, but at least
+// 1 where a > 0 and at most 2^24 - 1 where b > 0. The probability recorded
+// for the choice is the share taken, n / 2^24 or (2^24 - n) / 2^24, exactly
+// the frequency of the choice, and no side with weight is left without
+// one. (A float probability against a 24-bit number was neither: a side
+// with less than 2^-24 of the weight was drawn as often as one with 2^-24
+// but weighed as if rarer, and one with less than about 3e-8 never, so a
+// dim light beside a bright one it lit the shadow of was missed.)
+LC_KCONST uint kBranchSteps = 16777216u;  // 2^24
+LC_KCONST float kBranchStep = 1.0f / 16777216.0f;
+
+uint lc_branch_steps(float a, float b) {
+    if (!(a > 0.0f)) return 0u;
+    if (!(b > 0.0f)) return kBranchSteps;
+    uint n = uint(a / (a + b) * 16777216.0f + 0.5f);
+    return min(max(n, 1u), kBranchSteps - 1u);
+}
+
+// Whether the 24-bit draw of hash `h` takes the side given `n` steps, and
+// that side's probability multiplied into `pdf`.
+bool lc_branch(uint h, uint n, LC_INOUT(float) pdf) {
+    bool taken = (h >> 8u) < n;
+    pdf *= float(taken ? n : kBranchSteps - n) * kBranchStep;
+    return taken;
+}
+
+// The steps of the left of the two children `left` and `left + 1`, in
+// proportion to their weights. Where neither child has any weight (the
+// parent's bound was not zero, but both tighter ones are: no light below
+// can contribute) it goes by power instead: whatever light it reaches
 // contributes zero without a shadow ray, and the probabilities of all
 // lights still sum to one.
-float lc_left_probability(LC_IN(SurfacePoint) sp, uint left, uint pick, float min_distance2) {
+uint lc_left_steps(LC_IN(SurfacePoint) sp, uint left, uint pick, float min_distance2) {
     float wl = lc_pick_weight(sp, left, pick, min_distance2);
     float wr = lc_pick_weight(sp, left + 1u, pick, min_distance2);
     if (!(wl + wr > 0.0f) && pick != kLightPickPower) {
         wl = lc_pick_weight(sp, left, kLightPickPower, min_distance2);
         wr = lc_pick_weight(sp, left + 1u, kLightPickPower, min_distance2);
     }
-    float total = wl + wr;
-    return total > 0.0f ? wl / total : 0.5f;
+    return wl + wr > 0.0f ? lc_branch_steps(wl, wr) : kBranchSteps / 2u;
 }
 
-// Probability of picking the tree of light type `type` (its root), in
-// proportion to the roots' weights; 0 when no tree has any.
-float lc_root_probability(LC_IN(SurfacePoint) sp, LC_IN(FrameParams) f, uint type, uint pick) {
-    float total = 0.0f;
-    float mine = 0.0f;
-    for (uint t = 0u; t < kLightTypeCount; ++t) {
-        if (f.roots[t] == kInvalidIndex) continue;
-        float w = lc_pick_weight(sp, f.roots[t], pick, f.min_distance2);
-        total += w;
-        if (t == type) mine = w;
+// Probability that descent goes to the left child (for tests).
+float lc_left_probability(LC_IN(SurfacePoint) sp, uint left, uint pick, float min_distance2) {
+    return float(lc_left_steps(sp, left, pick, min_distance2)) * kBranchStep;
+}
+
+// The light types are drawn one after another: type t, if it has weight,
+// against the weight of the types after it (lc_branch_steps), each with a
+// fresh hash. The roots' weights at a point, and the weight of the types
+// after each.
+struct RootWeights {
+    float weight[kLightTypeCount];
+    float after[kLightTypeCount];
+};
+
+RootWeights lc_root_weights(LC_IN(SurfacePoint) sp, LC_IN(FrameParams) f, uint pick) {
+    RootWeights r;
+    for (uint t = 0u; t < kLightTypeCount; ++t)
+        r.weight[t] = f.roots[t] == kInvalidIndex ? 0.0f : lc_pick_weight(sp, f.roots[t], pick, f.min_distance2);
+    float rest = 0.0f;
+    for (uint i = 0u; i < kLightTypeCount; ++i) {
+        uint t = kLightTypeCount - 1u - i;
+        r.after[t] = rest;
+        rest += r.weight[t];
     }
-    return total > 0.0f ? mine / total : 0.0f;
+    return r;
+}
+
+// Probability of picking the tree of light type `type` (its root); 0 when
+// no tree has any weight (for tests).
+float lc_root_probability(LC_IN(SurfacePoint) sp, LC_IN(FrameParams) f, uint type, uint pick) {
+    RootWeights r = lc_root_weights(sp, f, pick);
+    float p = 1.0f;
+    for (uint t = 0u; t < kLightTypeCount; ++t) {
+        if (!(r.weight[t] > 0.0f)) {
+            if (t == type) return 0.0f;
+            continue;
+        }
+        uint n = lc_branch_steps(r.weight[t], r.after[t]);
+        if (t == type) return p * float(n) * kBranchStep;
+        p *= float(kBranchSteps - n) * kBranchStep;
+    }
+    return 0.0f;
 }
 
 // Descends from `node_index` to a leaf, choosing each child with
-// lc_left_probability and one fresh random number per level of `stream`.
+// lc_left_steps and one fresh random number per level of `stream`.
 // Returns the leaf's light and multiplies `pdf` by the branch probabilities
 // taken. (Written as a loop with its test in the head: with a `return`
 // inside `while (true)` instead, lavapipe returned light 0 from the copy of
@@ -119,46 +176,49 @@ uint lc_descend(LC_IN(SurfacePoint) sp, uint node_index, uint pick, float min_di
     uint h = stream;
     LightNode node = LC_LIGHT_NODE(node_index);
     while ((node.flags & kNodeLeaf) == 0u) {
-        float p_left = lc_left_probability(sp, node.left, pick, min_distance2);
+        uint n = lc_left_steps(sp, node.left, pick, min_distance2);
         h = lc_hash(h);
-        bool go_left = lc_unit_float(h) < p_left;
-        pdf *= go_left ? p_left : 1.0f - p_left;
-        node_index = go_left ? node.left : node.left + 1u;
+        node_index = lc_branch(h, n, pdf) ? node.left : node.left + 1u;
         node = LC_LIGHT_NODE(node_index);
     }
     return node.rep_light;
 }
 
-// One light drawn for a shaded point with the scene's light pick: a root in
-// proportion to the roots' weights, then down its tree (tree and power), or
-// any light with the same probability (uniform). Its probability in `pdf`;
+// Light `h mod n` for a hash h, every light with probability exactly 1/n:
+// h is hashed again while it falls in the last 2^32 mod n values, which
+// would give the first lights one chance more (at most 8 times; the chance
+// of a ninth is below (n / 2^32)^8). (The light of a 24-bit float u, u * n,
+// drew some of 10^7 lights half as often as others, and at 2 * 10^7 some
+// never.)
+uint lc_uniform_light(uint h, uint n) {
+    uint extra = (0u - n) % n;  // 2^32 mod n
+    for (uint tries = 0u; tries < 8u && h > 0xFFFFFFFFu - extra; ++tries) h = lc_hash(h);
+    return h % n;
+}
+
+// One light drawn for a shaded point with the scene's light pick: a root
+// (lc_root_weights), then down its tree (tree and power), or any light
+// with the same probability (uniform). Its probability in `pdf`;
 // kInvalidIndex when no light can be drawn.
 uint lc_pick_light(LC_IN(SurfacePoint) sp, LC_IN(FrameParams) f, uint stream, LC_OUT(float) pdf) {
     pdf = 0.0f;
     if (f.light_count == 0u) return kInvalidIndex;
-    float u = lc_unit_float(stream);
     if (f.light_pick == kLightPickUniform) {
         pdf = 1.0f / float(f.light_count);
-        return min(uint(u * float(f.light_count)), f.light_count - 1u);
+        return lc_uniform_light(stream, f.light_count);
     }
-    float weights[kLightTypeCount];
-    float total = 0.0f;
+    RootWeights r = lc_root_weights(sp, f, f.light_pick);
+    uint h = stream;
+    pdf = 1.0f;
     for (uint t = 0u; t < kLightTypeCount; ++t) {
-        weights[t] = f.roots[t] == kInvalidIndex ? 0.0f : lc_pick_weight(sp, f.roots[t], f.light_pick, f.min_distance2);
-        total += weights[t];
+        if (!(r.weight[t] > 0.0f)) continue;
+        h = lc_hash(h);
+        // The last type with weight has after[t] == 0: always taken.
+        if (lc_branch(h, lc_branch_steps(r.weight[t], r.after[t]), pdf))
+            return lc_descend(sp, f.roots[t], f.light_pick, f.min_distance2, h, pdf);
     }
-    if (!(total > 0.0f)) return kInvalidIndex;
-    // The last type with any weight takes what rounding leaves above the others.
-    uint type = kLightTypeCount;
-    float below = 0.0f;
-    for (uint t = 0u; t < kLightTypeCount; ++t) {
-        if (!(weights[t] > 0.0f)) continue;
-        type = t;
-        below += weights[t] / total;
-        if (u < below) break;
-    }
-    pdf = weights[type] / total;
-    return lc_descend(sp, f.roots[type], f.light_pick, f.min_distance2, stream, pdf);
+    pdf = 0.0f;
+    return kInvalidIndex;
 }
 
 // --method sampled: light samples [first, first + count) of the point's
