@@ -362,19 +362,22 @@ struct BasicShadeKernel {
     // tree's leaf order keeps close together, go down the tree as one packet
     // (lc_visible8; the room at 10^4 lights 4% faster than in packets of
     // four, the gallery 1% slower, docs/results/speed.md). The
-    // contributions are summed in light order, as there.
+    // contributions are summed in light order, as there, in double
+    // (lc_brute_add).
     vec3 lc_shade_brute_packets(const SurfacePoint& sp, uint light_count, float min_distance2, ShadeStats& stats) {
         if (kRecordRays || wide_nodes == nullptr) return lc_shade_brute(sp, light_count, min_distance2, stats);
         constexpr uint R = 8u;
-        vec3 sum(0.0f);
+        BruteSum acc;
         RayPacket8 packet;
         vec3 contribution[R];
         uint pending = 0u;
         auto trace = [&] {
             packet.valid = (1u << pending) - 1u;
             const unsigned visible = lc_visible8(packet);
-            for (uint j = 0; j < pending; ++j)
-                if ((visible >> j & 1u) != 0u) sum += contribution[j];
+            for (uint j = 0; j < pending; ++j) {
+                const vec3& x = contribution[j];
+                if ((visible >> j & 1u) != 0u && x.x + x.y + x.z > 0.0f) lc_brute_add(acc, x);
+            }
             pending = 0u;
         };
         for (uint i = 0u; i < light_count; ++i) {
@@ -391,7 +394,7 @@ struct BasicShadeKernel {
             if (++pending == R) trace();
         }
         if (pending > 0u) trace();
-        return sum;
+        return lc_brute_total(acc);
     }
 
     // The shadow rays' any-hit query: lc_trace_any's answer, from the 8-wide
