@@ -7,8 +7,7 @@
 // Brute force's sum over the lights keeps what float rounding would drop:
 // a million lights each below half a float step of the sum still count.
 // (A plain float sum dropped them: a point light beside 4 * 10^6 samples
-// of an emissive panel rendered 4% dark, and brute force with 4 * 10^6
-// VPLs fell 4% short of the path tracer's indirect light.) The CPU adds in
+// of an emissive panel rendered 4% dark.) The CPU adds in
 // double, whose add is as fast as float's; the kernels, which may lack
 // doubles, add in float with Kahan's compensation, `carry` keeping what the
 // sum's rounding dropped to take it off the next term, its operations
