@@ -374,10 +374,8 @@ struct BasicShadeKernel {
         auto trace = [&] {
             packet.valid = (1u << pending) - 1u;
             const unsigned visible = lc_visible8(packet);
-            for (uint j = 0; j < pending; ++j) {
-                const vec3& x = contribution[j];
-                if ((visible >> j & 1u) != 0u && x.x + x.y + x.z > 0.0f) lc_brute_add(acc, x);
-            }
+            for (uint j = 0; j < pending; ++j)
+                if ((visible >> j & 1u) != 0u) lc_brute_add(acc, contribution[j]);
             pending = 0u;
         };
         for (uint i = 0u; i < light_count; ++i) {

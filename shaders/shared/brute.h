@@ -33,7 +33,7 @@ void lc_brute_add(inout BruteSum acc, vec3 x) {
 vec3 lc_brute_total(BruteSum acc) { return acc.sum; }
 #endif
 
-// The contributions above zero, in light order, summed by lc_brute_add.
+// Every light's contribution, in light order, summed by lc_brute_add.
 vec3 lc_shade_brute(LC_IN(SurfacePoint) sp, uint light_count, float min_distance2,
                     LC_INOUT(ShadeStats) stats) {
     BruteSum acc;
@@ -43,8 +43,7 @@ vec3 lc_shade_brute(LC_IN(SurfacePoint) sp, uint light_count, float min_distance
 #endif
     for (uint i = 0u; i < light_count; ++i) {
         Light light = LC_LIGHT(i);
-        vec3 x = lc_light_unit_shadowed(sp, light, min_distance2, stats) * lc_light_intensity(light);
-        if (x.x + x.y + x.z > 0.0f) lc_brute_add(acc, x);
+        lc_brute_add(acc, lc_light_unit_shadowed(sp, light, min_distance2, stats) * lc_light_intensity(light));
     }
     return lc_brute_total(acc);
 }

@@ -93,7 +93,7 @@ LC_KCONST float kBranchStep = 1.0f / 16777216.0f;
 uint lc_branch_steps(float a, float b) {
     if (!(a > 0.0f)) return 0u;
     if (!(b > 0.0f)) return kBranchSteps;
-    uint n = uint(a / (a + b) * 16777216.0f + 0.5f);
+    uint n = uint(a / (a + b) * float(kBranchSteps) + 0.5f);
     return min(max(n, 1u), kBranchSteps - 1u);
 }
 
