@@ -118,6 +118,8 @@ int run_render(RenderArgs a) {
     // The path tracer finds indirect light itself: VPLs would only cost time.
     if (options.method == "path") scene.render.indirect.vpls = 0;
     lc::validate_render_options(options);
+    if (const std::string problem = lc::vulkan_options_problem(a.device, options.method); !problem.empty())
+        throw std::invalid_argument(problem);
     // Every output is checked and reserved before the render; none is left if any fails.
     lc::OutputSet outputs = lc::reserve_render_outputs(a.outputs, a.scene, options.method, scene.input_files);
 

@@ -201,6 +201,13 @@ for bad in "--max-bounces=1025" "--vpl-bounces=-1"; do
 for bad in "--vpl-clamp=-0.5" "--time-limit=nan" "--time-limit=-1" "--time-limit=1e308" "--vpl-clamp=1e300"; do
   expect_error "must be a number from 0 to 3.4e38 (the largest float)" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
 expect_error "method path (the path tracer) runs on the CPU only" render "$mini" -o "$tmp/edge2.exr" --method path --device vulkan
+# Vulkan's options on a render that cannot use Vulkan.
+expect_error '--validation is for Vulkan renders, and device "cpu" does not use Vulkan' \
+  render "$mini" -o "$tmp/edge2.exr" --device cpu --validation
+expect_error '--gpu is for Vulkan renders, and device "cpu" does not use Vulkan' \
+  render "$mini" -o "$tmp/edge2.exr" --device cpu --gpu 0
+expect_error '--gpu is for Vulkan renders, and method path (the path tracer) runs on the CPU only' \
+  render "$mini" -o "$tmp/edge2.exr" --method path --gpu 0
 # Cuts shared by quads on Vulkan (quadcuts.comp), and the message where
 # the quad's heap cannot fit the device's shared memory. In a sanitizer
 # build, leaks are not checked on this render: the driver (lavapipe) keeps a
@@ -234,6 +241,11 @@ no_vulkan=(env VK_DRIVER_FILES=/nonexistent.json VK_ICD_FILENAMES=/nonexistent.j
 [ "$(grep -c '^note: no Vulkan device' "$tmp/auto.txt")" = 1 ] && [ "$(wc -l <"$tmp/auto.txt")" = 1 ] ||
   fail "auto without Vulkan said: $(cat "$tmp/auto.txt")"
 grep -q '"device": "cpu"' "$tmp/auto.json" || fail "auto without Vulkan: $(cat "$tmp/auto.json")"
+# --validation there: the same one line says it checked nothing.
+"${no_vulkan[@]}" "$exe" render "$mini" -o "$tmp/auto.exr" --width 4 --height 4 --validation \
+  >/dev/null 2>"$tmp/auto.txt" || fail "auto --validation without Vulkan failed: $(cat "$tmp/auto.txt")"
+[ "$(grep -c '^note: no Vulkan device; rendering on the CPU, which --validation does not check$' "$tmp/auto.txt")" = 1 ] &&
+  [ "$(wc -l <"$tmp/auto.txt")" = 1 ] || fail "auto --validation without Vulkan said: $(cat "$tmp/auto.txt")"
 if "${no_vulkan[@]}" "$exe" render "$mini" -o "$tmp/vk.exr" --device vulkan >"$tmp/vk.txt" 2>&1 ||
    ! grep -q "no Vulkan device" "$tmp/vk.txt"; then fail "--device vulkan without Vulkan: $(cat "$tmp/vk.txt")"; fi
 # Drivers that find no device of theirs (Mesa's Intel and AMD drivers,

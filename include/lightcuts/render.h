@@ -205,12 +205,18 @@ struct DeviceChoice {
 // What is wrong with a device name, or "" for "auto", "cpu" and "vulkan".
 std::string device_problem(std::string_view device);
 
+// What is wrong with asking for Vulkan's options (`vulkan.validation`, a
+// `vulkan.gpu`) of a render that cannot use Vulkan: device "cpu", or
+// method "path" (the CPU's alone) under device "auto"; "" otherwise.
+// Device "vulkan" with method "path" is render_vulkan's error.
+std::string vulkan_options_problem(const DeviceChoice& choice, std::string_view method);
+
 // "cpu": render_cpu. "vulkan": render_vulkan, whatever the device, failing
 // as it fails (NoVulkanDevice included). "auto": Vulkan on a hardware GPU or
 // on the device `vulkan.gpu` names; otherwise, or when render_vulkan throws
 // NoVulkanDevice, the CPU, with a note (only a software rasterizer such as
 // lavapipe is slower than the CPU path). Throws std::invalid_argument for
-// any other device name.
+// any other device name, and for vulkan_options_problem.
 RenderResult render(const PreparedScene& prepared, const RenderOptions& options, const DeviceChoice& choice);
 
 }  // namespace lc
