@@ -125,16 +125,18 @@ float bsdf_pdf(Kernel& k, const gpu::Material& m, const LobeWeights& lobes, glm:
         // wo.(wi + wo) = 1 + wo.wi >= 0, so h is on wo's side of every
         // reflection and the one half vector that reflects wo into wi.
         const glm::vec3 h = glm::normalize(wi + wo);
-        const float cos_h = glm::dot(n, h);
+        const glm::vec2 half_angle = k.lc_half_angle(n, h);
         const float wo_h = glm::dot(wo, h);
-        if (cos_h > 0.0f && wo_h > 0.0f) pdf += lobes.specular * k.lc_ggx_d(cos_h, m.alpha) * cos_h / (4.0f * wo_h);
+        if (half_angle.x > 0.0f && wo_h > 0.0f)
+            pdf += lobes.specular * k.lc_ggx_d(half_angle.x, half_angle.y, m.alpha) * half_angle.x / (4.0f * wo_h);
     }
     if (lobes.clearcoat > 0.0f) {
         const glm::vec3 h = glm::normalize(wi + wo);
-        const float cos_h = glm::dot(n, h);
+        const glm::vec2 half_angle = k.lc_half_angle(n, h);
         const float wo_h = glm::dot(wo, h);
-        if (cos_h > 0.0f && wo_h > 0.0f)
-            pdf += lobes.clearcoat * k.lc_gtr1_d(cos_h, k.lc_clearcoat_alpha(m)) * cos_h / (4.0f * wo_h);
+        if (half_angle.x > 0.0f && wo_h > 0.0f)
+            pdf += lobes.clearcoat * k.lc_gtr1_d(half_angle.x, half_angle.y, k.lc_clearcoat_alpha(m)) * half_angle.x /
+                   (4.0f * wo_h);
     }
     return pdf;
 }

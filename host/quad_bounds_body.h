@@ -189,12 +189,25 @@ LC_ALWAYS_INLINE inline V cos_h_max(const QuadLanes& q, const BoxCones& cone) {
     return v_or(wide, narrow);
 }
 
-// lc_ggx_d(cos_h, alpha) lane by lane.
+// lc_ggx_d(cos_h, sin2_h, alpha) lane by lane.
 template <class Kernel>
-LC_ALWAYS_INLINE inline V ggx_d(const QuadLanes& q, V cos_h) {
-    const V c2 = v_mul(cos_h, cos_h);
-    const V denom = v_add(v_sub(v_set1(1.0f), c2), v_mul(q.a2, c2));
+LC_ALWAYS_INLINE inline V ggx_d(const QuadLanes& q, V cos_h, V sin2_h) {
+    const V denom = v_add(sin2_h, v_mul(q.a2, v_mul(cos_h, cos_h)));
     return v_div(q.a2, v_mul(v_mul(v_set1(Kernel::kPi), denom), denom));
+}
+
+// 1 - cos_h^2, as the bounds give lc_ggx_d and lc_gtr1_d for cos_h_max.
+LC_ALWAYS_INLINE inline V one_minus_square(V cos_h) { return v_sub(v_set1(1.0f), v_mul(cos_h, cos_h)); }
+
+// lc_half_angle(n, h) at each lane's point for the unit half vector h:
+// clamp(dot(n, h), 0, 1) into cos_h, and the square of glm's cross(n, h)
+// into sin2_h.
+LC_ALWAYS_INLINE inline void half_angle(const QuadLanes& q, V h_x, V h_y, V h_z, V& cos_h, V& sin2_h) {
+    cos_h = v_min(v_max(dot4(q.nx, q.ny, q.nz, h_x, h_y, h_z), v_zero()), v_set1(1.0f));
+    const V s_x = v_sub(v_mul(q.ny, h_z), v_mul(h_y, q.nz));
+    const V s_y = v_sub(v_mul(q.nz, h_x), v_mul(h_z, q.nx));
+    const V s_z = v_sub(v_mul(q.nx, h_y), v_mul(h_x, q.ny));
+    sin2_h = dot4(s_x, s_y, s_z, s_x, s_y, s_z);
 }
 
 // lc_ggx_bound of each lane's box at its point: lc_box_cone, lc_cos_h_max,
@@ -202,7 +215,8 @@ LC_ALWAYS_INLINE inline V ggx_d(const QuadLanes& q, V cos_h) {
 // caller masks.
 template <class Kernel>
 LC_ALWAYS_INLINE inline V ggx_bounds(const QuadLanes& q, V cos_h) {
-    const V bound = v_mul(v_div(v_mul(ggx_d<Kernel>(q, cos_h), q.g1), q.four_cos_o), v_set1(Kernel::kBoundSlack));
+    const V bound = v_mul(v_div(v_mul(ggx_d<Kernel>(q, cos_h, one_minus_square(cos_h)), q.g1), q.four_cos_o),
+                          v_set1(Kernel::kBoundSlack));
     return v_and(bound, v_cmpnle(q.cos_o, v_zero()));  // lc_ggx_bound: 0 where cos_o <= 0
 }
 
@@ -213,10 +227,10 @@ LC_ALWAYS_INLINE inline V schlick_weight(V cos_x) {
     return v_mul(v_mul(m2, m2), m);
 }
 
-// lc_gtr1_d(cos_h, lc_clearcoat_alpha) lane by lane, from the point's terms.
-LC_ALWAYS_INLINE inline V gtr1_d(const QuadLanes& q, V cos_h) {
-    const V c2 = v_mul(cos_h, cos_h);
-    return v_div(q.coat_a2_minus_1, v_mul(q.coat_pi_log, v_add(v_sub(v_set1(1.0f), c2), v_mul(q.coat_a2, c2))));
+// lc_gtr1_d(cos_h, sin2_h, lc_clearcoat_alpha) lane by lane, from the
+// point's terms.
+LC_ALWAYS_INLINE inline V gtr1_d(const QuadLanes& q, V cos_h, V sin2_h) {
+    return v_div(q.coat_a2_minus_1, v_mul(q.coat_pi_log, v_add(sin2_h, v_mul(q.coat_a2, v_mul(cos_h, cos_h)))));
 }
 
 // The Disney BRDF's lobes after the diffuse one, added to r, g, b in the
@@ -286,9 +300,11 @@ LC_ALWAYS_INLINE inline void disney_bounds(const QuadLanes& q, const BoxCones& c
     // The specular lobe at the largest cos_h, Schlick's weight at the
     // smallest cos_d.
     const V w = schlick_weight(d_min);
-    const V ggx = v_div(v_mul(ggx_d<Kernel>(q, cos_h), q.g1), q.four_cos_o);
+    const V sin2_h = one_minus_square(cos_h);
+    const V ggx = v_div(v_mul(ggx_d<Kernel>(q, cos_h, sin2_h), q.g1), q.four_cos_o);
     add_disney_lobes<Kernel>(
-        q, w, ggx, cos_bound, [&] { return v_div(v_mul(gtr1_d(q, cos_h), q.coat_g1), q.four_cos_o); }, r, g, b);
+        q, w, ggx, cos_bound, [&] { return v_div(v_mul(gtr1_d(q, cos_h, sin2_h), q.coat_g1), q.four_cos_o); }, r,
+        g, b);
     const V lit = v_cmpgt(q.cos_o, zero);  // lc_disney_bound: 0 where !(cos_o > 0)
     r = v_and(v_mul(r, slack), lit);
     g = v_and(v_mul(g, slack), lit);
@@ -305,7 +321,8 @@ LC_ALWAYS_INLINE inline void disney_values(const QuadLanes& q, V wi_x, V wi_y, V
     const V s_x = v_add(wi_x, q.wox), s_y = v_add(wi_y, q.woy), s_z = v_add(wi_z, q.woz);
     const V inverse = v_div(one, v_sqrt(dot4(s_x, s_y, s_z, s_x, s_y, s_z)));
     const V h_x = v_mul(s_x, inverse), h_y = v_mul(s_y, inverse), h_z = v_mul(s_z, inverse);
-    const V cos_h = v_max(dot4(q.nx, q.ny, q.nz, h_x, h_y, h_z), zero);
+    V cos_h, sin2_h;
+    half_angle(q, h_x, h_y, h_z, cos_h, sin2_h);
     const V cos_d = v_min(v_max(dot4(wi_x, wi_y, wi_z, h_x, h_y, h_z), zero), one);
     const V w = schlick_weight(cos_d);
     // The diffuse lobe (lc_disney_diffuse).
@@ -317,13 +334,14 @@ LC_ALWAYS_INLINE inline void disney_values(const QuadLanes& q, V wi_x, V wi_y, V
     g = v_mul(q.kd_g, diffuse);
     b = v_mul(q.kd_b, diffuse);
     // The specular lobe (lc_microfacet_cos; lc_smith_g1 at cos_i).
-    const V specular = v_div(v_mul(v_mul(ggx_d<Kernel>(q, cos_h), smith_g1(cos_i, q.a2)), q.g1), q.four_cos_o);
+    const V specular =
+        v_div(v_mul(v_mul(ggx_d<Kernel>(q, cos_h, sin2_h), smith_g1(cos_i, q.a2)), q.g1), q.four_cos_o);
     add_disney_lobes<Kernel>(
         q, w, specular, cos_i,
         [&] {
             const V g1_coat_i =
                 smith_g1(cos_i, v_set1(Kernel::kClearcoatSmithAlpha * Kernel::kClearcoatSmithAlpha));
-            return v_div(v_mul(v_mul(gtr1_d(q, cos_h), g1_coat_i), q.coat_g1), q.four_cos_o);
+            return v_div(v_mul(v_mul(gtr1_d(q, cos_h, sin2_h), g1_coat_i), q.coat_g1), q.four_cos_o);
         },
         r, g, b);
     const V seen = v_cmpgt(q.cos_o, zero);  // lc_disney_brdf_cos: 0 where !(cos_o > 0)
@@ -511,8 +529,10 @@ LC_ALWAYS_INLINE inline V light_values(const QuadLanes& q, const LightLanes& l, 
         // (4 cos_o), the point's terms from set_ggx_terms.
         const V hx = v_add(wi_x, q.wox), hy = v_add(wi_y, q.woy), hz = v_add(wi_z, q.woz);
         const V inverse = v_div(one, v_sqrt(dot4(hx, hy, hz, hx, hy, hz)));
-        const V cos_h = v_max(dot4(q.nx, q.ny, q.nz, v_mul(hx, inverse), v_mul(hy, inverse), v_mul(hz, inverse)), zero);
-        const V spec = v_div(v_mul(v_mul(ggx_d<Kernel>(q, cos_h), smith_g1(cos_i, q.a2)), q.g1), q.four_cos_o);
+        V cos_h, sin2_h;
+        half_angle(q, v_mul(hx, inverse), v_mul(hy, inverse), v_mul(hz, inverse), cos_h, sin2_h);
+        const V spec =
+            v_div(v_mul(v_mul(ggx_d<Kernel>(q, cos_h, sin2_h), smith_g1(cos_i, q.a2)), q.g1), q.four_cos_o);
         const V lobe = v_and(q.specular_lanes, v_cmpgt(q.cos_o, zero));
         r = v_select(lobe, v_add(r, v_mul(q.ks_r, spec)), r);
         g = v_select(lobe, v_add(g, v_mul(q.ks_g, spec)), g);

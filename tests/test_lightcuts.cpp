@@ -245,7 +245,7 @@ TEST(LightcutsBounds, GgxBoundIsTighterThanThePeak) {
     glm::vec3 n(0, 0, 1), wo = glm::normalize(glm::vec3(1, 0, 1));
     glm::vec3 lo(2.9f, -0.1f, 2.9f), hi(3.1f, 0.1f, 3.1f);  // along wo, far from the mirror (-1, 0, 1)
     float bound = k.lc_ggx_bound(m, lo, hi, glm::vec3(0.0f), n, wo);
-    float peak = k.lc_ggx_d(1.0f, m.alpha) * k.lc_smith_g1(wo.z, m.alpha) / (4.0f * wo.z);
+    float peak = k.lc_ggx_d(1.0f, 0.0f, m.alpha) * k.lc_smith_g1(wo.z, m.alpha) / (4.0f * wo.z);
     EXPECT_LT(bound, 1e-3f * peak);
     // And a cluster around the mirror direction gets the peak.
     glm::vec3 lo2(-3.1f, -0.1f, 2.9f), hi2(-2.9f, 0.1f, 3.1f);

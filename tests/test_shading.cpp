@@ -60,7 +60,7 @@ TEST(ShadingGgx, NormalDistributionIsNormalised) {
         for (int i = 0; i < steps; ++i) {
             const double t = (double(i) + 0.5) / steps;  // 1 - cos(theta_h)
             const double mu = 1.0 - t;
-            integral += double(k.lc_ggx_d(float(mu), alpha)) * mu * (2.0 * kPi / steps);
+            integral += double(k.lc_ggx_d(float(mu), float(t * (2.0 - t)), alpha)) * mu * (2.0 * kPi / steps);
         }
         EXPECT_NEAR(integral, 1.0, 2e-3) << "alpha " << alpha;
     }

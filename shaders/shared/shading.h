@@ -203,15 +203,25 @@ struct ShadeStats {
 // --- BRDF: Lambert kd/pi plus GGX with constant Fresnel ks and separable
 // Smith shadowing. The returned value is f * cos(theta_i); the GGX term is
 // written as D * G1(wi) * G1(wo) / (4 cos_o) so no division by cos_i occurs.
-float lc_ggx_d(float cos_h, float alpha) {
+float lc_ggx_d(float cos_h, float sin2_h, float alpha) {
     float a2 = alpha * alpha;
-    float c2 = cos_h * cos_h;
     // 1 + (a2 - 1) c2 written as sin^2 + a2 cos^2: the textbook form rounds
     // (a2 - 1) + 1 at the peak, which for alpha = 1e-3 put the radiance at
     // normal incidence 2.6% low (tests/test_shading.cpp); this form is exact
-    // there.
-    float denom = (1.0f - c2) + a2 * c2;
+    // there. The caller gives sin^2 (lc_half_angle).
+    float denom = sin2_h + a2 * (cos_h * cos_h);
     return a2 / (kPi * denom * denom);
+}
+
+// The cosine of the angle between the unit normal n and the unit half
+// vector h, and its sine squared, for lc_ggx_d and lc_gtr1_d. The sine
+// comes from the cross product: near a sharp highlight's peak, where sin^2
+// is about alpha^2 (1e-6 at the floor), cos rounds to within an ulp of 1
+// or above it, and 1 - cos^2 was off by as much as sin^2 itself (D came
+// out up to 3.65 times its peak at alpha = 1e-3).
+vec2 lc_half_angle(vec3 n, vec3 h) {
+    vec3 s = cross(n, h);
+    return vec2(clamp(dot(n, h), 0.0f, 1.0f), dot(s, s));
 }
 
 float lc_smith_g1(float cos_v, float alpha) {
@@ -249,10 +259,13 @@ vec3 lc_disney_tint(LC_IN(Material) m) {
     return lum > 0.0f ? base / lum : vec3(1.0f);
 }
 
-// Reflectance of the specular lobe at normal incidence.
+// Reflectance of the specular lobe at normal incidence, at most 1: a
+// saturated base colour's tint reaches 1 / 0.0722 (pure blue), which with
+// specular and specular_tint 1 made 1.108 (lc_disney_bound takes Schlick's
+// Fresnel to grow with its weight, true only up to 1).
 vec3 lc_disney_spec0(LC_IN(Material) m) {
     vec3 tinted = mix(vec3(1.0f), lc_disney_tint(m), m.specular_tint);
-    return mix(tinted * (0.08f * m.specular), lc_kd(m), m.metallic);
+    return min(mix(tinted * (0.08f * m.specular), lc_kd(m), m.metallic), vec3(1.0f));
 }
 
 vec3 lc_disney_sheen_color(LC_IN(Material) m) {
@@ -264,10 +277,9 @@ LC_KCONST float kClearcoatSmithAlpha = 0.25f;
 
 // Burley's GTR1 (Berry) distribution for alpha < 1; grows with cos_h like
 // GGX. The denominator written as in lc_ggx_d.
-float lc_gtr1_d(float cos_h, float alpha) {
+float lc_gtr1_d(float cos_h, float sin2_h, float alpha) {
     float a2 = alpha * alpha;
-    float c2 = cos_h * cos_h;
-    return (a2 - 1.0f) / (kPi * log(a2) * ((1.0f - c2) + a2 * c2));
+    return (a2 - 1.0f) / (kPi * log(a2) * (sin2_h + a2 * (cos_h * cos_h)));
 }
 
 // The diffuse lobe times cos_i, for a given F_D90.
@@ -287,15 +299,16 @@ vec3 lc_disney_brdf_cos(LC_IN(Material) m, vec3 n, vec3 wi, vec3 wo, float cos_i
     float cos_o = dot(n, wo);
     if (!(cos_o > 0.0f)) return vec3(0.0f);
     vec3 h = normalize(wi + wo);  // wi and wo are both above n, so wi + wo != 0
-    float cos_h = max(dot(n, h), 0.0f);
+    vec2 half_angle = lc_half_angle(n, h);
     float cos_d = clamp(dot(wi, h), 0.0f, 1.0f);
     float w = lc_schlick_weight(cos_d);
     vec3 value = lc_disney_diffuse(m, 0.5f + 2.0f * m.roughness * cos_d * cos_d, cos_i, cos_o);
     value += mix(lc_disney_spec0(m), vec3(1.0f), w) *
-             lc_microfacet_cos(lc_ggx_d(cos_h, m.alpha), cos_i, cos_o, m.alpha);
+             lc_microfacet_cos(lc_ggx_d(half_angle.x, half_angle.y, m.alpha), cos_i, cos_o, m.alpha);
     if (kEnableSheen && (m.flags & kMaterialHasSheen) != 0u) value += lc_disney_sheen_color(m) * (w * cos_i);
     if (kEnableClearcoat && (m.flags & kMaterialHasClearcoat) != 0u) {
-        float coat = lc_microfacet_cos(lc_gtr1_d(cos_h, lc_clearcoat_alpha(m)), cos_i, cos_o, kClearcoatSmithAlpha);
+        float coat = lc_microfacet_cos(lc_gtr1_d(half_angle.x, half_angle.y, lc_clearcoat_alpha(m)), cos_i, cos_o,
+                                       kClearcoatSmithAlpha);
         value += vec3(0.25f * m.clearcoat * mix(0.04f, 1.0f, w) * coat);
     }
     return value;
@@ -308,9 +321,8 @@ vec3 lc_brdf_cos(LC_IN(Material) m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
     if (kEnableGgx && (m.flags & kMaterialHasSpecular) != 0u) {
         float cos_o = dot(n, wo);
         if (cos_o > 0.0f) {
-            vec3 h = normalize(wi + wo);
-            float cos_h = max(dot(n, h), 0.0f);
-            float spec = lc_ggx_d(cos_h, m.alpha) * lc_smith_g1(cos_i, m.alpha) *
+            vec2 half_angle = lc_half_angle(n, normalize(wi + wo));
+            float spec = lc_ggx_d(half_angle.x, half_angle.y, m.alpha) * lc_smith_g1(cos_i, m.alpha) *
                          lc_smith_g1(cos_o, m.alpha) / (4.0f * cos_o);
             value += lc_ks(m) * spec;
         }
@@ -497,7 +509,7 @@ float lc_ggx_bound(LC_IN(Material) m, vec3 box_min, vec3 box_max, vec3 x, vec3 n
     float cos_o = dot(n, wo);
     if (cos_o <= 0.0f) return 0.0f;
     float cos_h_max = lc_cos_h_max(lc_box_cone(box_min, box_max, x), n, wo, cos_o);
-    return lc_ggx_d(cos_h_max, m.alpha) * lc_smith_g1(cos_o, m.alpha) / (4.0f * cos_o) *
+    return lc_ggx_d(cos_h_max, 1.0f - cos_h_max * cos_h_max, m.alpha) * lc_smith_g1(cos_o, m.alpha) / (4.0f * cos_o) *
            kBoundSlack;
 }
 
@@ -616,11 +628,12 @@ vec3 lc_disney_bound(LC_IN(Material) m, vec3 box_min, vec3 box_max, vec3 x, vec3
 #endif
     float w = lc_schlick_weight(cos_d.x);
     float cos_h_max = lc_cos_h_max(cone, n, wo, cos_o);
-    float ggx = lc_ggx_d(cos_h_max, m.alpha) * lc_smith_g1(cos_o, m.alpha) / (4.0f * cos_o);
+    float sin2_h_min = 1.0f - cos_h_max * cos_h_max;
+    float ggx = lc_ggx_d(cos_h_max, sin2_h_min, m.alpha) * lc_smith_g1(cos_o, m.alpha) / (4.0f * cos_o);
     bound += mix(lc_disney_spec0(m), vec3(1.0f), w) * ggx;
     if (kEnableSheen && (m.flags & kMaterialHasSheen) != 0u) bound += lc_disney_sheen_color(m) * (w * cos_bound);
     if (kEnableClearcoat && (m.flags & kMaterialHasClearcoat) != 0u) {
-        float coat = lc_gtr1_d(cos_h_max, lc_clearcoat_alpha(m)) * lc_smith_g1(cos_o, kClearcoatSmithAlpha) /
+        float coat = lc_gtr1_d(cos_h_max, sin2_h_min, lc_clearcoat_alpha(m)) * lc_smith_g1(cos_o, kClearcoatSmithAlpha) /
                      (4.0f * cos_o);
         bound += vec3(0.25f * m.clearcoat * mix(0.04f, 1.0f, w) * coat);
     }
