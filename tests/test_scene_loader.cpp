@@ -323,6 +323,24 @@ TEST(SceneLoader, MtllibMustNameARegularFile) {
     }
 }
 
+// A mesh file that cannot be looked at says why, not "file not found"; an
+// empty name is refused as such (it named the scene's folder).
+TEST(SceneLoader, MeshFileProblemsSayWhat) {
+    TempDir dir;
+    fs::create_symlink("loop_b.obj", dir.path() / "loop_a.obj");
+    fs::create_symlink("loop_a.obj", dir.path() / "loop_b.obj");
+    for (const auto& [obj, problem] :
+         {std::pair<std::string, std::string>{"loop_a.obj", "meshes[0].obj: '" +
+                                                                (dir.path() / "loop_a.obj").lexically_normal().string() +
+                                                                "' cannot be looked at: Too many levels of symbolic links"},
+          {"", "meshes[0].obj: is empty: it must name a file"}}) {
+        const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": ")" + obj + R"("}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+        const std::string message = input_error_of([&] { load_scene(scene); });
+        EXPECT_NE(message.find(problem), std::string::npos) << message;
+    }
+}
+
 // camera.up only gives a direction: one whose float length under- or
 // overflows (its square is out of float range) is used, as a unit vector;
 // only zero is refused.
@@ -1101,6 +1119,8 @@ const CsvError kCsvErrors[] = {
     {"empty_field", "1,2,,4,5,6\n", "line 1: ", "column 3 (z): '' is not a number"},
     {"not_a_number", "1,2,3,4,5,6\n1,2,3,4,five,6\n", "line 2: ", "'five' is not a number"},
     {"trailing_junk", "1,2,3,4,5,6x\n", "line 1: ", "is not a number"},
+    {"sign_after_plus", "1,2,3,4,5,6\n+-1,2,3,4,5,6\n", "line 2: ", "column 1 (x): '+-1' is not a number"},
+    {"signs_after_plus", "1,2,3,++0,5,6\n", "line 1: ", "column 4 (r): '++0' is not a number"},
     {"typo_in_first_line_is_not_a_header", "1,2,3,4,5,x\n1,2,3,4,5,6\n", "line 1: ", "'x' is not a number"},
     {"second_header", "x,y,z,r,g,b\n1,2,3,4,5,6\nx,y,z,r,g,b\n", "line 3: ", "is not a number"},
     {"nan", "1,2,3,nan,5,6\n", "line 1: ", "column 4 (r): 'nan' is not finite"},

@@ -276,7 +276,16 @@ TEST(ObjTextures, MissingOrBrokenTextureNamesTheFiles) {
     } catch (const InputError& e) {
         const std::string message = e.what();
         EXPECT_EQ(message.rfind(obj + ": material 'paint'.norm: texture '", 0), 0u) << message;
-        EXPECT_NE(message.find("garbage.png' cannot be decoded as PNG or JPEG"), std::string::npos) << message;
+        EXPECT_NE(message.find("garbage.png' is neither a PNG nor a JPEG file"), std::string::npos) << message;
+    }
+    dir.write("broken.jpg", "\xFF\xD8\xFF\xE0 then no JPEG");
+    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd broken.jpg\n");
+    try {
+        load_scene(scene);
+        FAIL() << "no error";
+    } catch (const InputError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find("broken.jpg' cannot be decoded as PNG or JPEG"), std::string::npos) << message;
     }
 }
 
@@ -309,13 +318,18 @@ std::string png_header(std::uint32_t width, std::uint32_t height, const std::str
 // decoding); so is a PNG whose chunk claims more bytes than the file has
 // (stb_image reserved them first). Through an MTL and through glTF.
 TEST(TextureLimits, OversizedOrTruncatedImagesAreRefusedFromTheirHeaders) {
-    EXPECT_EQ(loader::encoded_image_problem(nullptr, 0), "");
+    const auto problem = [](const std::string& bytes) {
+        return loader::encoded_image_problem(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
+    };
     const std::string small = png_header(2, 2);
-    EXPECT_EQ(loader::encoded_image_problem(reinterpret_cast<const unsigned char*>(small.data()), small.size()), "");
+    EXPECT_EQ(problem(small), "");
+    // A size stb_image does not say (over 2^24 a side), from the PNG's
+    // header chunk.
+    EXPECT_EQ(problem(png_header(100000, 100000)),
+              "is 100000 x 100000 texels, more than the 134217728 that textures may hold in all");
     // Cut between chunks (stb_image's reason named the last chunk type it
     // read, bytes of the file): the IHDR chunk and nothing after it.
-    const std::string headless = small.substr(0, 8 + 25);
-    EXPECT_EQ(loader::encoded_image_problem(reinterpret_cast<const unsigned char*>(headless.data()), headless.size()),
+    EXPECT_EQ(problem(small.substr(0, 8 + 25)),
               "is a corrupt or truncated PNG: it ends after 1 chunk without the IEND chunk that closes a PNG");
 
     TempDir dir;
@@ -336,7 +350,8 @@ TEST(TextureLimits, OversizedOrTruncatedImagesAreRefusedFromTheirHeaders) {
                                        ? "big.png' is 16384 x 16384 texels, more than the 134217728 that "
                                          "textures may hold in all"
                                        : "cut.png' is a corrupt or truncated PNG: chunk 2 claims 1073741824 "
-                                         "bytes, 25 are left"),
+                                         "bytes of data, 1073741836 with its length, type and CRC, and 25 are "
+                                         "left"),
                       std::string::npos)
                 << message;
         }
@@ -350,6 +365,37 @@ TEST(TextureLimits, OversizedOrTruncatedImagesAreRefusedFromTheirHeaders) {
         EXPECT_EQ(std::string(e.what()), gltf.lexically_normal().string() +
                                              ": tinygltf: images[0] is 16384 x 16384 texels, more than the "
                                              "134217728 that textures may hold in all");
+    }
+}
+
+// Textures are PNG or JPEG: stb_image's decoders of other formats (BMP,
+// GIF, TGA, PSD, PIC, PNM, HDR) are not reached, whatever the file is
+// called. An empty file is neither.
+TEST(TextureLimits, OnlyPngAndJpegAreDecoded) {
+    const auto problem = [](const std::string& bytes) {
+        return loader::encoded_image_problem(reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
+    };
+    const std::string neither = "is neither a PNG nor a JPEG file (textures must be one or the other)";
+    EXPECT_EQ(problem(""), neither);
+    for (const std::string& bytes : {std::string("BM\x46\0\0\0\0\0\0\0\x36\0\0\0", 14), std::string("GIF89a\x01\0\x01\0"),
+                                     std::string("P6\n1 1\n255\nabc"), std::string("#?RADIANCE\n")})
+        EXPECT_EQ(problem(bytes), neither) << bytes;
+    EXPECT_EQ(problem(std::string("\xFF\xD8\xFF\xE0", 4)), "");  // a JPEG's start: decoding says the rest
+
+    TempDir dir;
+    // A real GIF (1x1), which stb_image would decode.
+    dir.write("tex.gif", std::string("GIF89a\x01\0\x01\0\x80\0\0\xff\xff\xff\0\0\0,\0\0\0\0\x01\0\x01\0\0\x02\x02D\x01\0;", 35));
+    dir.write("quad.obj", kTexturedObj);
+    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd tex.gif\n");
+    const std::filesystem::path scene = dir.write("scene.json", quad_scene_json());
+    try {
+        load_scene(scene);
+        FAIL() << "a GIF texture loaded";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("material 'paint'.map_Kd: texture '" +
+                                             (dir.path() / "tex.gif").lexically_normal().string() + "' " + neither),
+                  std::string::npos)
+            << e.what();
     }
 }
 

@@ -52,7 +52,11 @@ std::string_view trim(std::string_view s) {
 enum class FieldStatus { ok, not_a_number, out_of_range };
 
 FieldStatus parse_float(std::string_view text, float& out) {
-    if (!text.empty() && text.front() == '+') text.remove_prefix(1);  // from_chars rejects '+'
+    // from_chars rejects a leading '+', and would read a sign after it.
+    if (!text.empty() && text.front() == '+') {
+        text.remove_prefix(1);
+        if (!text.empty() && (text.front() == '+' || text.front() == '-')) return FieldStatus::not_a_number;
+    }
     if (text.empty()) return FieldStatus::not_a_number;
     const char* end = text.data() + text.size();
     const auto [ptr, ec] = std::from_chars(text.data(), end, out);

@@ -2,6 +2,8 @@
 #include "input_file.h"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 
 #include "huge_pages.h"
@@ -35,6 +37,10 @@ std::string input_file_problem(const fs::path& path) {
     std::error_code ec;
     const fs::file_status status = fs::status(path, ec);
     if (fs::is_regular_file(status)) return "";
+    // A path that cannot be looked at (a folder on it without search
+    // permission, a loop of symbolic links, a name too long) says why.
+    if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory)
+        return "cannot be looked at: " + ec.message();
     switch (status.type()) {
         case fs::file_type::not_found:
         case fs::file_type::none: return kFileNotFound;
@@ -51,8 +57,10 @@ std::string input_file_problem(const fs::path& path) {
 std::string read_input_file(const fs::path& path) {
     const std::string name = display(path);
     if (const std::string problem = input_file_problem(path); !problem.empty()) throw InputError(name, "", problem);
+    errno = 0;
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw InputError(name, "", "cannot read file");
+    if (!in) throw InputError(name, "", errno != 0 ? std::string("cannot read file: ") + std::strerror(errno)
+                                                   : std::string("cannot read file"));
     in.seekg(0, std::ios::end);
     const std::streamoff size = in.tellg();
     if (size < 0) throw InputError(name, "", "cannot read file");

@@ -85,6 +85,7 @@ private:
     // A file the scene names, relative to the scene's folder. A NUL would
     // end the name where the system reads it, and another file be opened.
     fs::path resolve(const std::string& relative, const std::string& field) const {
+        if (relative.empty()) in_.fail(field, "is empty: it must name a file");
         if (relative.find('\0') != std::string::npos) in_.fail(field, "the file name contains a NUL character");
         return dir_ / relative;
     }

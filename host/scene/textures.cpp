@@ -36,20 +36,31 @@ std::uint32_t add_texture(Scene& scene, std::uint32_t width, std::uint32_t heigh
 }
 
 std::string encoded_image_problem(const unsigned char* bytes, std::size_t size) {
-    // A PNG's chunks, each a 4-byte big-endian length, a 4-byte type, the
-    // data and a CRC, must lie inside the file: stb_image reserves an IDAT
-    // chunk's length before it finds the data missing (1.2 GB for a 70-byte
-    // file in the fuzzer's corpus).
     static constexpr unsigned char kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-    if (size >= 8 && std::equal(kPngSignature, kPngSignature + 8, bytes)) {
+    const bool png = size >= 8 && std::equal(kPngSignature, kPngSignature + 8, bytes);
+    // Only PNG and JPEG (whose files start FF D8 FF): stb_image would
+    // decode BMP, GIF, TGA, PSD, PIC, PNM and HDR files as well, and no
+    // scene has a use for its decoders of those.
+    if (!png && !(size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF))
+        return "is neither a PNG nor a JPEG file (textures must be one or the other)";
+    const auto big_endian = [&](std::size_t at) {
+        return std::uint64_t(bytes[at]) << 24 | std::uint64_t(bytes[at + 1]) << 16 |
+               std::uint64_t(bytes[at + 2]) << 8 | bytes[at + 3];
+    };
+    std::uint64_t w = 0, h = 0;
+    if (png) {
+        // A PNG's chunks, each a 4-byte big-endian length, a 4-byte type,
+        // the data and a CRC, must lie inside the file: stb_image reserves
+        // an IDAT chunk's length before it finds the data missing (1.2 GB
+        // for a 70-byte file in the fuzzer's corpus).
         std::size_t chunk = 0;
         bool ended = false;
         for (std::size_t at = 8; at + 8 <= size; ++chunk) {
-            const std::uint64_t length = std::uint64_t(bytes[at]) << 24 | std::uint64_t(bytes[at + 1]) << 16 |
-                                         std::uint64_t(bytes[at + 2]) << 8 | bytes[at + 3];
+            const std::uint64_t length = big_endian(at);
             if (length + 12 > size - at)
                 return "is a corrupt or truncated PNG: chunk " + std::to_string(chunk + 1) + " claims " +
-                       std::to_string(length) + " bytes, " + std::to_string(size - at) + " are left";
+                       std::to_string(length) + " bytes of data, " + std::to_string(length + 12) +
+                       " with its length, type and CRC, and " + std::to_string(size - at) + " are left";
             if (std::equal(bytes + at + 4, bytes + at + 8, "IEND")) {
                 ended = true;
                 break;
@@ -61,12 +72,20 @@ std::string encoded_image_problem(const unsigned char* bytes, std::size_t size) 
         if (!ended)
             return "is a corrupt or truncated PNG: it ends after " + std::to_string(chunk) +
                    (chunk == 1 ? " chunk" : " chunks") + " without the IEND chunk that closes a PNG";
+        // The size from the header chunk itself: stb_image does not say one
+        // above 2^24 a side.
+        if (!std::equal(bytes + 12, bytes + 16, "IHDR")) return "";  // decoding says what is wrong
+        w = big_endian(16);
+        h = big_endian(20);
+    } else {
+        int iw = 0, ih = 0, channels = 0;
+        if (size > std::size_t(std::numeric_limits<int>::max()) ||
+            stbi_info_from_memory(bytes, int(size), &iw, &ih, &channels) == 0)
+            return "";
+        w = std::uint64_t(iw);
+        h = std::uint64_t(ih);
     }
-    int w = 0, h = 0, channels = 0;
-    if (size == 0 || size > std::size_t(std::numeric_limits<int>::max()) ||
-        stbi_info_from_memory(bytes, int(size), &w, &h, &channels) == 0)
-        return "";
-    if (std::uint64_t(w) * std::uint64_t(h) <= kMaxTexels) return "";
+    if (w * h <= kMaxTexels) return "";
     return "is " + std::to_string(w) + " x " + std::to_string(h) + " texels, more than the " +
            std::to_string(kMaxTexels) + " that textures may hold in all";
 }

@@ -27,9 +27,9 @@ std::uint32_t load_texture(Scene& scene, const std::filesystem::path& image, con
 // All textures of a scene together hold at most this many texels (512 MiB).
 inline constexpr std::uint64_t kMaxTexels = std::uint64_t(1) << 27;
 
-// What is wrong with an encoded PNG or JPEG's size, read from its header
-// before anything is decoded, or "" (also where stb_image does not know the
-// format: decoding then says why). stb_image allocates the pixels a header
+// What is wrong with an encoded image before anything is decoded: not a PNG
+// or a JPEG, a PNG's chunks not inside the file, or the size its header
+// declares; or "" (decoding then says what else may be wrong). stb_image allocates the pixels a header
 // declares however small the file: a 1 MB PNG of 16384 x 16384 zeros took
 // 2 GB and 8.5 s to decode before kMaxTexels refused it.
 std::string encoded_image_problem(const unsigned char* bytes, std::size_t size);
