@@ -200,14 +200,18 @@ LC_ALWAYS_INLINE inline V ggx_d(const QuadLanes& q, V cos_h, V sin2_h) {
 LC_ALWAYS_INLINE inline V one_minus_square(V cos_h) { return v_sub(v_set1(1.0f), v_mul(cos_h, cos_h)); }
 
 // lc_half_angle(n, h) at each lane's point for the unit half vector h:
-// clamp(dot(n, h), 0, 1) into cos_h, and the square of glm's cross(n, h)
-// into sin2_h.
+// clamp(dot(n, h), 0, 1) into cos_h, and into sin2_h 1 - cos_h^2, or where
+// that is below kHalfAngleCross the square of glm's cross(n, h).
+template <class Kernel>
 LC_ALWAYS_INLINE inline void half_angle(const QuadLanes& q, V h_x, V h_y, V h_z, V& cos_h, V& sin2_h) {
     cos_h = v_min(v_max(dot4(q.nx, q.ny, q.nz, h_x, h_y, h_z), v_zero()), v_set1(1.0f));
+    sin2_h = one_minus_square(cos_h);
+    const V near_peak = v_cmpgt(v_set1(Kernel::kHalfAngleCross), sin2_h);
+    if (v_movemask(near_peak) == 0) return;
     const V s_x = v_sub(v_mul(q.ny, h_z), v_mul(h_y, q.nz));
     const V s_y = v_sub(v_mul(q.nz, h_x), v_mul(h_z, q.nx));
     const V s_z = v_sub(v_mul(q.nx, h_y), v_mul(h_x, q.ny));
-    sin2_h = dot4(s_x, s_y, s_z, s_x, s_y, s_z);
+    sin2_h = v_select(near_peak, dot4(s_x, s_y, s_z, s_x, s_y, s_z), sin2_h);
 }
 
 // lc_ggx_bound of each lane's box at its point: lc_box_cone, lc_cos_h_max,
@@ -322,7 +326,7 @@ LC_ALWAYS_INLINE inline void disney_values(const QuadLanes& q, V wi_x, V wi_y, V
     const V inverse = v_div(one, v_sqrt(dot4(s_x, s_y, s_z, s_x, s_y, s_z)));
     const V h_x = v_mul(s_x, inverse), h_y = v_mul(s_y, inverse), h_z = v_mul(s_z, inverse);
     V cos_h, sin2_h;
-    half_angle(q, h_x, h_y, h_z, cos_h, sin2_h);
+    half_angle<Kernel>(q, h_x, h_y, h_z, cos_h, sin2_h);
     const V cos_d = v_min(v_max(dot4(wi_x, wi_y, wi_z, h_x, h_y, h_z), zero), one);
     const V w = schlick_weight(cos_d);
     // The diffuse lobe (lc_disney_diffuse).
@@ -530,7 +534,7 @@ LC_ALWAYS_INLINE inline V light_values(const QuadLanes& q, const LightLanes& l, 
         const V hx = v_add(wi_x, q.wox), hy = v_add(wi_y, q.woy), hz = v_add(wi_z, q.woz);
         const V inverse = v_div(one, v_sqrt(dot4(hx, hy, hz, hx, hy, hz)));
         V cos_h, sin2_h;
-        half_angle(q, v_mul(hx, inverse), v_mul(hy, inverse), v_mul(hz, inverse), cos_h, sin2_h);
+        half_angle<Kernel>(q, v_mul(hx, inverse), v_mul(hy, inverse), v_mul(hz, inverse), cos_h, sin2_h);
         const V spec =
             v_div(v_mul(v_mul(ggx_d<Kernel>(q, cos_h, sin2_h), smith_g1(cos_i, q.a2)), q.g1), q.four_cos_o);
         const V lobe = v_and(q.specular_lanes, v_cmpgt(q.cos_o, zero));

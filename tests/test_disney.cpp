@@ -101,12 +101,12 @@ TEST(Disney, MatchesBurleysFormulas) {
 // Sharp highlights: roughness 0 to 0.3 (alpha from its floor 1e-3) and
 // clearcoat gloss 0.5 to 1, wi within a few alpha of wo's mirror direction
 // about a random normal, where D is 1e5 times its value a few degrees off.
-// The kernel takes sin^2(theta_h) from the cross product, exact to about
-// 1e-7 of each component, so that near the peak, where sin^2 is about
-// alpha^2, D is off by about 4e-7 / alpha relative at worst; the largest
-// relative difference over these trials was 3.3e-4. Taking sin^2 as
-// 1 - cos^2 (and cos_h unclamped, a few ulps above 1) put D up to 3.65
-// times its peak.
+// Near the peak the kernel takes sin^2(theta_h) from the cross product
+// (lc_half_angle), exact to about 1e-7 of each component, so that where
+// sin^2 is about alpha^2 D is off by about 4e-7 / alpha relative at worst;
+// the largest relative difference over these trials was 1.5e-4. Taking
+// sin^2 as 1 - cos^2 there (and cos_h unclamped, a few ulps above 1) put D
+// up to 3.65 times its peak.
 TEST(Disney, SharpHighlightsMatchBurleysFormulas) {
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
