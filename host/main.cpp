@@ -331,7 +331,26 @@ int main(int argc, char** argv) {
     info->add_option("--area-samples", info_area_samples, "Point lights the emissive surfaces become, as render's")
         ->transform(setting(lc::kSettingAreaLightSamples));
 
-    CLI11_PARSE(app, argc, argv);
+    // A first word that is neither a subcommand nor an option: CLI11 would
+    // say only that a subcommand is required.
+    if (argc > 1 && argv[1][0] != '-') {
+        const std::vector<CLI::App*> commands = app.get_subcommands([](CLI::App*) { return true; });
+        if (std::none_of(commands.begin(), commands.end(), [&](CLI::App* c) { return c->check_name(argv[1]); })) {
+            std::string names;
+            for (const CLI::App* c : commands) names += (names.empty() ? "" : ", ") + c->get_name();
+            std::fprintf(stderr, "error: unknown command '%s' (the commands are %s)\n", argv[1], names.c_str());
+            return 1;
+        }
+    }
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        // --help and the like exit 0 and print as CLI11 does; errors read
+        // as every other error does.
+        if (e.get_exit_code() == 0) return app.exit(e);
+        std::fprintf(stderr, "error: %s\nRun with --help for more information.\n", e.what());
+        return e.get_exit_code();
+    }
     // Ctrl-C or a kill during a render leaves no temporary beside its outputs.
     lc::remove_temporaries_on_signal();
     try {

@@ -231,6 +231,9 @@ expect_error '--cut-sharing: must be "auto", "pixel", "quad" or "octet", got "ti
 expect_error '--method: must be "brute", "lightcuts", "sampled", "stochastic" or "path", got "fast"' render "$mini" -o "$tmp/edge2.exr" --method fast
 expect_error '--light-pick: must be "tree", "uniform" or "power", got "random"' render "$mini" -o "$tmp/edge2.exr" --light-pick random
 expect_error '--device: must be "auto", "cpu" or "vulkan"' render "$mini" -o "$tmp/edge2.exr" --device gpu
+# The command line's own errors read as the others do.
+expect_error "error: unknown command 'frobnicate' (the commands are render, compare, info)" frobnicate "$mini"
+expect_error "error: --width: must be an integer from 1 to 16384" render "$mini" -o "$tmp/edge2.exr" --width=+8
 [ -e "$tmp/edge2.exr" ] && fail "a refused render left edge2.exr behind"
 
 # --device auto without any Vulkan driver renders on the CPU and says so in
