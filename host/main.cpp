@@ -89,6 +89,33 @@ lc::RenderOptions render_options(const RenderArgs& a, const lc::Scene& scene) {
     return o;
 }
 
+// The options given on the command line that the method does not use, as
+// one note ("" if none): a render that ignores what it was told says so.
+std::string unused_options_note(const RenderArgs& a, const std::string& method) {
+    const bool cuts = method == "lightcuts" || method == "stochastic";
+    const struct {
+        bool given, used;
+        const char* name;
+    } options[] = {
+        {a.relative_error.has_value(), cuts, "--error"},
+        {a.max_cut.has_value(), cuts, "--max-cut"},
+        {a.cut_heap.has_value(), cuts, "--cut-heap"},
+        {!a.cut_sharing.empty(), method == "lightcuts", "--cut-sharing"},
+        {a.light_samples.has_value(), method == "sampled" || method == "stochastic" || method == "path",
+         "--light-samples"},
+        {!a.light_pick.empty(), method == "sampled", "--light-pick"},
+        {a.max_bounces.has_value(), method == "path", "--max-bounces"},
+        {a.time_limit.has_value(), method == "path", "--time-limit"},
+        {a.vpls.has_value(), method != "path", "--vpls"},
+        {a.vpl_bounces.has_value(), method != "path", "--vpl-bounces"},
+        {a.vpl_clamp.has_value(), method != "path", "--vpl-clamp"},
+    };
+    std::string unused;
+    for (const auto& o : options)
+        if (o.given && !o.used) unused += std::string(unused.empty() ? "" : ", ") + o.name;
+    return unused.empty() ? "" : "method " + method + " does not use " + unused;
+}
+
 // What the loader dropped or left out, on stderr before anything else.
 void print_load_notes(const std::string& file, const lc::Scene& scene) {
     if (scene.degenerate_triangles_dropped)
@@ -118,6 +145,8 @@ int run_render(RenderArgs a) {
     // The path tracer finds indirect light itself: VPLs would only cost time.
     if (options.method == "path") scene.render.indirect.vpls = 0;
     lc::validate_render_options(options);
+    if (const std::string note = unused_options_note(a, options.method); !note.empty())
+        std::fprintf(stderr, "note: %s\n", note.c_str());
     if (const std::string problem = lc::vulkan_options_problem(a.device, options.method); !problem.empty())
         throw std::invalid_argument(problem);
     // Every output is checked and reserved before the render; none is left if any fails.

@@ -231,6 +231,12 @@ expect_error '--cut-sharing: must be "auto", "pixel", "quad" or "octet", got "ti
 expect_error '--method: must be "brute", "lightcuts", "sampled", "stochastic" or "path", got "fast"' render "$mini" -o "$tmp/edge2.exr" --method fast
 expect_error '--light-pick: must be "tree", "uniform" or "power", got "random"' render "$mini" -o "$tmp/edge2.exr" --light-pick random
 expect_error '--device: must be "auto", "cpu" or "vulkan"' render "$mini" -o "$tmp/edge2.exr" --device gpu
+# Options the method does not use are named in one note.
+"$exe" render "$mini" -o "$tmp/unused.exr" --no-png --device cpu --width 2 --height 2 --method brute \
+  --error 0.1 --time-limit 5 --light-pick uniform >/dev/null 2>"$tmp/unused.txt" ||
+  fail "unused options: $(cat "$tmp/unused.txt")"
+grep -qx "note: method brute does not use --error, --light-pick, --time-limit" "$tmp/unused.txt" ||
+  fail "unused options said: $(cat "$tmp/unused.txt")"
 # The command line's own errors read as the others do.
 expect_error "error: unknown command 'frobnicate' (the commands are render, compare, info)" frobnicate "$mini"
 expect_error "error: --width: must be an integer from 1 to 16384" render "$mini" -o "$tmp/edge2.exr" --width=+8
