@@ -134,6 +134,7 @@ int run_render(RenderArgs a) {
     if (a.device.device == "auto" && a.device.vulkan.gpu.empty() && a.method != "path")
         a.device.devices = std::async(std::launch::async, lc::probe_gpus).share();
     const auto start = std::chrono::steady_clock::now();
+    a.scene_options.threads = a.threads;
     lc::Scene scene = lc::load_scene(a.scene, a.scene_options);
     const double load_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     print_load_notes(a.scene, scene);
@@ -319,8 +320,8 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
     render->add_option("--seed", r.seed, "Seed for pixel jitter, light-tree representatives and light samples")
         ->transform(setting(lc::kSettingSeed));
     render->add_option("--threads", r.threads,
-                       "CPU threads of the render, the area-light sampling, the VPLs and the light tree's build "
-                       "(0 = all cores)");
+                       "CPU threads of the render, the reading of light lists, the area-light sampling, the VPLs "
+                       "and the light tree's build (0 = all cores)");
     render->add_option("--device", r.device.device,
                        "auto (a hardware GPU through Vulkan, else the CPU path), cpu or vulkan")
         ->check(ask(lc::device_problem));

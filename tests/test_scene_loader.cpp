@@ -1145,7 +1145,7 @@ TEST_P(PointsCsvError, SameErrorInChunks) {
         SCOPED_TRACE(chunk_bytes);
         const std::string chunked = input_error_of([&] {
             loader::LightLimits limits;
-            loader::read_points_csv(file, limits, chunk_bytes);
+            loader::read_points_csv(file, limits, 0u, chunk_bytes);
         });
         EXPECT_EQ(chunked, whole);
     }
@@ -1169,13 +1169,14 @@ TEST(PointsCsv, SameLightsInChunks) {
     const fs::path file = dir.write("chunks.csv", text);
     const std::vector<gpu::Light> whole = load_points_csv(file);
     ASSERT_EQ(whole.size(), 201u);
-    for (std::size_t chunk_bytes : {1u, 7u, 64u, 1000u}) {
-        SCOPED_TRACE(chunk_bytes);
-        loader::LightLimits limits;
-        const std::vector<gpu::Light> chunked = loader::read_points_csv(file, limits, chunk_bytes);
-        ASSERT_EQ(chunked.size(), whole.size());
-        EXPECT_EQ(std::memcmp(chunked.data(), whole.data(), whole.size() * sizeof(gpu::Light)), 0);
-    }
+    for (std::size_t chunk_bytes : {1u, 7u, 64u, 1000u})
+        for (unsigned threads : {0u, 1u, 3u}) {
+            SCOPED_TRACE(std::to_string(chunk_bytes) + " bytes, " + std::to_string(threads) + " threads");
+            loader::LightLimits limits;
+            const std::vector<gpu::Light> chunked = loader::read_points_csv(file, limits, threads, chunk_bytes);
+            ASSERT_EQ(chunked.size(), whole.size());
+            EXPECT_EQ(std::memcmp(chunked.data(), whole.data(), whole.size() * sizeof(gpu::Light)), 0);
+        }
     EXPECT_EQ(whole.back().x, 9.0f);
     EXPECT_EQ(whole[199].y, -199.0f);
 }
@@ -1195,7 +1196,7 @@ TEST(PointsCsv, FirstErrorInFileOrderInChunks) {
         SCOPED_TRACE(chunk_bytes);
         const std::string message = input_error_of([&] {
             loader::LightLimits limits;
-            loader::read_points_csv(file, limits, chunk_bytes);
+            loader::read_points_csv(file, limits, 0u, chunk_bytes);
         });
         EXPECT_NE(message.find("line 52: "), std::string::npos) << message;
         EXPECT_NE(message.find("'x' is not a number"), std::string::npos) << message;

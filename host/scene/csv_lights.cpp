@@ -202,10 +202,11 @@ std::size_t line_of_light(const Chunk& chunk, std::size_t index) {
     return found;
 }
 
-// Runs fn(i) for i in [0, n) on up to one thread per core.
+// Runs fn(i) for i in [0, n) on up to `threads` threads (0: one per core).
 template <typename Fn>
-void for_each_index(std::size_t n, Fn fn) {
-    const std::size_t threads = std::min<std::size_t>(n, std::max(1u, std::thread::hardware_concurrency()));
+void for_each_index(std::size_t n, unsigned threads_asked, Fn fn) {
+    const unsigned cores = threads_asked != 0u ? threads_asked : std::max(1u, std::thread::hardware_concurrency());
+    const std::size_t threads = std::min<std::size_t>(n, cores);
     std::atomic<std::size_t> next{0};
     auto work = [&] {
         for (std::size_t i; (i = next.fetch_add(1)) < n;) fn(i);
@@ -222,7 +223,7 @@ void for_each_index(std::size_t n, Fn fn) {
 // first chunk that stopped. (At 10^7 lights the array is 458 MB: parsing
 // into chunks' own arrays and joining them took that twice over.)
 std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::path& file, LightLimits& limits,
-                                 std::size_t chunk_bytes) {
+                                 unsigned threads, std::size_t chunk_bytes) {
     const std::string name = display(file);
     const std::string text = read_input_file(file);
     std::string_view all = without_bom(text);  // spreadsheets write one
@@ -254,7 +255,7 @@ std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::pa
     }
     // Line numbers: each chunk starts after the newlines of those before it.
     std::vector<std::size_t> newlines(chunks.size());
-    for_each_index(chunks.size(), [&](std::size_t c) {
+    for_each_index(chunks.size(), threads, [&](std::size_t c) {
         newlines[c] = std::size_t(std::count(chunks[c].text.begin(), chunks[c].text.end(), '\n'));
     });
     // A chunk has at most one line more than newlines (the file's last line
@@ -268,7 +269,7 @@ std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::pa
     std::vector<gpu::Light> lights;
     reserve_huge(lights, room);
     lights.resize(room);
-    for_each_index(chunks.size(),
+    for_each_index(chunks.size(), threads,
                    [&](std::size_t c) { parse_chunk(format, name, chunks[c], lights.data() + chunks[c].first_light); });
 
     std::size_t count = 0;
@@ -289,21 +290,21 @@ std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::pa
 
 }  // namespace
 
-std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file, LightLimits& limits,
+std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file, LightLimits& limits, unsigned threads,
                                         std::size_t chunk_bytes) {
-    return read_csv(kPoints, file, limits, chunk_bytes);
+    return read_csv(kPoints, file, limits, threads, chunk_bytes);
 }
 
-std::vector<gpu::Light> read_spots_csv(const std::filesystem::path& file, LightLimits& limits,
+std::vector<gpu::Light> read_spots_csv(const std::filesystem::path& file, LightLimits& limits, unsigned threads,
                                        std::size_t chunk_bytes) {
-    return read_csv(kSpots, file, limits, chunk_bytes);
+    return read_csv(kSpots, file, limits, threads, chunk_bytes);
 }
 
 }  // namespace loader
 
 std::vector<gpu::Light> load_points_csv(const std::filesystem::path& file) {
     loader::LightLimits limits;
-    return loader::read_points_csv(file, limits);
+    return loader::read_points_csv(file, limits, 0u);
 }
 
 }  // namespace lc

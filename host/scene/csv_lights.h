@@ -10,18 +10,19 @@
 
 namespace lc::loader {
 
-// The file is parsed in chunks of about this many bytes, on every core.
+// The file is parsed in chunks of about this many bytes, on `threads`
+// threads (0: one per core).
 inline constexpr std::size_t kCsvChunkBytes = std::size_t(1) << 20;
 
 // load_points_csv (lightcuts/scene.h), with the totals and the box carried
 // over from the rest of the scene, so that an overflow is reported at the
 // CSV line that caused it. (chunk_bytes: tests cut small files into many
 // chunks; the lights and the first error are the same for any size.)
-std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file, LightLimits& limits,
+std::vector<gpu::Light> read_points_csv(const std::filesystem::path& file, LightLimits& limits, unsigned threads,
                                         std::size_t chunk_bytes = kCsvChunkBytes);
 
 // The same for spot lights, checked as a JSON spot is (light_records.h).
-std::vector<gpu::Light> read_spots_csv(const std::filesystem::path& file, LightLimits& limits,
+std::vector<gpu::Light> read_spots_csv(const std::filesystem::path& file, LightLimits& limits, unsigned threads,
                                        std::size_t chunk_bytes = kCsvChunkBytes);
 
 }  // namespace lc::loader

@@ -40,7 +40,8 @@ constexpr std::uint64_t kMaxEnvironmentPixels = std::uint64_t(1) << 27;
 
 class SceneParser {
 public:
-    explicit SceneParser(const fs::path& file) : file_(file), dir_(file.parent_path()), in_(display(file)) {}
+    SceneParser(const fs::path& file, unsigned threads)
+        : file_(file), dir_(file.parent_path()), in_(display(file)), threads_(threads) {}
 
     Scene parse() {
         const json root = parse_json_file(file_);
@@ -67,6 +68,7 @@ private:
     fs::path file_;
     fs::path dir_;
     JsonReader in_;
+    unsigned threads_;  // SceneOptions::threads
     Scene scene_;
     MeshTarget meshes_{scene_, {}, {}};
     LightLimits limits_;
@@ -382,7 +384,7 @@ private:
             in_.check_keys(j, path, {"type", "file"});
             const fs::path csv = existing_file(j, path, "file");
             std::vector<gpu::Light> loaded =
-                type == "points_csv" ? read_points_csv(csv, limits_) : read_spots_csv(csv, limits_);
+                type == "points_csv" ? read_points_csv(csv, limits_, threads_) : read_spots_csv(csv, limits_, threads_);
             if (scene_.lights.empty())
                 scene_.lights = std::move(loaded);  // no copy of a file of 10^7 lights
             else
@@ -476,7 +478,7 @@ Scene load_scene(const std::filesystem::path& file, const SceneOptions& options)
             if (!options.camera.empty())
                 throw InputError(loader::display(file), "",
                                  "--camera picks a camera of a glTF scene; a JSON scene has its own");
-            scene = loader::SceneParser(file).parse();
+            scene = loader::SceneParser(file, options.threads).parse();
         }
     }
     scene.input_files = std::move(inputs);

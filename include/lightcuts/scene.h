@@ -94,6 +94,8 @@ struct SceneOptions {
     // glTF scenes: the perspective camera of this name (empty: the first in
     // node order). A JSON scene has its own camera and refuses this.
     std::string camera;
+    // Threads that read light lists (CSV files); 0: one per core.
+    unsigned threads = 0;
 };
 
 // Loads a scene from JSON, or from a glTF 2.0 file (.gltf or .glb) on its
