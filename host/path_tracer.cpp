@@ -196,7 +196,7 @@ PathTracer::PathTracer(const PreparedScene& prepared, const RenderOptions& optio
       emitters_(prepared.scene),
       kernel_(cpu::make_shade_kernel(prepared, nullptr)) {}
 
-glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, std::uint64_t& shadow_rays,
+glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, PathRays& rays,
                              std::uint32_t j) const {
     Kernel k = kernel_;
     SurfacePoint sp;
@@ -215,7 +215,7 @@ glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, 
         VertexRandom rnd(k, stream, bounce);
         const gpu::Material& m = sp.mat;
         const LobeWeights lobes = lobe_weights(m, sp.n, sp.wo);
-        add(radiance, throughput * next_event(k, sp, lobes, rnd, shadow_rays));
+        add(radiance, throughput * next_event(k, sp, lobes, rnd, rays.shadow));
 
         const BsdfSample b = sample_bsdf(k, m, lobes, sp.n, sp.wo, rnd.unit(kDimLobe), rnd.unit(kDimDirection0),
                                          rnd.unit(kDimDirection1));
@@ -223,6 +223,7 @@ glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, 
         throughput *= b.weight;
         float t, b1, b2;
         const std::uint32_t tri = k.lc_trace_first_hit(sp.p, b.wi, Kernel::kRayInfinity, t, b1, b2);
+        ++rays.bounce;
         // Emission the BRDF ray finds, weighted against NEE's chance of
         // having found the same light.
         if (tri == gpu::kInvalidIndex) {
@@ -373,7 +374,7 @@ private:
 
 // A worker thread's counters, on a cache line of its own.
 struct alignas(64) Worker {
-    std::uint64_t shadow_rays = 0;
+    path::PathRays rays;
 };
 
 
@@ -421,7 +422,7 @@ RenderResult render_path(const PreparedScene& prepared, const RenderOptions& opt
                     glm::dvec3& sum = sums[std::size_t(y) * frame.width + x];
                     for (std::uint32_t i = done; i < end; ++i) {
                         const std::uint32_t k = order(i);
-                        sum += glm::dvec3(tracer.sample(x, y, k % camera_spp, w.shadow_rays, k / camera_spp));
+                        sum += glm::dvec3(tracer.sample(x, y, k % camera_spp, w.rays, k / camera_spp));
                     }
                 }
             // Done: the samples' share, or the time limit's if that ends the render sooner.
@@ -444,7 +445,10 @@ RenderResult render_path(const PreparedScene& prepared, const RenderOptions& opt
     stats.device = "cpu";
     stats.spp_done = done;
     stats.camera_rays = std::uint64_t(frame.width) * frame.height * done;
-    for (const Worker& w : workers) stats.shadow_rays += w.shadow_rays;
+    for (const Worker& w : workers) {
+        stats.shadow_rays += w.rays.shadow;
+        stats.bounce_rays += w.rays.bounce;
+    }
     stats.seconds_total = elapsed();
     stats.seconds_shading = stats.seconds_total;  // the CPU does not time the stages apart
     return result;

@@ -59,6 +59,12 @@ float bsdf_pdf(Kernel& k, const gpu::Material& m, const LobeWeights& lobes, glm:
 // weight of the technique with density `pdf` against the other's `other`.
 float power_heuristic(float pdf, float other);
 
+// The rays a path tracer's samples cast: shadow rays (next-event
+// estimation) and the rays that continue paths after a bounce.
+struct PathRays {
+    std::uint64_t shadow = 0, bounce = 0;
+};
+
 // One path tracer bound to a prepared scene (which must outlive it) and a
 // set of options. sample() is const and thread-safe.
 class PathTracer {
@@ -71,9 +77,8 @@ public:
     // camera sample `s` of pixel (x, y), the same camera ray as every other
     // method's sample s. Its random numbers are hashes of (seed, x, y, s, j,
     // bounce, dimension), so the result depends on nothing else. Adds the
-    // shadow rays it cast to `shadow_rays`.
-    glm::vec3 sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, std::uint64_t& shadow_rays,
-                     std::uint32_t j = 0) const;
+    // rays it cast to `rays`.
+    glm::vec3 sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, PathRays& rays, std::uint32_t j = 0) const;
 
 private:
     class VertexRandom;

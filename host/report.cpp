@@ -71,8 +71,11 @@ LightcutsReport lightcuts_report(const RenderOptions& o, const PreparedScene& p,
 std::string lightcuts_text(const RenderReport& r, const LightcutsReport& l) {
     std::string text = format("  light tree %zu nodes (%s) built in %.3f s\n", l.tree_nodes,
                               human_bytes(l.tree_bytes).c_str(), r.seconds.light_tree_build);
-    text += format("  cut size mean %.1f, p50 %.0f, p99 %.0f, max %.0f; %llu samples hit max_cut %u\n",
-                   l.cut_size_mean, l.cut_size_p50, l.cut_size_p99, l.cut_size_max,
+    // Above 1 spp the percentiles and the largest are of each pixel's mean
+    // cut, which can stay below max_cut while samples reach it.
+    const std::string per_pixel = r.spp > 1 ? format(" (each pixel's mean over its %u samples)", r.spp) : "";
+    text += format("  cut size%s mean %.1f, p50 %.0f, p99 %.0f, max %.0f; %llu samples hit max_cut %u\n",
+                   per_pixel.c_str(), l.cut_size_mean, l.cut_size_p50, l.cut_size_p99, l.cut_size_max,
                    static_cast<unsigned long long>(l.max_cut_samples), l.max_cut);
     if (r.indirect)
         text += format("  of the cut: %.1f direct, %.1f indirect (VPL) clusters on average\n",
@@ -161,9 +164,10 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
     r.seconds.shading = s.seconds_shading;
     r.camera_rays = s.camera_rays;
     r.shadow_rays = s.shadow_rays;
+    r.bounce_rays = s.bounce_rays;
     const double pixels = double(r.width) * double(r.height);
     r.shadow_rays_per_pixel = pixels > 0.0 ? double(s.shadow_rays) / pixels : 0.0;
-    r.rays_per_second = double(s.camera_rays + s.shadow_rays) / std::max(s.seconds_total, 1e-9);
+    r.rays_per_second = double(s.camera_rays + s.shadow_rays + s.bounce_rays) / std::max(s.seconds_total, 1e-9);
     r.loop_limit_retries = s.loop_limit_retries;
     r.buffer_bytes = scene_buffer_bytes(prepared);
     for (const auto& [name, bytes] : s.buffer_bytes) {
@@ -193,14 +197,19 @@ std::string report_text(const RenderReport& r) {
     text += format("  triangles %zu, lights %zu%s, BVH %zu nodes built in %.3f s\n", r.triangles, r.lights,
                    black.c_str(), r.bvh_nodes, r.seconds.bvh_build);
     if (r.area_lights || r.environment_lights)
-        text += format("  of the lights: %zu area-light samples, %zu environment directions (%.3f s)\n",
-                       r.area_lights, r.environment_lights, r.seconds.light_sampling);
+        text += format("  sampled: %zu area-light samples, %zu environment directions (%.3f s)%s\n", r.area_lights,
+                       r.environment_lights, r.seconds.light_sampling,
+                       r.black_lights ? ", the black among them left out as above" : "");
     if (r.indirect)
         text += format("  and %zu VPLs from %zu light paths (max_bounces %u, clamp %g) traced in %.3f s\n",
                        r.indirect->vpls, r.indirect->paths, r.indirect->max_bounces, double(r.indirect->clamp),
                        r.seconds.vpls);
     text += format("  render %.3f s, %.0f rays (%.2f Mrays/s), %.1f shadow rays per pixel\n", r.seconds.render,
-                   double(r.camera_rays + r.shadow_rays), r.rays_per_second * 1e-6, r.shadow_rays_per_pixel);
+                   double(r.camera_rays + r.shadow_rays + r.bounce_rays), r.rays_per_second * 1e-6,
+                   r.shadow_rays_per_pixel);
+    if (r.bounce_rays)
+        text += format("  of the rays: %.0f camera, %.0f shadow, %.0f after a bounce\n", double(r.camera_rays),
+                       double(r.shadow_rays), double(r.bounce_rays));
     if (r.loop_limit_retries)
         text += format("  tiles rendered again %u time(s) with the work split finer (the driver cut long loops short)\n",
                        r.loop_limit_retries);
@@ -240,6 +249,7 @@ std::string report_json(const RenderReport& r) {
                      {"shading", r.seconds.shading}}},
         {"camera_rays", r.camera_rays},
         {"shadow_rays", r.shadow_rays},
+        {"bounce_rays", r.bounce_rays},
         {"shadow_rays_per_pixel", r.shadow_rays_per_pixel},
         {"rays_per_second", r.rays_per_second},
         {"loop_limit_retries", r.loop_limit_retries},

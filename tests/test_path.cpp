@@ -76,7 +76,7 @@ PixelEstimates centre_paths(const PreparedScene& p, RenderOptions o, std::uint32
     const std::uint32_t w = tracer.frame().width, h = tracer.frame().height;
     PixelEstimates e{std::vector<double>(std::size_t(w) * h), std::vector<double>(std::size_t(w) * h)};
     auto rows = [&](std::uint32_t first) {
-        std::uint64_t rays = 0;
+        path::PathRays rays;
         for (std::uint32_t y = first; y < h; y += 2)
             for (std::uint32_t x = 0; x < w; ++x) {
                 double sum = 0.0, sum2 = 0.0;
@@ -290,6 +290,9 @@ TEST(PathRender, FurnaceGivesGeometricSeries) {
         EXPECT_EQ(r.stats.device, "cpu");
         EXPECT_EQ(r.stats.camera_rays, 16u * 16u * 64u);
         EXPECT_GT(r.stats.shadow_rays, 0u);
+        // Inside the box every path bounces, each bounce's ray counted.
+        if (bounces != 0u) EXPECT_EQ(r.stats.bounce_rays, r.stats.camera_rays * bounces);
+        else EXPECT_GT(r.stats.bounce_rays, r.stats.camera_rays);
     }
 }
 

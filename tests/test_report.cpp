@@ -48,6 +48,12 @@ TEST(Report, JsonHasEveryKeyScriptsReadAndTheBlackLights) {
     EXPECT_THAT(json, HasSubstr("\"load\": 0.25"));
     EXPECT_THAT(report_text(report), HasSubstr("lights 20 (and 3 black, left out of the tree)"));
     EXPECT_THAT(report_text(report), HasSubstr("cut size mean"));
+    EXPECT_THAT(json, HasSubstr("\"bounce_rays\": 0,"));
+    // Above 1 spp the cut sizes' percentiles are of each pixel's mean.
+    RenderOptions two = o;
+    two.spp = 2;
+    EXPECT_THAT(report_text(make_report("room.json", two, p, render_cpu(p, two), 0.25)),
+                HasSubstr("cut size (each pixel's mean over its 2 samples) mean"));
     // The CPU's default: octets share cuts, and the heap is an octet's.
     EXPECT_THAT(json, HasSubstr("\"cut_sharing\": \"octet\""));
     // A GPU's heaps are in shared or private memory; the CPU's are neither.

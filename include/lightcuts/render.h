@@ -96,6 +96,7 @@ struct RenderStats {
     std::uint32_t spp_done = 0;       // samples per pixel rendered (path: fewer at a time limit)
     std::uint64_t camera_rays = 0;
     std::uint64_t shadow_rays = 0;
+    std::uint64_t bounce_rays = 0;          // path: the rays that continue paths after a bounce
     std::uint64_t max_cut_pixels = 0;       // samples where refinement hit max_cut
     std::uint32_t cut_points = 1;           // lightcuts: the pixels that shared each cut: 1, 4 (2x2
                                             // quads) or 8 (4x2 octets; cut_sharing); the heap is theirs

@@ -23,6 +23,9 @@ struct LightcutsReport {
     std::uint32_t max_cut = 0;
     std::size_t tree_nodes = 0;
     std::uint64_t tree_bytes = 0;
+    // Over the pixels, each pixel's mean cut over its samples (at 1 spp its
+    // cut): so above 1 spp the largest can be below max_cut where samples
+    // reached it.
     double cut_size_mean = 0.0, cut_size_p50 = 0.0, cut_size_p99 = 0.0, cut_size_max = 0.0;
     double cut_indirect_mean = 0.0;           // of cut_size_mean, VPL clusters (indirect light)
     std::uint64_t max_cut_samples = 0;        // samples whose refinement stopped at max_cut
@@ -61,13 +64,13 @@ struct RenderReport {
     std::uint32_t max_bounces = 0;           // path only
     std::size_t triangles = 0, lights = 0, bvh_nodes = 0;
     std::size_t black_lights = 0;             // zero-intensity lights left out of the tree
-    std::size_t area_lights = 0;              // samples of the emissive surfaces (in `lights`)
+    std::size_t area_lights = 0;              // samples of the emissive surfaces (in `lights`, or black)
     std::size_t environment_lights = 0;       // directions of the environment (in `lights`)
     struct Seconds {
         double load = 0.0, bvh_build = 0.0, light_tree_build = 0.0, light_sampling = 0.0, vpls = 0.0;
         double render = 0.0, primary = 0.0, shading = 0.0;
     } seconds;
-    std::uint64_t camera_rays = 0, shadow_rays = 0;
+    std::uint64_t camera_rays = 0, shadow_rays = 0, bounce_rays = 0;  // bounce: path's continuations
     double shadow_rays_per_pixel = 0.0, rays_per_second = 0.0;
     std::uint32_t loop_limit_retries = 0;     // GPU: times a tile was redone with the work split finer
     // The kernels' arrays (scene_arrays), then the device's own buffers; a
