@@ -228,6 +228,11 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
     const char* err = nullptr;
     if (ParseEXRHeaderFromMemory(&header, &version, data, bytes.size(), &err) != TINYEXR_SUCCESS)
         throw InputError(name, "", exr_unreadable(err, "cannot parse the OpenEXR header"));
+    // The line order says only in which order the blocks are stored, each
+    // with its own y or tile coordinates; tinyexr (1.0.1) takes any but
+    // INCREASING_Y to mean an image stored upside down (and for tiles, each
+    // tile flipped, reading past the short ones at an edge).
+    header.line_order = 0;
     const EXRBox2i& window = header.data_window;
     const std::int64_t width = std::int64_t(window.max_x) - window.min_x + 1;
     const std::int64_t height = std::int64_t(window.max_y) - window.min_y + 1;

@@ -87,6 +87,24 @@ TEST_F(ImageFiles, ExrRoundTripIsBitExact) {
     EXPECT_EQ(entries(), std::set<std::string>{"round.exr"});
 }
 
+// An OpenEXR file's line order says only in which order its blocks are
+// stored; each block carries its own y. A file that says DECREASING_Y
+// (here with its blocks in increasing order, as OpenEXR reads any order)
+// reads the same: tinyexr turned such images upside down (an environment
+// map's sky went below the horizon).
+TEST_F(ImageFiles, ExrLineOrderDoesNotFlipTheImage) {
+    lc::Image image(3, 37);
+    for (std::uint32_t y = 0; y < image.height; ++y)
+        for (std::uint32_t x = 0; x < image.width; ++x) image.set(x, y, glm::vec3(float(x), float(y), 0.5f));
+    const fs::path file = dir_ / "decreasing.exr";
+    lc::write_exr(file, image);
+    const unsigned char decreasing_y = 1;
+    lc::test::patch_exr_attribute(file, "lineOrder", "lineOrder", &decreasing_y, 1);
+    const lc::Image back = lc::read_exr(file);
+    ASSERT_EQ(back.height, image.height);
+    EXPECT_EQ(back.rgb, image.rgb);
+}
+
 TEST_F(ImageFiles, ExrStoresFloatChannelsSortedByName) {
     lc::Image image(2, 1);
     image.set(0, 0, {1.0f, 2.0f, 3.0f});

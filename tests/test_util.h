@@ -21,22 +21,29 @@
 
 namespace lc::test {
 
-// Rewrites an OpenEXR file's data window (its header's "dataWindow"
-// attribute) to (0, 0) .. (max_x, max_y), leaving its pixels as they are:
-// a small file whose header declares a large image.
-inline void set_exr_data_window(const std::filesystem::path& file, std::int32_t max_x, std::int32_t max_y) {
+// Overwrites the value of an OpenEXR file's header attribute `name` of
+// type `type` with `size` bytes of `value`, leaving the rest as it is.
+inline void patch_exr_attribute(const std::filesystem::path& file, const std::string& name, const std::string& type,
+                                const void* value, std::size_t size) {
     std::string bytes;
     {
         std::ifstream in(file, std::ios::binary);
         bytes.assign(std::istreambuf_iterator<char>(in), {});
     }
-    const std::string attribute("dataWindow\0box2i\0", 17);
+    const std::string attribute = name + '\0' + type + '\0';
     const std::size_t at = bytes.find(attribute);
-    if (at == std::string::npos || at + attribute.size() + 20 > bytes.size())
-        throw std::runtime_error(file.string() + ": no dataWindow attribute");
-    const std::int32_t window[4] = {0, 0, max_x, max_y};  // after the attribute's 4-byte size
-    std::memcpy(&bytes[at + attribute.size() + 4], window, sizeof(window));
+    if (at == std::string::npos || at + attribute.size() + 4 + size > bytes.size())
+        throw std::runtime_error(file.string() + ": no " + name + " attribute");
+    std::memcpy(&bytes[at + attribute.size() + 4], value, size);  // after the attribute's 4-byte size
     std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+// Rewrites an OpenEXR file's data window (its header's "dataWindow"
+// attribute) to (0, 0) .. (max_x, max_y), leaving its pixels as they are:
+// a small file whose header declares a large image.
+inline void set_exr_data_window(const std::filesystem::path& file, std::int32_t max_x, std::int32_t max_y) {
+    const std::int32_t window[4] = {0, 0, max_x, max_y};
+    patch_exr_attribute(file, "dataWindow", "box2i", window, sizeof(window));
 }
 
 // A fresh directory under the system temp dir, removed with everything in it.
