@@ -24,6 +24,7 @@
 #include "lightcuts/error.h"
 #include "lightcuts/image.h"
 #include "lightcuts/scene.h"
+#include "scene/polygon.h"
 #include "test_util.h"
 #include "lightcuts/settings.h"
 #include "scene/csv_lights.h"
@@ -284,6 +285,84 @@ TEST(SceneLoader, ObjAndMtlByteOrderMarksAreSkipped) {
     dir.write("m.obj", "\xEF\xBB\xBF" "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n");
     const std::string message = input_error_of([&] { load_scene(scene); });
     EXPECT_NE(message.find("m.obj: line 2 (v): 'nan' is not a number"), std::string::npos) << message;
+}
+
+// Polygons are cut into triangles inside them, each keeping the face's
+// winding: tinyobjloader cut a concave quad (a dart) along its shorter
+// diagonal, outside the quad, and its ear clipping filled in concave
+// polygons (an L, a U) or left parts out, by where they lay.
+TEST(ObjPolygons, TrianglesCoverEveryPolygonExactly) {
+    // Twice the signed area of (a, b, c), and the polygon's by the shoelace
+    // formula, in double.
+    const auto turn = [](glm::dvec2 a, glm::dvec2 b, glm::dvec2 c) {
+        return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+    };
+    const auto area = [&](const std::vector<glm::vec2>& p) {
+        double a = 0.0;
+        for (std::size_t i = 1; i + 1 < p.size(); ++i) a += turn(p[0], p[i], p[i + 1]);
+        return 0.5 * a;
+    };
+    const std::vector<std::vector<glm::vec2>> shapes = {
+        {{-0.3f, -0.8f}, {0.0f, -0.5f}, {0.3f, -0.8f}, {0.0f, 0.8f}},  // dart: its shorter diagonal lies outside
+        {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 3}, {0, 3}},                // L
+        {{0, 0}, {3, 0}, {3, 3}, {2, 3}, {2, 1}, {1, 1}, {1, 3}, {0, 3}},  // U
+        {{0, 0}, {5, 0}, {5, 1}, {4, 1}, {4, 3}, {3, 3}, {3, 1}, {2, 1}, {2, 3}, {1, 3}, {1, 1}, {0, 1}},  // comb
+    };
+    for (std::size_t s = 0; s < shapes.size(); ++s)
+        for (bool clockwise : {false, true})
+            for (std::size_t start = 0; start < shapes[s].size(); ++start)
+                for (const glm::vec3 offset : {glm::vec3(0.0f), glm::vec3(100.0f, -40.0f, 7.0f)}) {
+                    // The shape turned, started at another corner, moved, and
+                    // placed in a tilted plane.
+                    std::vector<glm::vec2> flat;
+                    for (std::size_t k = 0; k < shapes[s].size(); ++k)
+                        flat.push_back(shapes[s][(start + (clockwise ? shapes[s].size() - k : k)) % shapes[s].size()]);
+                    const glm::vec3 ax = glm::normalize(glm::vec3(1.0f, 0.2f, 0.3f));
+                    const glm::vec3 ay = glm::normalize(glm::cross(glm::vec3(0.1f, 0.3f, 1.0f), ax));
+                    std::vector<glm::vec3> corners;
+                    for (const glm::vec2 q : flat) corners.push_back(offset + q.x * ax + q.y * ay);
+                    const double want = area(flat);
+                    double covered = 0.0;
+                    const auto triangles = loader::triangulate_polygon(corners);
+                    // One fewer for each straight corner, none with no area.
+                    ASSERT_LE(triangles.size(), flat.size() - 2) << s;
+                    for (const auto& [a, b, c] : triangles) {
+                        const double t = 0.5 * turn(flat[a], flat[b], flat[c]);
+                        // Each triangle turns as the polygon does, so none
+                        // reaches outside it and together they cover it.
+                        EXPECT_GT(t * want, 0.0) << "shape " << s << " clockwise " << clockwise << " start " << start;
+                        covered += t;
+                    }
+                    EXPECT_NEAR(covered, want, 1e-9 * std::abs(want) + 1e-12) << "shape " << s;
+                }
+}
+
+// Through the loader: the dart quad's two triangles cover its area only,
+// and a corner index out of range is an error, as in a triangle
+// (tinyobjloader dropped the quad's face with a warning).
+TEST(ObjPolygons, ConcaveQuadLoadsInsideAndBadIndicesAreRefused) {
+    TempDir dir;
+    const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0, 3], "look_at": [0, 0, 0]},
+ "meshes": [{"obj": "m.obj"}], "lights": [{"type": "point", "position": [0, 0, 2], "intensity": [1, 1, 1]}]})");
+    dir.write("m.obj", "v -0.3 -0.8 0\nv 0 -0.5 0\nv 0.3 -0.8 0\nv 0 0.8 0\nf 1 2 3 4\n");
+    const Scene loaded = load_scene(scene);
+    ASSERT_EQ(loaded.triangles.size(), 2u);
+    double covered = 0.0;
+    for (const gpu::Triangle& t : loaded.triangles) {
+        const glm::vec3 a = vertex(t, 0), b = vertex(t, 1), c = vertex(t, 2);
+        const double z = 0.5 * glm::cross(b - a, c - a).z;
+        EXPECT_GT(z, 0.0);  // the face's counter-clockwise winding
+        covered += z;
+    }
+    EXPECT_NEAR(covered, 0.48 - 0.09, 1e-6);  // the triangle round it, less the notch
+    dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 2 3 9\n");
+    EXPECT_NE(input_error_of([&] { load_scene(scene); }).find("m.obj: face 2: vertex index 9 out of range (4 vertices)"),
+              std::string::npos);
+    std::string big = "v 0 0 0\nv 1 0 0\nv 1 1 0\nf";
+    for (int k = 0; k < 256; ++k) big.append(" ").append(std::to_string(k % 3 + 1));
+    dir.write("m.obj", big + "\n");
+    EXPECT_NE(input_error_of([&] { load_scene(scene); }).find("m.obj: line 4 (f): a face of 256 corners; at most 255"),
+              std::string::npos);
 }
 
 // A material library must be a regular file: tinyobjloader read a folder as

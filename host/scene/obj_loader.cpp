@@ -18,6 +18,7 @@
 #include "lightcuts/error.h"
 #include "materials.h"
 #include "obj_numbers.h"
+#include "polygon.h"
 #include "textures.h"
 
 namespace lc::loader {
@@ -127,7 +128,7 @@ void read_obj(const std::filesystem::path& file, const std::string& obj_name, bo
     MtlLibraries libraries(file.parent_path(), obj_name, uses_mtl);
     std::string warning, err;
     const bool ok = tinyobj::LoadObj(&obj.attrib, &obj.shapes, &obj.materials, &warning, &err, &in, &libraries,
-                                     /*triangulate=*/true, /*default_vcols_fallback=*/false);
+                                     /*triangulate=*/false, /*default_vcols_fallback=*/false);
     libraries.rethrow(warning);
     if (!ok) {
         while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
@@ -136,9 +137,11 @@ void read_obj(const std::filesystem::path& file, const std::string& obj_name, bo
     if (uses_mtl) check_usemtl_warnings(warning, obj_name);
 }
 
-// Built only on error: the face loop runs once per triangle.
+// Built only on error: the face loop runs once per face. A face of three
+// corners is a triangle; a larger one is named a face.
 std::string face_name(std::size_t face, const tinyobj::shape_t& shape) {
-    return "triangle " + std::to_string(face + 1) +
+    const bool triangle = face < shape.mesh.num_face_vertices.size() && shape.mesh.num_face_vertices[face] == 3;
+    return (triangle ? "triangle " : "face ") + std::to_string(face + 1) +
            (shape.name.empty() ? std::string() : " of shape '" + shape.name + "'");
 }
 
@@ -174,17 +177,22 @@ public:
         const tinyobj::mesh_t& mesh = shape.mesh;
         std::size_t kept = 0;
         std::size_t first = 0;
+        std::vector<glm::vec3> polygon;
         for (std::size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
             const std::size_t corners = mesh.num_face_vertices[f];
-            if (corners != 3) {
-                throw InputError(obj_name_, face_name(f, shape),
-                                 "has " + std::to_string(corners) + " corners after triangulation");
-            }
-            const Corners idx{mesh.indices[first], mesh.indices[first + 1], mesh.indices[first + 2]};
+            const tinyobj::index_t* face = mesh.indices.data() + first;
             first += corners;
-            check_indices(idx, f, shape);
+            if (corners < 3) continue;  // a line or a point: no surface
+            for (std::size_t c = 0; c < corners; ++c) check_index(face[c], f, shape);
             const int mtl_id = mesh.material_ids.empty() ? -1 : mesh.material_ids[f];
-            kept += add_triangle(idx, mtl_id, f, shape) ? 1 : 0;
+            if (corners == 3) {
+                kept += add_triangle({face[0], face[1], face[2]}, mtl_id, f, shape) ? 1 : 0;
+                continue;
+            }
+            polygon.clear();
+            for (std::size_t c = 0; c < corners; ++c) polygon.push_back(raw_position(face[c].vertex_index));
+            for (const auto& [a, b, c] : triangulate_polygon(polygon))
+                kept += add_triangle({face[a], face[b], face[c]}, mtl_id, f, shape) ? 1 : 0;
         }
         return kept;
     }
@@ -221,27 +229,26 @@ private:
         }
     }
 
-    // tinyobj only warns about out-of-range indices and keeps them.
-    void check_indices(const Corners& idx, std::size_t f, const tinyobj::shape_t& shape) const {
+    // tinyobj keeps out-of-range indices (only its own triangulation of
+    // quads skipped their faces, with a warning).
+    void check_index(const tinyobj::index_t& i, std::size_t f, const tinyobj::shape_t& shape) const {
         const std::size_t vertex_count = attrib_.vertices.size() / 3;
         const std::size_t normal_count = attrib_.normals.size() / 3;
         const std::size_t texcoord_count = attrib_.texcoords.size() / 2;
-        for (const tinyobj::index_t& i : idx) {
-            if (i.vertex_index < 0 || static_cast<std::size_t>(i.vertex_index) >= vertex_count) {
-                throw InputError(obj_name_, face_name(f, shape),
-                                 "vertex index " + std::to_string(i.vertex_index + 1) + " out of range (" +
-                                     std::to_string(vertex_count) + " vertices)");
-            }
-            if (i.normal_index >= 0 && static_cast<std::size_t>(i.normal_index) >= normal_count) {
-                throw InputError(obj_name_, face_name(f, shape),
-                                 "normal index " + std::to_string(i.normal_index + 1) + " out of range (" +
-                                     std::to_string(normal_count) + " normals)");
-            }
-            if (i.texcoord_index >= 0 && static_cast<std::size_t>(i.texcoord_index) >= texcoord_count) {
-                throw InputError(obj_name_, face_name(f, shape),
-                                 "texture coordinate index " + std::to_string(i.texcoord_index + 1) +
-                                     " out of range (" + std::to_string(texcoord_count) + " vt)");
-            }
+        if (i.vertex_index < 0 || static_cast<std::size_t>(i.vertex_index) >= vertex_count) {
+            throw InputError(obj_name_, face_name(f, shape),
+                             "vertex index " + std::to_string(i.vertex_index + 1) + " out of range (" +
+                                 std::to_string(vertex_count) + " vertices)");
+        }
+        if (i.normal_index >= 0 && static_cast<std::size_t>(i.normal_index) >= normal_count) {
+            throw InputError(obj_name_, face_name(f, shape),
+                             "normal index " + std::to_string(i.normal_index + 1) + " out of range (" +
+                                 std::to_string(normal_count) + " normals)");
+        }
+        if (i.texcoord_index >= 0 && static_cast<std::size_t>(i.texcoord_index) >= texcoord_count) {
+            throw InputError(obj_name_, face_name(f, shape),
+                             "texture coordinate index " + std::to_string(i.texcoord_index + 1) +
+                                 " out of range (" + std::to_string(texcoord_count) + " vt)");
         }
     }
 

@@ -102,8 +102,12 @@ bool is_int(std::string_view w) {
     return value <= 2147483647LL;
 }
 
-// A face's corners: v, v/vt, v//vn or v/vt/vn, each index an int.
+// A face's corners: v, v/vt, v//vn or v/vt/vn, each index an int; at most
+// 255 of them (tinyobjloader keeps a face's corner count in a byte).
 void check_face(const Line& line, const std::string& name) {
+    if (line.words.size() > 256)
+        throw InputError(name, "line " + std::to_string(line.number) + " (f)",
+                         "a face of " + std::to_string(line.words.size() - 1) + " corners; at most 255 are read");
     for (std::size_t k = 1; k < line.words.size(); ++k) {
         std::string_view corner = line.words[k];
         for (int part = 0; part < 3 && !corner.empty(); ++part) {
