@@ -262,6 +262,15 @@ TEST(SceneLoader, ObjAndMtlNumbersThatAreNotNumbersAreRefused) {
     ASSERT_EQ(loaded.triangles.size(), 1u);
     EXPECT_EQ(loaded.triangles[0].v2_y, 1.0f);
     EXPECT_NEAR(loaded.materials.at(loaded.triangles[0].material).kd_g, 0.5f, 1e-6f);
+    // A normal with only some words NaN or infinite counts as none too:
+    // tinyobjloader read each of them as 0 and kept (1, 0, 1).
+    for (const char* vn : {"vn 1 nan 1", "vn 1 inf 1", "vn 0 0 -inf"}) {
+        dir.write("m.obj", std::string("v 0 0 0\nv 1 0 0\nv 0 1 0\n") + vn + "\nf 1//1 2//1 3//1\n");
+        const Scene flat = load_scene(scene);
+        ASSERT_EQ(flat.normals.size(), 1u);
+        EXPECT_EQ(flat.normals[0].n0_x, 0.0f) << vn;
+        EXPECT_EQ(flat.normals[0].n0_z, 1.0f) << vn;
+    }
 }
 
 // Some editors start a file with a UTF-8 byte order mark. tinyobjloader

@@ -122,7 +122,7 @@ void read_obj(const std::filesystem::path& file, const std::string& obj_name, bo
     // that line (and shifting every later vertex index): skipped here.
     const std::string bytes = read_input_file(file);
     const std::string_view text = without_bom(bytes);
-    check_obj_numbers(text, obj_name);
+    const std::vector<std::size_t> non_finite_normals = check_obj_numbers(text, obj_name);
     TextBuffer buffer(text);
     std::istream in(&buffer);
     MtlLibraries libraries(file.parent_path(), obj_name, uses_mtl);
@@ -135,6 +135,9 @@ void read_obj(const std::filesystem::path& file, const std::string& obj_name, bo
         throw InputError(obj_name, "", "tinyobjloader: " + (err.empty() ? "parse failed" : err));
     }
     if (uses_mtl) check_usemtl_warnings(warning, obj_name);
+    for (const std::size_t n : non_finite_normals)
+        if (3 * n + 2 < obj.attrib.normals.size())
+            obj.attrib.normals[3 * n] = obj.attrib.normals[3 * n + 1] = obj.attrib.normals[3 * n + 2] = 0.0f;
 }
 
 // Built only on error: the face loop runs once per face. A face of three

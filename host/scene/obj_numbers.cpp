@@ -134,7 +134,9 @@ void check_weights(const Line& line, const std::string& name) {
 
 }  // namespace
 
-void check_obj_numbers(std::string_view text, const std::string& name) {
+std::vector<std::size_t> check_obj_numbers(std::string_view text, const std::string& name) {
+    std::vector<std::size_t> non_finite_normals;
+    std::size_t normals = 0;
     for_each_line(text, [&](const Line& line) {
         const std::string_view key = line.words[0];
         if (key == "v") check_numbers(line, 3, name);
@@ -142,11 +144,20 @@ void check_obj_numbers(std::string_view text, const std::string& name) {
         // tinyobjloader reads 0 and the loader takes the face normal for a
         // zero vertex normal, as documented. Words that are no number at
         // all are still refused.
-        else if (key == "vn") check_numbers(line, 3, name, true);
+        else if (key == "vn") {
+            check_numbers(line, 3, name, true);
+            for (std::size_t k = 1; k < line.words.size(); ++k)
+                if (is_non_finite(line.words[k])) {
+                    non_finite_normals.push_back(normals);
+                    break;
+                }
+            ++normals;
+        }
         else if (key == "vt") check_numbers(line, 1, name);
         else if (key == "f") check_face(line, name);
         else if (key == "vw") check_weights(line, name);
     });
+    return non_finite_normals;
 }
 
 void check_mtl_numbers(std::string_view text, const std::string& name) {

@@ -4,8 +4,10 @@
 // line, as a bad CSV line is.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace lc::loader {
 
@@ -17,7 +19,10 @@ namespace lc::loader {
 // within int's range. Throws InputError "NAME: line N (v): 'nan' is not a
 // number". `text` starts after any byte order mark (without_bom: the
 // loader strips it once, for these checks and tinyobjloader alike).
-void check_obj_numbers(std::string_view text, const std::string& name);
+// Returns the vn lines (0 for the first) with any NaN or infinity:
+// tinyobjloader reads each such word as 0 and keeps the others, so the
+// loader zeroes the whole normal, which then counts as none.
+std::vector<std::size_t> check_obj_numbers(std::string_view text, const std::string& name);
 
 // The same for the MTL values the loader reads: the colours Kd, Ks and Ke
 // (three numbers each) and the scalars Ns, Pr, Pm, Ps, Pc and Pcr.
