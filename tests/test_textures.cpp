@@ -235,6 +235,24 @@ TEST(ObjTextures, MapKdLoadsAndVtTurnsToGrowDownwards) {
     EXPECT_EQ(m.normal_texture, gpu::kInvalidIndex);
 }
 
+// What an MTL asks for that is not done gets a note: a map's options, and
+// maps the renderer has no use for (tinyobjloader reads them all).
+TEST(ObjTextures, UnusedMapsAndOptionsAreNoted) {
+    TempDir dir;
+    write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
+    dir.write("quad.obj", kTexturedObj);
+    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd -s 2 1 1 paint.png\nmap_Bump paint.png\nmap_Ks paint.png\n");
+    const Scene scene = load_scene(dir.write("scene.json", quad_scene_json()));
+    const std::string obj = (dir.path() / "quad.obj").lexically_normal().string();
+    EXPECT_EQ(scene.load_notes,
+              (std::vector<std::string>{obj + ": material 'paint'.map_Bump is not used (a normal map is read from norm)",
+                                        obj + ": material 'paint'.map_Ks is not used",
+                                        obj + ": material 'paint'.map_Kd: its options are not applied (the texture "
+                                              "repeats, unscaled and unmoved)"}));
+    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd paint.png\n");
+    EXPECT_TRUE(load_scene(dir.path() / "scene.json").load_notes.empty());
+}
+
 // JPEG as well as PNG: a uniform 8 x 8 JPEG decodes to (nearly) its colour.
 TEST(ObjTextures, JpegTexturesLoad) {
     TempDir dir;

@@ -1,6 +1,7 @@
 // load_obj: one OBJ file's faces and materials into the scene (obj_loader.h).
 #include "obj_loader.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <exception>
@@ -214,16 +215,38 @@ private:
     // albedo (base colour), map_Ke the emission (black or absent Ke counts
     // as 1 where there is a map_Ke), norm is a tangent-space normal map.
     // Paths are relative to the OBJ's folder; each file is loaded once.
+    // What is read but not used gets a note: a map's options (-s, -o, -t,
+    // -clamp, -imfchan, -bm, -mm, -boost, -blendu, -blendv; lookups repeat
+    // and are bilinear), and the maps the renderer has no use for.
     void add_textures(gpu::Material& m, const tinyobj::material_t& mtl, const std::filesystem::path& folder,
                       std::map<std::string, std::uint32_t>& loaded) {
+        const std::string where = obj_name_ + ": material '" + mtl.name + "'.";
+        const auto note = [&](const std::string& line) {
+            std::vector<std::string>& notes = target_.scene.load_notes;
+            if (std::find(notes.begin(), notes.end(), line) == notes.end()) notes.push_back(line);
+        };
         const auto texture = [&](const std::string& name, const char* key, std::uint32_t gpu::Material::*slot) {
             if (name.empty()) return;
+            const tinyobj::texture_option_t& o = key == std::string("map_Kd")   ? mtl.diffuse_texopt
+                                                 : key == std::string("norm") ? mtl.normal_texopt
+                                                                              : mtl.emissive_texopt;
+            const bool plain = o.scale[0] == 1 && o.scale[1] == 1 && o.scale[2] == 1 && o.origin_offset[0] == 0 &&
+                               o.origin_offset[1] == 0 && o.origin_offset[2] == 0 && o.turbulence[0] == 0 &&
+                               o.turbulence[1] == 0 && o.turbulence[2] == 0 && !o.clamp && o.imfchan == 'm' &&
+                               o.bump_multiplier == 1 && o.brightness == 0 && o.contrast == 1 && o.sharpness == 1 &&
+                               o.blendu && o.blendv;
+            if (!plain) note(where + key + ": its options are not applied (the texture repeats, unscaled and unmoved)");
             const auto [at, added] = loaded.try_emplace(name, 0u);
             if (added)
                 at->second = load_texture(target_.scene, folder / name, obj_name_,
                                           "material '" + mtl.name + "'." + key);
             set_texture(m, slot, at->second);
         };
+        if (!mtl.bump_texname.empty()) note(where + "map_Bump is not used (a normal map is read from norm)");
+        for (const auto& [name, key] : {std::pair{&mtl.specular_texname, "map_Ks"}, {&mtl.ambient_texname, "map_Ka"},
+                                        {&mtl.specular_highlight_texname, "map_Ns"},
+                                        {&mtl.displacement_texname, "disp"}, {&mtl.alpha_texname, "map_d"}})
+            if (!name->empty()) note(where + key + " is not used");
         texture(mtl.diffuse_texname, "map_Kd", &gpu::Material::base_color_texture);
         texture(mtl.normal_texname, "norm", &gpu::Material::normal_texture);
         if (!mtl.emissive_texname.empty()) {
