@@ -377,9 +377,25 @@ TEST(ObjPolygons, ConcaveQuadLoadsInsideAndBadIndicesAreRefused) {
 // A material library must be a regular file: tinyobjloader read a folder as
 // an empty library and /dev/zero until memory ran out (and a pipe until its
 // writer closes it). Refused with or without a material override.
-// A `mtllib` line is satisfied by the first of its files that exists; the
-// message names a file of the line that found none, not one an earlier
-// line skipped on its way to a file it found.
+// Every library a `mtllib` line names is read (tinyobjloader read only the
+// first it found, so `usemtl blue` of the second was an error).
+TEST(SceneLoader, MtllibReadsEveryLibraryOfItsLine) {
+    TempDir dir;
+    dir.write("a.mtl", "newmtl red\nKd 0.9 0.1 0.1\n");
+    dir.write("b.mtl", "newmtl blue\nKd 0.1 0.1 0.9\n");
+    dir.write("m.obj", "mtllib a.mtl missing.mtl b.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl blue\nf 1 2 3\n"
+                       "usemtl red\nf 1 2 3\n");
+    const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "m.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+    const Scene loaded = load_scene(scene);
+    ASSERT_EQ(loaded.triangles.size(), 2u);
+    EXPECT_NEAR(loaded.materials.at(loaded.triangles[0].material).kd_b, 0.9f, 1e-6f);
+    EXPECT_NEAR(loaded.materials.at(loaded.triangles[1].material).kd_r, 0.9f, 1e-6f);
+}
+
+// A `mtllib` line needs one of its files to exist (the others are read
+// where they exist too); the message names a file of the line that found
+// none, not one an earlier line skipped on its way to a file it found.
 TEST(SceneLoader, MissingMtllibNamesTheLineThatFoundNone) {
     TempDir dir;
     dir.write("b.mtl", "newmtl m\nKd 0.5 0.5 0.5\n");

@@ -7,6 +7,7 @@
 #include <exception>
 #include <istream>
 #include <map>
+#include <sstream>
 #include <streambuf>
 #include <string>
 #include <string_view>
@@ -54,29 +55,45 @@ public:
 // tinyobjloader would read /dev/zero until memory runs out and take a folder
 // for an empty library. Problems are kept, not thrown through
 // tinyobjloader, and raised by rethrow() after it returns.
+//
+// A `mtllib` line may name several libraries, all of which the OBJ format
+// reads. tinyobjloader asks for the line's names in turn and stops at the
+// first it gets, so on that one the rest of the line is read too (`obj`,
+// the OBJ's text, gives the lines); a name that is not found is skipped,
+// as tinyobjloader skips it, and a line none of whose files is found is an
+// error where the materials are used.
 class MtlLibraries : public tinyobj::MaterialReader {
 public:
-    MtlLibraries(std::filesystem::path folder, const std::string& obj_name, bool uses_mtl)
-        : folder_(std::move(folder)), obj_name_(obj_name), uses_mtl_(uses_mtl) {}
+    MtlLibraries(std::filesystem::path folder, const std::string& obj_name, bool uses_mtl, std::string_view obj)
+        : folder_(std::move(folder)), obj_name_(obj_name), uses_mtl_(uses_mtl) {
+        for (std::size_t at = 0; at < obj.size();) {
+            const std::size_t end = std::min(obj.find_first_of("\r\n", at), obj.size());
+            std::istringstream words{std::string(obj.substr(at, end - at))};
+            std::string word;
+            if (words >> word && word == "mtllib") {
+                std::vector<std::string>& names = lines_.emplace_back();
+                while (words >> word) names.push_back(word);
+            }
+            at = end + 1;
+        }
+    }
 
     bool operator()(const std::string& library, std::vector<tinyobj::material_t>* materials,
                     std::map<std::string, int>* material_map, std::string* warn, std::string* err) override {
         if (problem_) return false;
         try {
-            const std::filesystem::path file = folder_ / library;
-            const std::string problem = input_file_problem(file);
-            if (problem == kFileNotFound) {
+            if (!read(library, materials, material_map, warn, err)) {
                 if (missing_.empty()) missing_ = library;
                 return false;  // tinyobjloader tries the line's next file name
             }
             missing_.clear();  // (see missing_)
-            if (!problem.empty()) throw InputError(obj_name_, "mtllib", "'" + library + "' " + problem);
-            const std::string text = read_input_file(file);
-            const std::string_view mtl = without_bom(text);
-            if (uses_mtl_) check_mtl_numbers(mtl, display(file));
-            TextBuffer buffer(mtl);
-            std::istream in(&buffer);
-            tinyobj::LoadMtl(material_map, materials, &in, warn, err);
+            // The names after this one on its line.
+            for (const std::vector<std::string>& names : lines_) {
+                const auto self = std::find(names.begin(), names.end(), library);
+                if (self == names.end()) continue;
+                for (auto next = self + 1; next != names.end(); ++next) read(*next, materials, material_map, warn, err);
+                break;
+            }
             return true;
         } catch (...) {
             problem_ = std::current_exception();
@@ -95,9 +112,27 @@ public:
     }
 
 private:
+    // Reads the library `name` into the materials; false where it is not
+    // found. Throws InputError where it is not a regular file.
+    bool read(const std::string& name, std::vector<tinyobj::material_t>* materials,
+              std::map<std::string, int>* material_map, std::string* warn, std::string* err) {
+        const std::filesystem::path file = folder_ / name;
+        const std::string problem = input_file_problem(file);
+        if (problem == kFileNotFound) return false;
+        if (!problem.empty()) throw InputError(obj_name_, "mtllib", "'" + name + "' " + problem);
+        const std::string text = read_input_file(file);
+        const std::string_view mtl = without_bom(text);
+        if (uses_mtl_) check_mtl_numbers(mtl, display(file));
+        TextBuffer buffer(mtl);
+        std::istream in(&buffer);
+        tinyobj::LoadMtl(material_map, materials, &in, warn, err);
+        return true;
+    }
+
     std::filesystem::path folder_;
     const std::string& obj_name_;
     bool uses_mtl_;
+    std::vector<std::vector<std::string>> lines_;  // the names of each mtllib line
     // The first of the names not found since the last one found: where the
     // OBJ's last `mtllib` line found none of its files, that line's first.
     // (Where an earlier line found none, a later line's found name clears
@@ -126,7 +161,7 @@ void read_obj(const std::filesystem::path& file, const std::string& obj_name, bo
     const std::vector<std::size_t> non_finite_normals = check_obj_numbers(text, obj_name);
     TextBuffer buffer(text);
     std::istream in(&buffer);
-    MtlLibraries libraries(file.parent_path(), obj_name, uses_mtl);
+    MtlLibraries libraries(file.parent_path(), obj_name, uses_mtl, text);
     std::string warning, err;
     const bool ok = tinyobj::LoadObj(&obj.attrib, &obj.shapes, &obj.materials, &warning, &err, &in, &libraries,
                                      /*triangulate=*/false, /*default_vcols_fallback=*/false);
