@@ -393,6 +393,18 @@ TEST(SceneLoader, MtllibReadsEveryLibraryOfItsLine) {
     EXPECT_NEAR(loaded.materials.at(loaded.triangles[1].material).kd_r, 0.9f, 1e-6f);
 }
 
+// A usemtl in an OBJ without any mtllib line says so (it said "not found in
+// .mtl", naming a file that was never asked for).
+TEST(SceneLoader, UsemtlWithoutMtllibSaysSo) {
+    TempDir dir;
+    dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl foo\nf 1 2 3\n");
+    const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "m.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+    EXPECT_EQ(input_error_of([&] { load_scene(scene); }),
+              (dir.path() / "m.obj").lexically_normal().string() +
+                  ": usemtl: tinyobjloader: material [ 'foo' ] not found: the OBJ has no mtllib line");
+}
+
 // A `mtllib` line needs one of its files to exist (the others are read
 // where they exist too); the message names a file of the line that found
 // none, not one an earlier line skipped on its way to a file it found.

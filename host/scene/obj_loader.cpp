@@ -101,6 +101,9 @@ public:
         }
     }
 
+    // Whether the OBJ has a mtllib line.
+    bool any() const { return !lines_.empty(); }
+
     // Throws the first problem met, if any; else, when the materials are
     // used and a `mtllib` line found none of its files, InputError naming it.
     void rethrow(const std::string& warning) const {
@@ -142,13 +145,15 @@ private:
 };
 
 // tinyobj treats an unknown usemtl name as a warning and falls back to "no
-// material"; silently grey walls are worse than an error.
-void check_usemtl_warnings(const std::string& warning, const std::string& obj_name) {
+// material"; silently grey walls are worse than an error. `libraries`:
+// whether the OBJ has a mtllib line at all.
+void check_usemtl_warnings(const std::string& warning, const std::string& obj_name, bool libraries) {
     if (const auto at = warning.find("not found in .mtl"); at != std::string::npos) {
         const auto begin = warning.rfind('\n', at);
         const auto from = begin == std::string::npos ? 0 : begin + 1;
         throw InputError(obj_name, "usemtl",
-                         "tinyobjloader: " + warning.substr(from, at - from) + "not found in .mtl");
+                         "tinyobjloader: " + warning.substr(from, at - from) +
+                             (libraries ? "not found in .mtl" : "not found: the OBJ has no mtllib line"));
     }
 }
 
@@ -170,7 +175,7 @@ void read_obj(const std::filesystem::path& file, const std::string& obj_name, bo
         while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
         throw InputError(obj_name, "", "tinyobjloader: " + (err.empty() ? "parse failed" : err));
     }
-    if (uses_mtl) check_usemtl_warnings(warning, obj_name);
+    if (uses_mtl) check_usemtl_warnings(warning, obj_name, libraries.any());
     for (const std::size_t n : non_finite_normals)
         if (3 * n + 2 < obj.attrib.normals.size())
             obj.attrib.normals[3 * n] = obj.attrib.normals[3 * n + 1] = obj.attrib.normals[3 * n + 2] = 0.0f;
