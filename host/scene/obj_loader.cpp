@@ -7,7 +7,6 @@
 #include <exception>
 #include <istream>
 #include <map>
-#include <sstream>
 #include <streambuf>
 #include <string>
 #include <string_view>
@@ -66,16 +65,9 @@ class MtlLibraries : public tinyobj::MaterialReader {
 public:
     MtlLibraries(std::filesystem::path folder, const std::string& obj_name, bool uses_mtl, std::string_view obj)
         : folder_(std::move(folder)), obj_name_(obj_name), uses_mtl_(uses_mtl) {
-        for (std::size_t at = 0; at < obj.size();) {
-            const std::size_t end = std::min(obj.find_first_of("\r\n", at), obj.size());
-            std::istringstream words{std::string(obj.substr(at, end - at))};
-            std::string word;
-            if (words >> word && word == "mtllib") {
-                std::vector<std::string>& names = lines_.emplace_back();
-                while (words >> word) names.push_back(word);
-            }
-            at = end + 1;
-        }
+        for_each_line(obj, [&](const Line& line) {
+            if (line.words[0] == "mtllib") lines_.emplace_back(line.words.begin() + 1, line.words.end());
+        });
     }
 
     bool operator()(const std::string& library, std::vector<tinyobj::material_t>* materials,

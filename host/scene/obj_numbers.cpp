@@ -10,36 +10,6 @@
 namespace lc::loader {
 namespace {
 
-struct Line {
-    std::size_t number;                   // from 1
-    std::vector<std::string_view> words;  // up to a '#' comment
-};
-
-bool is_space(char c) { return c == ' ' || c == '\t' || c == '\v' || c == '\f'; }
-
-// Calls visit(Line) for each line that has a word. Lines end as
-// tinyobjloader ends them: at "\n", "\r\n" or a lone "\r".
-template <class Visit>
-void for_each_line(std::string_view text, Visit&& visit) {
-    Line line{0, {}};
-    std::size_t at = 0;
-    while (at <= text.size()) {
-        const std::size_t end = std::min(text.find_first_of("\r\n", at), text.size());
-        ++line.number;
-        line.words.clear();
-        std::size_t i = at;
-        while (i < end) {
-            while (i < end && is_space(text[i])) ++i;
-            if (i == end || text[i] == '#') break;
-            const std::size_t start = i;
-            while (i < end && !is_space(text[i])) ++i;
-            line.words.push_back(text.substr(start, i - start));
-        }
-        if (!line.words.empty()) visit(line);
-        at = end + (text.compare(end, 2, "\r\n") == 0 ? 2 : 1);
-    }
-}
-
 // A decimal number as tinyobjloader parses one: [+-] digits [. digits]
 // [(e|E) [+-] digits], with at least one digit before the exponent.
 bool is_number(std::string_view w) {
