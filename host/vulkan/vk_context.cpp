@@ -1,5 +1,8 @@
 #include "vk_context.h"
 
+#include <dlfcn.h>
+#include <link.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cctype>
@@ -63,6 +66,30 @@ bool has_instance_extension(const char* name, const char* layer = nullptr) {
     });
 }
 
+// Every shared library the process has open, drivers and layers the loader
+// opened for a live instance among them, marked never to unload. The NVIDIA
+// driver keeps its thread-local variables in glibc's static TLS block, and
+// an unloaded library's share of that block is given back only when it sits
+// at the block's end: on an H200 (driver 580), a process that made and
+// destroyed instances one after another (the GPU tests; an application
+// rendering frame after frame) could not load the driver after about a
+// dozen instances ("libnvidia-tls.so: cannot allocate memory in static TLS
+// block"). Kept loaded, the driver takes its share once.
+void keep_libraries_loaded() {
+    std::vector<std::string> names;
+    dl_iterate_phdr(
+        [](dl_phdr_info* info, std::size_t, void* out) {
+            if (info->dlpi_name != nullptr && info->dlpi_name[0] == '/')
+                static_cast<std::vector<std::string>*>(out)->push_back(info->dlpi_name);
+            return 0;
+        },
+        &names);
+    // dlopen is not called from the callback, which runs under the dynamic
+    // linker's lock.
+    for (const std::string& name : names)
+        if (void* handle = dlopen(name.c_str(), RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE)) dlclose(handle);
+}
+
 // The instance, with validation and the messenger's create-info chained so
 // that messages from vkCreateInstance/vkDestroyInstance are caught too.
 Instance create_instance(bool validation, MessageLog* log, bool& debug_utils) {
@@ -118,6 +145,7 @@ Instance create_instance(bool validation, MessageLog* log, bool& debug_utils) {
             "VK_ERROR_INCOMPATIBLE_DRIVER)");
     VK_CHECK(result);
     volkLoadInstanceOnly(instance);
+    keep_libraries_loaded();
     return Instance(instance, {});
 }
 
