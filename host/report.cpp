@@ -169,6 +169,7 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
     r.shadow_rays_per_pixel = pixels > 0.0 ? double(s.shadow_rays) / pixels : 0.0;
     r.rays_per_second = double(s.camera_rays + s.shadow_rays + s.bounce_rays) / std::max(s.seconds_total, 1e-9);
     r.loop_limit_retries = s.loop_limit_retries;
+    r.work_splits = s.work_splits;
     r.buffer_bytes = scene_buffer_bytes(prepared);
     for (const auto& [name, bytes] : s.buffer_bytes) {
         auto same = std::find_if(r.buffer_bytes.begin(), r.buffer_bytes.end(),
@@ -213,6 +214,10 @@ std::string report_text(const RenderReport& r) {
     if (r.loop_limit_retries)
         text += format("  tiles rendered again %u time(s) with the work split finer (the driver cut long loops short)\n",
                        r.loop_limit_retries);
+    if (r.work_splits)
+        text += format("  each pixel's work split %u time(s) over more dispatches (tiles of the smallest size "
+                       "took over 4 times the target)\n",
+                       r.work_splits);
     if (r.lightcuts) text += lightcuts_text(r, *r.lightcuts);
     if (r.sampling && r.method == "stochastic")
         text += format("  %u fresh representative(s) per cluster of the cut\n", r.sampling->light_samples);
@@ -253,6 +258,7 @@ std::string report_json(const RenderReport& r) {
         {"shadow_rays_per_pixel", r.shadow_rays_per_pixel},
         {"rays_per_second", r.rays_per_second},
         {"loop_limit_retries", r.loop_limit_retries},
+        {"work_splits", r.work_splits},
         {"buffer_bytes", buffers},
     };
     if (r.lightcuts) j["lightcuts"] = lightcuts_json(*r.lightcuts, r.device == "cpu");

@@ -32,9 +32,10 @@ Tuning device_tuning(const Context& ctx, Tuning tuning);
 bool share_cuts(const Context& ctx, const LightTree& tree, const RenderOptions& options,
                 const gpu::FrameParams& frame, const Tuning& tuning);
 
-// The smallest tile worth a pass on this device: one pixel on a GPU; on a
-// CPU device enough workgroups to keep each of its threads busy.
-std::uint32_t min_tile_pixels(const Context& ctx);
+// The smallest tile worth a pass on this device (Tuning::min_tile_pixels
+// where set): Tuning::kGpuMinTilePixels on a GPU; on a CPU device enough
+// workgroups to keep each of its threads busy.
+std::uint32_t min_tile_pixels(const Context& ctx, const Tuning& tuning);
 
 // scene_arrays() and then the frame constants: what the kernels read, in
 // binding order.

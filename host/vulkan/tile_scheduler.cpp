@@ -9,7 +9,7 @@ namespace lc::vk {
 TileScheduler::TileScheduler(std::string device_name, Submitter& submitter, TilePass& pass,
                              ShadingMethod& method, const GpuResources& resources,
                              const gpu::FrameParams& frame, double target_dispatch_ms,
-                             std::uint32_t min_tile_pixels, bool progress)
+                             std::uint32_t min_tile_pixels, bool split_slow_tiles, bool progress)
     : device_name_(std::move(device_name)),
       submitter_(submitter),
       pass_(pass),
@@ -18,6 +18,7 @@ TileScheduler::TileScheduler(std::string device_name, Submitter& submitter, Tile
       frame_(frame),
       target_dispatch_ms_(target_dispatch_ms),
       min_tile_pixels_(min_tile_pixels),
+      split_slow_tiles_(split_slow_tiles),
       progress_(progress) {}
 
 // Tiles: bands of rows, each cut into tiles of about `budget` pixels. The
@@ -25,7 +26,9 @@ TileScheduler::TileScheduler(std::string device_name, Submitter& submitter, Tile
 // most 2x per tile, as the next tile may be harder): starting small keeps
 // the first dispatch short on any device, and a pass that the driver's loop
 // limit spoils cheap. A tile never drops below min_tile_pixels (a CPU
-// device's threads each need workgroups) unless the buffers say so.
+// device's threads each need workgroups, a GPU's multiprocessors many)
+// unless the buffers say so; with split_slow_tiles, a tile of that size that
+// takes over 4x the target splits the method's work finer instead.
 //
 // Cuts shared by quads (ShadingMethod::quad_cuts) need every tile to start
 // at an even pixel, so tiles are then an even number of pixels wide and
@@ -39,6 +42,7 @@ void TileScheduler::render(RenderResult& result) {
     const auto rounded_up = [quads](std::uint32_t v) { return quads ? (v + 1u) & ~1u : v; };
     samples_total_ = std::uint64_t(width) * height * frame_.spp;
     double budget = std::min<double>(std::max(4 * gpu::kWorkgroupSize, min_tile_pixels_), max_pixels);
+    const double min_budget = std::min<double>(min_tile_pixels_, max_pixels);
     for (std::uint32_t y0 = 0; y0 < height;) {
         const std::uint32_t band = std::min<std::uint32_t>(
             height - y0, even(std::max<std::uint32_t>(1, std::uint32_t(std::sqrt(budget)))));
@@ -48,6 +52,13 @@ void TileScheduler::render(RenderResult& result) {
             if (quads) fit = even(std::min(fit, resources_.tiles().invocations / rounded_up(band)));
             w = std::min({w, width - x0, fit});
             const double ms = render_tile({x0, y0, w, band}, result);
+            // A tile of the smallest size that still takes too long: each
+            // of its pixels' work is too long for one dispatch (on a GPU a
+            // tile too small to fill the device takes one pixel's time
+            // whatever its size), so that work is split over more
+            // dispatches instead of the tile shrinking.
+            if (split_slow_tiles_ && budget <= min_budget && ms > 4 * target_dispatch_ms_ && method_.split_finer())
+                result.stats.work_splits += 1;
             budget = next_budget(budget, double(w) * band, ms);
             x0 += w;
         }

@@ -73,7 +73,8 @@ RenderResult render(const Context& ctx, const PreparedScene& prepared,
     }
     TileScheduler scheduler(ctx.device_name(), setup.submitter, setup.pass, *setup.method,
                             setup.resources, frame, tuning.target_dispatch_ms,
-                            min_tile_pixels(ctx), options.progress);
+                            min_tile_pixels(ctx, tuning), tuning.split_slow_tiles == Tuning::SplitSlowTiles::kOn,
+                            options.progress);
     scheduler.render(result);
 
     stats.spp_done = frame.spp;
@@ -128,8 +129,9 @@ Tuning device_tuning(const Context& ctx, Tuning tuning) {
         tuning.texel_reads = cpu ? Tuning::TexelReads::kOn : Tuning::TexelReads::kOff;
     if (tuning.specialize_on_host == Tuning::HostSpecialization::kAuto)
         tuning.specialize_on_host = cpu ? Tuning::HostSpecialization::kOn : Tuning::HostSpecialization::kOff;
-    if (tuning.heap_memory == Tuning::HeapMemory::kAuto)
-        tuning.heap_memory = cpu ? Tuning::HeapMemory::kPrivate : Tuning::HeapMemory::kShared;
+    if (tuning.heap_memory == Tuning::HeapMemory::kAuto) tuning.heap_memory = Tuning::HeapMemory::kPrivate;
+    if (tuning.split_slow_tiles == Tuning::SplitSlowTiles::kAuto)
+        tuning.split_slow_tiles = cpu ? Tuning::SplitSlowTiles::kOff : Tuning::SplitSlowTiles::kOn;
     if (tuning.presplit_on_llvmpipe && tuning.refinements_per_dispatch == 0 && driver_limits_loops(ctx)) {
         tuning.refinements_per_dispatch = Tuning::kLlvmpipeRefinements;
         tuning.whole_cut_steps = Tuning::kLlvmpipeWholeCutSteps;
@@ -137,8 +139,9 @@ Tuning device_tuning(const Context& ctx, Tuning tuning) {
     return tuning;
 }
 
-std::uint32_t min_tile_pixels(const Context& ctx) {
-    if (ctx.properties().deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) return 1;
+std::uint32_t min_tile_pixels(const Context& ctx, const Tuning& tuning) {
+    if (tuning.min_tile_pixels > 0) return tuning.min_tile_pixels;
+    if (ctx.properties().deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU) return Tuning::kGpuMinTilePixels;
     // lavapipe runs each workgroup on one of its threads (LP_NUM_THREADS,
     // by default one per core); four workgroups per thread keep them all
     // busy to the end of most dispatches.
@@ -225,6 +228,13 @@ Tuning Tuning::from_environment() {
         const std::string mode = v;
         if (mode == "shared") tuning.heap_memory = Tuning::HeapMemory::kShared;
         if (mode == "private") tuning.heap_memory = Tuning::HeapMemory::kPrivate;
+    }
+    if (const char* v = std::getenv("LC_VK_MIN_TILE_PIXELS"))
+        tuning.min_tile_pixels = std::uint32_t(std::strtoul(v, nullptr, 10));
+    if (const char* v = std::getenv("LC_VK_SPLIT_SLOW_TILES")) {
+        const std::string mode = v;
+        if (mode == "on") tuning.split_slow_tiles = Tuning::SplitSlowTiles::kOn;
+        if (mode == "off") tuning.split_slow_tiles = Tuning::SplitSlowTiles::kOff;
     }
     if (const char* v = std::getenv("LC_VK_TARGET_MS")) {
         const double ms = std::strtod(v, nullptr);

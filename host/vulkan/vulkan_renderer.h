@@ -48,8 +48,23 @@ struct Tuning {
     // workgroups. GPUs keep tile order.
     bool spread_groups_on_cpu = true;
 
+    // The smallest tile (0: the device's, min_tile_pixels in render_setup.h).
+    std::uint32_t min_tile_pixels = 0;
+    // Where a tile of the smallest size takes over 4x target_dispatch_ms,
+    // split each pixel's work over more dispatches (ShadingMethod::
+    // split_finer) for the tiles after it. kAuto: on GPUs, whose watchdogs
+    // the target is for; a CPU device has none.
+    enum class SplitSlowTiles { kAuto, kOn, kOff };
+    SplitSlowTiles split_slow_tiles = SplitSlowTiles::kAuto;
+
     // One dispatch on a GPU stays well under any display watchdog.
     static constexpr double kGpuTargetMs = 30.0;
+    // A GPU's smallest tile: 1024 workgroups, about 8 invocations for each
+    // of an H200's 132 x 64 lanes. With tiles of a few hundred pixels
+    // brute force over 10^4 lights on an H200, whose dispatches took one
+    // pixel's time whatever the tile's size, shrank its tiles towards
+    // single pixels and did not finish 240x135 in 40 s (docs/results/gpu.md).
+    static constexpr std::uint32_t kGpuMinTilePixels = 1024 * 64;
     // A CPU device (lavapipe) has no watchdog, and runs each workgroup on
     // one of its threads: long dispatches of many workgroups keep them all
     // busy (docs/results/lavapipe.md).
@@ -100,18 +115,24 @@ struct Tuning {
     enum class HostSpecialization { kAuto, kOn, kOff };
     HostSpecialization specialize_on_host = HostSpecialization::kAuto;
 
-    // Where the kernels keep each invocation's cut heap (shaders/heap.glsl).
-    // kAuto: in private memory on CPU devices, where lavapipe's shading took
-    // 0.78-0.82 s against 0.93-1.42 s with shared memory on the room
-    // (docs/results/lavapipe.md, §10);
-    // in workgroup shared memory on GPUs, the heap's place there.
+    // Where the kernels keep each invocation's cut heap (shaders/heap.glsl):
+    // in workgroup shared memory (K slots for each of the workgroup's
+    // invocations, which limits K) or in each invocation's private array.
+    // kAuto: private, on every device measured. On lavapipe shading took
+    // 0.78-0.82 s against 0.93-1.42 s in shared memory on the room
+    // (docs/results/lavapipe.md, §10). On an H200 the room with 10^5 lights
+    // at 1080p took 17.7/29.7/50.7/79.8 ms of GPU time with K = 8/16/32/64
+    // private slots against 18.2/33.1/72.4/246.4 ms in shared memory, whose
+    // 4 to 32 KiB a workgroup leave room for fewer workgroups at a time
+    // (docs/results/gpu.md).
     enum class HeapMemory { kAuto, kShared, kPrivate };
     HeapMemory heap_memory = HeapMemory::kAuto;
 
     // LC_VK_FORCE_FEATURES=ggx,shadows,oriented,textures,disney,sheen,clearcoat (or all), LC_VK_MAX_TILE_PIXELS=N, LC_VK_TARGET_MS=X,
     // LC_VK_LIGHTS_PER_DISPATCH=N, LC_VK_REFINEMENTS_PER_DISPATCH=N, LC_VK_SPLIT_BYTES=N,
     // LC_VK_CHUNK_BUFFERS=1, LC_VK_HOST_IMPORT=0, LC_VK_TEXEL_READS=on|off,
-    // LC_VK_SPECIALIZE_ON_HOST=on|off, LC_VK_HEAP_MEMORY=shared|private.
+    // LC_VK_SPECIALIZE_ON_HOST=on|off, LC_VK_HEAP_MEMORY=shared|private,
+    // LC_VK_MIN_TILE_PIXELS=N, LC_VK_SPLIT_SLOW_TILES=on|off.
     static Tuning from_environment();
 };
 

@@ -113,6 +113,8 @@ struct RenderStats {
     std::uint32_t workgroup_size = 0;       // GPU: invocations per workgroup
     std::uint32_t loop_limit_retries = 0;   // GPU: times a tile was rendered again with the work split
                                             // over more dispatches (the driver cut loops short)
+    std::uint32_t work_splits = 0;          // GPU: times each pixel's work was split over more
+                                            // dispatches, as tiles of the smallest size took too long
     std::vector<float> cut_size;      // per pixel, mean over samples (lightcuts only)
     std::vector<float> heap_froze;    // per pixel, the fraction of samples whose cut froze
                                       // clusters out of a full heap (lightcuts only)

@@ -73,6 +73,7 @@ struct RenderReport {
     std::uint64_t camera_rays = 0, shadow_rays = 0, bounce_rays = 0;  // bounce: path's continuations
     double shadow_rays_per_pixel = 0.0, rays_per_second = 0.0;
     std::uint32_t loop_limit_retries = 0;     // GPU: times a tile was redone with the work split finer
+    std::uint32_t work_splits = 0;            // GPU: times the work was split finer for slow small tiles
     // The kernels' arrays (scene_arrays), then the device's own buffers; a
     // device buffer of the same name replaces the scene array's entry.
     std::vector<BufferBytes> buffer_bytes;

@@ -328,6 +328,35 @@ TEST_F(Vulkan, WorkSplitOverDispatchesMatchesCpu) {
     }
 }
 
+// Tiles of the smallest size that take over 4x the dispatch target (here
+// every tile: a target of a microsecond) split each pixel's work over more
+// dispatches for the tiles after them, as on GPUs, where a tile too small
+// to fill the device takes one pixel's time whatever its size: the images
+// stay the CPU's. Switched off, nothing is split.
+TEST_F(Vulkan, SlowSmallTilesSplitTheWorkFiner) {
+    PreparedScene p = prepare_scene(random_scene(72, 300, 2, 24, 20), 9);
+    vk::Tuning slow;
+    slow.split_slow_tiles = vk::Tuning::SplitSlowTiles::kOn;
+    slow.target_dispatch_ms = 1e-3;
+    slow.min_tile_pixels = 64;
+    slow.max_tile_pixels = 64;
+    {
+        RenderOptions o = options("brute", 24, 20, 2);
+        const RenderResult g = gpu(p, o, slow);
+        EXPECT_GT(g.stats.work_splits, 0u);
+        expect_brute_matches(p, o, g, vulkan_test::kBruteSplitRelative);
+    }
+    RenderOptions o = options("lightcuts", 24, 20, 2);
+    o.relative_error = 0.0f;
+    o.max_cut = 200;
+    const RenderResult g = gpu(p, o, slow);
+    EXPECT_GT(g.stats.work_splits, 0u);
+    EXPECT_GT(g.stats.heap_paused_samples, 0u);
+    expect_lightcuts_matches(p, o, g);
+    slow.split_slow_tiles = vk::Tuning::SplitSlowTiles::kOff;
+    EXPECT_EQ(gpu(p, o, slow).stats.work_splits, 0u);
+}
+
 // max_cut 1 keeps both roots, so the cut (and its heap) has two clusters.
 TEST_F(Vulkan, TinyMaxCutMatchesCpu) {
     PreparedScene p = prepare_scene(random_scene(51, 50, 2, 24, 20), 5);
@@ -414,14 +443,15 @@ TEST_F(Vulkan, TexturedSceneMatchesCpu) {
     // coordinates (FMA contraction in the barycentric sums) into value
     // differences of up to (texels per unit) x (texel contrast) x 1 ulp:
     // here 16 noise texels per unit, dark channels of 1/255 beside bright
-    // ones. Measured on lavapipe: 1.25e-4 (a 1 x 1 texture: below 2e-5, as
-    // without textures). About 3x that.
-    constexpr double kTexturedRelative = 4e-4;
+    // ones. Measured: 1.25e-4 on lavapipe (a 1 x 1 texture: below 2e-5, as
+    // without textures), 2.77e-4 on an H200 (NVIDIA 580), brute force and
+    // Lightcuts alike, as their cuts are the same. About 2x the larger.
+    constexpr double kTexturedRelative = 6e-4;
     const RenderOptions brute = options("brute", 40, 32);
     expect_brute_matches(p, brute, gpu(p, brute), kTexturedRelative);
     RenderOptions lc = options("lightcuts", 40, 32);
     lc.max_cut = 200;
-    expect_lightcuts_matches(p, lc, gpu(p, lc));
+    expect_lightcuts_matches(p, lc, gpu(p, lc), kTexturedRelative);
 }
 
 // The shipped demo room (GGX torus, 1000 point lights) at reduced size.

@@ -33,9 +33,10 @@ TEST_F(Vulkan, GltfRoomRendersLikeTheJsonRoom) {
 // contraction in the barycentric sums), which a texture turns into value
 // differences of up to (texels per unit) x (texel contrast) x 1 ulp; here a
 // 64-texel checker repeated 4 times over 6 m, of contrast about 0.8.
-// Measured on lavapipe: at most 1.65e-4 (4.5e-6 with every texture left
-// out). About 3x that.
-constexpr double kTexturedRelative = 5e-4;
+// Measured: at most 1.65e-4 on lavapipe (4.5e-6 with every texture left
+// out), 5.76e-4 on an H200 (NVIDIA 580; not broken down further). About 2x
+// the larger.
+constexpr double kTexturedRelative = 1.2e-3;
 
 TEST_F(Vulkan, TexturedGltfSceneMatchesTheCpu) {
     Scene s = load_scene(LC_SOURCE_DIR "/scenes/gltf/textured.gltf");
