@@ -1,19 +1,22 @@
-// The per-invocation cut heap of shared/lightcuts.h: K = kHeapSlots entries
-// in workgroup shared memory, nothing in global memory while a cut is
-// refined. K is the smaller of render.cut_heap and the tree's
-// LightTree::cut_heap_capacity(max_cut); a cut that would outgrow it freezes
-// its smallest clusters (lc_heap_push), on the CPU reference alike.
+// The per-invocation cut heap of shared/lightcuts.h: K = kHeapSlots entries,
+// an array of the invocation's own (kHeapPrivate, the default) or in
+// workgroup shared memory. K is the smaller of render.cut_heap and the
+// tree's LightTree::cut_heap_capacity(max_cut); a cut that would outgrow it
+// freezes its smallest clusters (lc_heap_push), on the CPU reference alike.
 //
-// On CPU devices the K entries are an array of the invocation's own
-// instead (kHeapPrivate): llvmpipe turns every shared-memory access whose
-// address differs between lanes into a loop over the lanes, and such loops
-// fell from 26% to 2.7% of the shader's profile samples with the heap in
-// private memory; lavapipe's shading took 0.78-0.82 s instead of 0.93-1.42 s
-// on the room (docs/results/lavapipe.md, §10). GPUs keep shared memory.
+// Private memory measured faster on both kinds of device: llvmpipe turns
+// every shared-memory access whose address differs between lanes into a
+// loop over the lanes, and such loops fell from 26% to 2.7% of the shader's
+// profile samples with the heap in private memory (lavapipe's shading 0.78-
+// 0.82 s instead of 0.93-1.42 s on the room, docs/results/lavapipe.md,
+// §10); on an H200 K = 64 slots in shared memory left room for a fifth of
+// the invocations a multiprocessor runs, 246 ms of GPU time against 80 ms
+// private (docs/results/gpu.md).
 //
 // Only where a cut is spread over several dispatches (the driver limits how
-// long an invocation may loop: lavapipe) is its heap saved to the heap-save
-// buffer at the end of a dispatch and restored at the start of the next.
+// long an invocation may loop, as lavapipe does, or a GPU's slow tiles
+// split the work) is its heap saved to the heap-save buffer at the end of a
+// dispatch and restored at the start of the next.
 #ifndef LC_HEAP_GLSL
 #define LC_HEAP_GLSL
 

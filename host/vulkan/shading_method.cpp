@@ -68,9 +68,9 @@ public:
         // lc_heap_push); the tree bounds it too, whatever max_cut says. A
         // quad's shared cut pools its four points' K, as on the CPU
         // (host/cpu_renderer.cpp), and each of its lanes holds all of it
-        // (quadcuts.comp). All slots of every invocation live in shared
-        // memory, which limits K, or (Tuning::heap_memory, CPU devices) in
-        // each invocation's own private array, which does not.
+        // (quadcuts.comp). The slots are each invocation's own private
+        // array, which does not limit K, or (Tuning::heap_memory) all
+        // slots of every invocation live in shared memory, which does.
         heap_slots_ = tree.cut_heap_slots(frame.max_cut, quads ? quad_cut_heap(cut_heap) : cut_heap);
         const std::uint64_t bytes = std::uint64_t(heap_slots_) * gpu::kWorkgroupSize * entry_bytes();
         if (tuning.heap_memory != Tuning::HeapMemory::kPrivate && bytes > shared_memory_bytes)

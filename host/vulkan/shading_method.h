@@ -37,8 +37,8 @@ public:
     virtual ~ShadingMethod() = default;
 
     virtual KernelCode kernel() const = 0;
-    // Cut-heap slots per invocation, all in workgroup shared memory
-    // (shaders/heap.glsl); 0 for a method without a heap.
+    // Cut-heap slots per invocation, in its private memory or in workgroup
+    // shared memory (shaders/heap.glsl); 0 for a method without a heap.
     virtual std::uint32_t heap_slots() const { return 0; }
     // Bytes per tile pixel of the heap-save and cut state buffers (0: not
     // used; the binding still gets a one-element buffer).

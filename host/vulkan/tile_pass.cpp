@@ -162,11 +162,13 @@ PassTiming TilePass::run(Submitter& submitter, const gpu::PushConstants& tile, b
     const std::vector<double> seconds = timestamps_.intervals(2 + dispatches);
     if (seconds.empty()) {
         timing.slowest_dispatch_ms = wall_ms / (1 + dispatches);
+        timing.slowest_shading_ms = timing.slowest_dispatch_ms;
         return timing;
     }
     timing.seconds_primary = seconds[0];
     timing.seconds_shading = std::accumulate(seconds.begin() + 1, seconds.end(), 0.0);
     timing.slowest_dispatch_ms = *std::max_element(seconds.begin(), seconds.end()) * 1e3;
+    timing.slowest_shading_ms = *std::max_element(seconds.begin() + 1, seconds.end()) * 1e3;
     return timing;
 }
 

@@ -18,7 +18,8 @@ namespace lc::vk {
 struct PassTiming {
     double seconds_primary = 0.0;
     double seconds_shading = 0.0;
-    double slowest_dispatch_ms = 0.0;
+    double slowest_dispatch_ms = 0.0;  // camera rays or shading
+    double slowest_shading_ms = 0.0;
 };
 
 class TilePass {

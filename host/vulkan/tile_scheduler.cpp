@@ -24,8 +24,9 @@ TileScheduler::TileScheduler(std::string device_name, Submitter& submitter, Tile
 // Tiles: bands of rows, each cut into tiles of about `budget` pixels. The
 // budget adapts so one dispatch takes about target_dispatch_ms (growing at
 // most 2x per tile, as the next tile may be harder): starting small keeps
-// the first dispatch short on any device, and a pass that the driver's loop
-// limit spoils cheap. A tile never drops below min_tile_pixels (a CPU
+// the first dispatch about one pixel's time (where a pixel's own work takes
+// longer than the target, the first dispatch does too; later ones are split
+// below), and a pass that the driver's loop limit spoils cheap. A tile never drops below min_tile_pixels (a CPU
 // device's threads each need workgroups, a GPU's multiprocessors many)
 // unless the buffers say so; with split_slow_tiles, a tile of that size that
 // takes over 4x the target splits the method's work finer instead.
@@ -41,7 +42,12 @@ void TileScheduler::render(RenderResult& result) {
     const auto even = [quads](std::uint32_t v) { return quads ? std::max(2u, v & ~1u) : v; };
     const auto rounded_up = [quads](std::uint32_t v) { return quads ? (v + 1u) & ~1u : v; };
     samples_total_ = std::uint64_t(width) * height * frame_.spp;
-    double budget = std::min<double>(std::max(4 * gpu::kWorkgroupSize, min_tile_pixels_), max_pixels);
+    // The first tile is a probe of 256 pixels where slow tiles split the
+    // work (GPUs): its dispatch takes about one pixel's time, which says
+    // how finely to split before the tiles of the smallest size come.
+    double budget = std::min<double>(
+        split_slow_tiles_ ? 4 * gpu::kWorkgroupSize : std::max(4 * gpu::kWorkgroupSize, min_tile_pixels_),
+        max_pixels);
     const double min_budget = std::min<double>(min_tile_pixels_, max_pixels);
     for (std::uint32_t y0 = 0; y0 < height;) {
         const std::uint32_t band = std::min<std::uint32_t>(
@@ -52,13 +58,19 @@ void TileScheduler::render(RenderResult& result) {
             if (quads) fit = even(std::min(fit, resources_.tiles().invocations / rounded_up(band)));
             w = std::min({w, width - x0, fit});
             const double ms = render_tile({x0, y0, w, band}, result);
-            // A tile of the smallest size that still takes too long: each
-            // of its pixels' work is too long for one dispatch (on a GPU a
-            // tile too small to fill the device takes one pixel's time
-            // whatever its size), so that work is split over more
-            // dispatches instead of the tile shrinking.
-            if (split_slow_tiles_ && budget <= min_budget && ms > 4 * target_dispatch_ms_ && method_.split_finer())
-                result.stats.work_splits += 1;
+            // A tile no larger than the smallest size whose shading still
+            // takes too long: each of its pixels' work is too long for one
+            // dispatch (on a GPU a tile too small to fill the device takes
+            // one pixel's time whatever its size), so that work is split
+            // over more dispatches, a quarter each time until the estimate
+            // meets the target, instead of the tile shrinking.
+            const bool last = x0 + w >= width && y0 + band >= height;
+            if (split_slow_tiles_ && !last && budget <= min_budget) {
+                const std::uint32_t dispatches = method_.dispatch_count();
+                for (double t = slowest_shading_ms_; t > 4 * target_dispatch_ms_ && method_.split_finer(); t /= 4) {
+                }
+                if (method_.dispatch_count() > dispatches) result.stats.work_splits += 1;
+            }
             budget = next_budget(budget, double(w) * band, ms);
             x0 += w;
         }
@@ -77,6 +89,7 @@ double TileScheduler::next_budget(double budget, double pixels, double slowest_m
 
 double TileScheduler::render_tile(const Tile& tile, RenderResult& result) {
     double slowest_ms = 0.0;
+    slowest_shading_ms_ = 0.0;
     for (;;) {
         slowest_ms = std::max(slowest_ms, render_samples(tile, result.stats));
         const std::uint32_t cut_short = loop_limited_pixels(tile);
@@ -102,6 +115,7 @@ double TileScheduler::render_samples(const Tile& tile, RenderStats& stats) {
         stats.seconds_primary += t.seconds_primary;
         stats.seconds_shading += t.seconds_shading;
         slowest_ms = std::max(slowest_ms, t.slowest_dispatch_ms);
+        slowest_shading_ms_ = std::max(slowest_shading_ms_, t.slowest_shading_ms);
         samples_done_ += tile.pixels();
         progress_.update(samples_total_ ? double(samples_done_) / double(samples_total_) : 1.0);
     }

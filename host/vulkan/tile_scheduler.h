@@ -55,6 +55,7 @@ private:
     const double target_dispatch_ms_;
     const std::uint32_t min_tile_pixels_;  // unless the buffers allow fewer
     const bool split_slow_tiles_;
+    double slowest_shading_ms_ = 0.0;  // the current tile's slowest shading dispatch
     Progress progress_;
     std::uint64_t samples_done_ = 0, samples_total_ = 0;
 };

@@ -66,28 +66,35 @@ bool has_instance_extension(const char* name, const char* layer = nullptr) {
     });
 }
 
-// Every shared library the process has open, drivers and layers the loader
-// opened for a live instance among them, marked never to unload. The NVIDIA
-// driver keeps its thread-local variables in glibc's static TLS block, and
-// an unloaded library's share of that block is given back only when it sits
-// at the block's end: on an H200 (driver 580), a process that made and
-// destroyed instances one after another (the GPU tests; an application
-// rendering frame after frame) could not load the driver after about a
-// dozen instances ("libnvidia-tls.so: cannot allocate memory in static TLS
-// block"). Kept loaded, the driver takes its share once.
-void keep_libraries_loaded() {
+// The shared libraries the process has open, by the names the dynamic
+// linker knows them by (a path, relative where a relative search path
+// found it; the program and the vDSO have none).
+std::vector<std::string> loaded_libraries() {
     std::vector<std::string> names;
     dl_iterate_phdr(
         [](dl_phdr_info* info, std::size_t, void* out) {
-            if (info->dlpi_name != nullptr && info->dlpi_name[0] == '/')
+            if (info->dlpi_name != nullptr && std::strchr(info->dlpi_name, '/') != nullptr)
                 static_cast<std::vector<std::string>*>(out)->push_back(info->dlpi_name);
             return 0;
         },
         &names);
-    // dlopen is not called from the callback, which runs under the dynamic
-    // linker's lock.
-    for (const std::string& name : names)
-        if (void* handle = dlopen(name.c_str(), RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE)) dlclose(handle);
+    return names;
+}
+
+// The libraries opened since `before` (for an instance: its drivers and
+// layers), marked never to unload. The NVIDIA driver keeps its thread-local
+// variables in glibc's static TLS block, and an unloaded library's share of
+// that block is given back only when it sits at the block's end: on an H200
+// (driver 580), a process that made and destroyed instances one after
+// another (the GPU tests; an application rendering frame after frame) could
+// not load the driver after about a dozen instances ("libnvidia-tls.so:
+// cannot allocate memory in static TLS block"). Kept loaded, the driver
+// takes its share once. dlopen is not called from dl_iterate_phdr's
+// callback, which runs under the dynamic linker's lock.
+void keep_loaded_since(const std::vector<std::string>& before) {
+    for (const std::string& name : loaded_libraries())
+        if (std::find(before.begin(), before.end(), name) == before.end())
+            if (void* handle = dlopen(name.c_str(), RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE)) dlclose(handle);
 }
 
 // The instance, with validation and the messenger's create-info chained so
@@ -137,6 +144,7 @@ Instance create_instance(bool validation, MessageLog* log, bool& debug_utils) {
     info.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
     info.ppEnabledLayerNames = layers.data();
 
+    const std::vector<std::string> before = loaded_libraries();
     VkInstance instance = VK_NULL_HANDLE;
     VkResult result = vkCreateInstance(&info, nullptr, &instance);
     if (result == VK_ERROR_INCOMPATIBLE_DRIVER)
@@ -145,7 +153,7 @@ Instance create_instance(bool validation, MessageLog* log, bool& debug_utils) {
             "VK_ERROR_INCOMPATIBLE_DRIVER)");
     VK_CHECK(result);
     volkLoadInstanceOnly(instance);
-    keep_libraries_loaded();
+    keep_loaded_since(before);
     return Instance(instance, {});
 }
 

@@ -50,20 +50,22 @@ struct Tuning {
 
     // The smallest tile (0: the device's, min_tile_pixels in render_setup.h).
     std::uint32_t min_tile_pixels = 0;
-    // Where a tile of the smallest size takes over 4x target_dispatch_ms,
-    // split each pixel's work over more dispatches (ShadingMethod::
-    // split_finer) for the tiles after it. kAuto: on GPUs, whose watchdogs
-    // the target is for; a CPU device has none.
+    // Where a tile no larger than the smallest has a shading dispatch over
+    // 4x target_dispatch_ms, split each pixel's work over more dispatches
+    // (ShadingMethod::split_finer) for the tiles after it; the first tile
+    // is then a 256-pixel probe. kAuto: on GPUs, whose watchdogs the target
+    // is for; a CPU device has none.
     enum class SplitSlowTiles { kAuto, kOn, kOff };
     SplitSlowTiles split_slow_tiles = SplitSlowTiles::kAuto;
 
     // One dispatch on a GPU stays well under any display watchdog.
     static constexpr double kGpuTargetMs = 30.0;
-    // A GPU's smallest tile: 1024 workgroups, about 8 invocations for each
-    // of an H200's 132 x 64 lanes. With tiles of a few hundred pixels
-    // brute force over 10^4 lights on an H200, whose dispatches took one
-    // pixel's time whatever the tile's size, shrank its tiles towards
-    // single pixels and did not finish 240x135 in 40 s (docs/results/gpu.md).
+    // A GPU's smallest tile: 1024 workgroups, about a quarter of the 132 x
+    // 2048 invocations an H200's multiprocessors hold. With tiles of a few
+    // hundred pixels, brute force over 10^4 lights on an H200, whose
+    // dispatches took one pixel's time whatever the tile's size, shrank its
+    // tiles towards single pixels and did not finish 240x135 in 40 s
+    // (docs/results/gpu.md).
     static constexpr std::uint32_t kGpuMinTilePixels = 1024 * 64;
     // A CPU device (lavapipe) has no watchdog, and runs each workgroup on
     // one of its threads: long dispatches of many workgroups keep them all

@@ -17,8 +17,9 @@
 //                           found the includer's way
 //   LC_CHILD_ERRORS(sp, m, left, right, min_distance2) (optional) -> vec2,
 //                           both children's lc_cluster_error at once
-// On the GPU the K slots live in workgroup shared memory; on the CPU they
-// are a per-thread array.
+// In the Vulkan kernels the K slots are each invocation's own array or in
+// workgroup shared memory (shaders/heap.glsl); on the CPU a per-thread
+// array.
 // No include guard: each kernel context (a GLSL shader, a C++ kernel
 // struct in host/cpu_kernel.h) includes it exactly once.
 

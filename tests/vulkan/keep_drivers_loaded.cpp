@@ -4,12 +4,13 @@
 
 namespace {
 
-// Sanitizer builds: LeakSanitizer checks for leaks at exit, when the
-// Vulkan loader has long unloaded the driver and the layers, so what those
-// libraries never free shows up with frames in unknown modules that no
-// suppression can name. One instance created at start and kept (reachable
-// from a global, so not itself a leak) keeps them loaded, and
-// tests/vulkan/lsan.supp can name the driver's modules.
+// Sanitizer builds: LeakSanitizer checks for leaks at exit, and a library
+// unloaded by then leaves frames in unknown modules that no suppression can
+// name. The renderer keeps the drivers and layers an instance loaded
+// (host/vulkan/vk_context.cpp), but only those of an instance it made; one
+// instance created at start and kept (reachable from a global, so not
+// itself a leak) loads them first, before any test, so that
+// tests/vulkan/lsan.supp can name the driver's modules whatever runs.
 #ifdef __SANITIZE_ADDRESS__
 struct KeepVulkanDriversLoaded : ::testing::Environment {
     void SetUp() override {

@@ -277,7 +277,7 @@ TEST_F(Vulkan, SmallTilesAndSeveralSamplesMatchCpu) {
 // wherever a bound is non-zero, so a heap of 4 slots freezes clusters at
 // most points. The GPU freezes as the CPU reference does: same image, and
 // the same count of samples that froze (but for pixels whose cut differs by
-// a rounding), all with the heap in shared memory.
+// a rounding), with the heap in the device's default memory (private).
 TEST_F(Vulkan, BoundedHeapFreezesAsTheCpuDoes) {
     PreparedScene p = prepare_scene(random_scene(41, 400, 0, 24, 20), 5);
     RenderOptions o = options("lightcuts", 24, 20, 2);
@@ -328,11 +328,12 @@ TEST_F(Vulkan, WorkSplitOverDispatchesMatchesCpu) {
     }
 }
 
-// Tiles of the smallest size that take over 4x the dispatch target (here
-// every tile: a target of a microsecond) split each pixel's work over more
-// dispatches for the tiles after them, as on GPUs, where a tile too small
-// to fill the device takes one pixel's time whatever its size: the images
-// stay the CPU's. Switched off, nothing is split.
+// Tiles of the smallest size whose shading takes over 4x the dispatch
+// target (here every tile: a target of a microsecond) split each pixel's
+// work over more dispatches for the tiles after them, as on GPUs, where a
+// tile too small to fill the device takes one pixel's time whatever its
+// size: the images stay the CPU's. An image of one tile has no tile after
+// it, and switched off nothing is split.
 TEST_F(Vulkan, SlowSmallTilesSplitTheWorkFiner) {
     PreparedScene p = prepare_scene(random_scene(72, 300, 2, 24, 20), 9);
     vk::Tuning slow;
@@ -353,6 +354,7 @@ TEST_F(Vulkan, SlowSmallTilesSplitTheWorkFiner) {
     EXPECT_GT(g.stats.work_splits, 0u);
     EXPECT_GT(g.stats.heap_paused_samples, 0u);
     expect_lightcuts_matches(p, o, g);
+    EXPECT_EQ(gpu(p, options("lightcuts", 8, 8), slow).stats.work_splits, 0u);
     slow.split_slow_tiles = vk::Tuning::SplitSlowTiles::kOff;
     EXPECT_EQ(gpu(p, o, slow).stats.work_splits, 0u);
 }

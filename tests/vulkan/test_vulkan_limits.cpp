@@ -419,7 +419,7 @@ TEST_F(Vulkan, SpreadWorkgroupsGiveTheImagesOfTileOrder) {
 }
 
 // The cut heaps in each invocation's private memory (Tuning::heap_memory;
-// the default on CPU devices) and in workgroup shared memory (GPUs') hold
+// the default) and in workgroup shared memory hold
 // the same entries: the images and counts are identical for Lightcuts and
 // Stochastic Lightcuts, with each cut in one dispatch and spread over many
 // (its heap paused in global memory between them). A heap of 8 slots
