@@ -300,10 +300,14 @@ glm::vec3 PathTracer::triangle_sample(Kernel& k, const SurfacePoint& sp, const L
     const float light_pdf = triangle_light_pdf(tri, wi, d);
     if (!(light_pdf > 0.0f && std::isfinite(light_pdf))) return glm::vec3(0.0f);  // seen edge-on
     const gpu::Material& m = sp.mat;
+    // No shadow ray where the BRDF is black (a black material, a view from
+    // below the shading normal): it could not change the sum.
+    const glm::vec3 f = k.lc_brdf_cos(m, sp.n, wi, sp.wo, cos_i);
+    if (black(f)) return glm::vec3(0.0f);
     const float weight = power_heuristic(light_pdf, bsdf_pdf(k, m, lobes, sp.n, sp.wo, wi));
     ++shadow_rays;
     if (k.lc_trace_shadow(sp.p, wi, d * (1.0f - Kernel::kShadowEndRelative))) return glm::vec3(0.0f);
-    return k.lc_brdf_cos(m, sp.n, wi, sp.wo, cos_i) * emitted * (weight / light_pdf);
+    return f * emitted * (weight / light_pdf);
 }
 
 float PathTracer::triangle_light_pdf(std::uint32_t tri, glm::vec3 wi, float t) const {
@@ -329,10 +333,12 @@ glm::vec3 PathTracer::environment_sample(Kernel& k, const SurfacePoint& sp, cons
     const glm::vec3 sky = k.lc_environment_radiance(frame_, wi);
     if (black(sky)) return glm::vec3(0.0f);
     const gpu::Material& m = sp.mat;
+    const glm::vec3 f = k.lc_brdf_cos(m, sp.n, wi, sp.wo, cos_i);
+    if (black(f)) return glm::vec3(0.0f);  // as for a triangle
     const float weight = power_heuristic(light_pdf, bsdf_pdf(k, m, lobes, sp.n, sp.wo, wi));
     ++shadow_rays;
     if (k.lc_trace_shadow(sp.p, wi, Kernel::kRayInfinity)) return glm::vec3(0.0f);
-    return k.lc_brdf_cos(m, sp.n, wi, sp.wo, cos_i) * sky * (weight / light_pdf);
+    return f * sky * (weight / light_pdf);
 }
 
 }  // namespace lc::path

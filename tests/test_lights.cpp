@@ -410,6 +410,46 @@ TEST(EnvironmentLight, ConstantSkyGivesAlbedoTimesRadiance) {
     }
 }
 
+// Few samples per texel, on maps whose texels are tall (an 8 x 1 map's
+// reach from pole to pole): the samples of a texel spread over latitudes,
+// so an upward (and a downward) plane under a constant sky still sees rho L
+// (before, a texel's two samples sat on the horizon and the plane was
+// black). A map of one light, whose directions cancel, gets a finite
+// direction (before: NaN, and the sky was dropped without a word).
+TEST(EnvironmentLight, FewSamplesOfTallTexelsSpreadOverLatitudes) {
+    for (const auto& [width, height, count] :
+         {std::tuple{8u, 1u, 16u}, {8u, 1u, 100u}, {2u, 1u, 4u}, {1u, 1u, 2u}, {1u, 1u, 8u}, {64u, 32u, 3000u}}) {
+        Environment map;
+        map.width = width;
+        map.height = height;
+        map.rgb.assign(std::size_t(map.width) * map.height * 3, 1.5f);
+        const std::vector<gpu::Light> lights = environment_lights(map, count);
+        ASSERT_EQ(lights.size(), count);
+        for (const glm::vec3 n : {glm::vec3(0, 1, 0), glm::vec3(0, -1, 0)}) {
+            const double got = plane_radiance(lights, {0, 0, 0}, n).x;
+            std::printf("[ measured ] constant sky, %ux%u map, %u directions, normal y %.0f: rho L = 0.75, got %.6f\n",
+                        width, height, count, n.y, got);
+            // The samples of a texel cover it in a few rows, each at its
+            // middle cosine: where a row straddles the plane's horizon the
+            // plane misses that row's upper part. Measured: exact but for
+            // 0.3% (8 x 1, 100 directions) and 6.25% (1 x 1, 8 directions:
+            // three rows, the middle one across the horizon); before, 0.
+            EXPECT_NEAR(got, 0.75, 0.07 * 0.75) << width << "x" << height << ", " << count;
+        }
+    }
+    for (const auto& [width, height] : {std::pair{4u, 2u}, {8u, 1u}, {64u, 32u}}) {
+        Environment map;
+        map.width = width;
+        map.height = height;
+        map.rgb.assign(std::size_t(map.width) * map.height * 3, 1.5f);
+        const std::vector<gpu::Light> one = environment_lights(map, 1);
+        ASSERT_EQ(one.size(), 1u);
+        const glm::vec3 d(one[0].x, one[0].y, one[0].z);
+        EXPECT_NEAR(glm::length(d), 1.0f, 1e-5f) << width << "x" << height;
+        EXPECT_NEAR(one[0].r, 4.0 * 3.14159265358979 * 1.5, 1e-3);
+    }
+}
+
 // A map black but for one small texel acts as the directional light from
 // that texel's direction, carrying its irradiance L * solid angle.
 TEST(EnvironmentLight, SingleTexelIsADirectionalLight) {

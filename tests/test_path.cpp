@@ -417,6 +417,25 @@ TEST(PathRender, ErrorFallsAsInverseSquareRootOfSamples) {
 
 // A scene with every kind of emitter the path tracer samples: a point
 // light, an emissive quad, and a sky outside the closed room.
+// Black surfaces under an emitter and a sky: no light, and no shadow ray
+// either, as the BRDF is black before any ray is traced (before, each
+// light sample traced one for nothing).
+TEST(PathRender, BlackSurfacesTraceNoShadowRays) {
+    Scene s;
+    s.materials = {test::lambert(glm::vec3(0.0f)), emitter(glm::vec3(0.0f), glm::vec3(4.0f), true)};
+    test::add_quad(s, {-100, 0, -100}, {-100, 0, 100}, {100, 0, 100}, {100, 0, -100}, 0);
+    test::add_quad(s, {-1, 2, -1}, {1, 2, -1}, {1, 2, 1}, {-1, 2, 1}, 1);
+    s.environment.width = s.environment.height = 1;
+    s.environment.rgb = {0.5f, 0.6f, 0.7f};
+    s.camera = test::camera({0.0f, 1.0f, 2.0f}, {0.0f, 0.0f, -1.0f}, 40.0f, 8, 8);
+    s.render.area_light_samples = 1;
+    update_bounds(s);
+    const PreparedScene p = prepare_scene(std::move(s), 1);
+    const RenderResult r = render_path(p, path_options(8, 4, 0));
+    EXPECT_GT(r.stats.camera_rays, 0u);
+    EXPECT_EQ(r.stats.shadow_rays, 0u);
+}
+
 PreparedScene all_emitters_scene(std::uint32_t size) {
     Scene s = test::room_scene({test::point_light({0.0f, 1.8f, 0.0f}, glm::vec3(1.0f))}, size);
     const auto light = std::uint32_t(s.materials.size());
