@@ -2,7 +2,7 @@
 """The Vulkan path on a hardware GPU, in one run (docs/results/gpu.md).
 
   bench/gpu.py [--out DIR] [--exe PATH] [--width W] [--height H] [--runs N]
-               [--lights FILE] [--quick]
+               [--lights FILE] [--parts 1,2,3,4,5,6] [--brute-timeout S] [--quick]
 
 Renders through Vulkan on the device the renderer picks (VK_DRIVER_FILES
 chooses the driver), each scene after one 8x8 render that compiles its

@@ -8,7 +8,7 @@ the same brightness when its light set is scaled from 10^3 to 10^6 lights.
 
 Examples:
   scripts/gen_lights.py --shape room --count 10000 --out scenes/room/lights_1e4.csv
-  scripts/gen_lights.py --shape clusters --count 1000000 --box -1,0,-1,1,2,1 \\
+  scripts/gen_lights.py --shape clusters --count 1000000 --box=-1,0,-1,1,2,1 \\
       --total-intensity 20 --out /tmp/lights_1e6.csv
 
 Standard library only, so it runs on any python3.

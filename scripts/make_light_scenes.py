@@ -11,7 +11,8 @@
                    sun: sky.json (the EXR comes from scripts/make_sky.py)
 
 Seeded and deterministic; standard library only.
-  /usr/bin/python3 scripts/make_light_scenes.py            # scenes and 10^4 spots
+  /usr/bin/python3 scripts/make_light_scenes.py            # the scenes only
+  /usr/bin/python3 scripts/make_light_scenes.py --spots 10000 --out scenes/gallery/spots_1e4.csv
   /usr/bin/python3 scripts/make_light_scenes.py --spots 100000 --out scenes/gallery/spots_1e5.csv
 """
 
