@@ -305,6 +305,15 @@ TEST(EmissionBound, UnionCosBetaIsConeUnions) {
 
 // Radiance of an upward Lambert plane point p (albedo 0.5) from a set of
 // lights, unshadowed.
+// A width x height map of one radiance.
+Environment constant_map(std::uint32_t width, std::uint32_t height, float radiance) {
+    Environment map;
+    map.width = width;
+    map.height = height;
+    map.rgb.assign(std::size_t(width) * height * 3, radiance);
+    return map;
+}
+
 glm::dvec3 plane_radiance(const std::vector<gpu::Light>& lights, glm::vec3 p, glm::vec3 n = {0, 1, 0}) {
     Plane plane;
     const Kernel::SurfacePoint sp = plane.k.lc_make_surface(p, n, n, 0, glm::vec2(0.0f));
@@ -391,10 +400,7 @@ TEST(AreaLight, SameSamplesWhateverTheThreadCount) {
 // many samples each, as from a 64 x 32 map, whose texels get one or two.
 TEST(EnvironmentLight, ConstantSkyGivesAlbedoTimesRadiance) {
     for (const auto& [width, height] : {std::pair{64u, 32u}, {1u, 1u}, {2u, 1u}, {4u, 2u}, {3u, 5u}}) {
-        Environment map;
-        map.width = width;
-        map.height = height;
-        map.rgb.assign(std::size_t(map.width) * map.height * 3, 1.5f);
+        const Environment map = constant_map(width, height, 1.5f);
         const std::vector<gpu::Light> lights = environment_lights(map, 3000);
         ASSERT_EQ(lights.size(), 3000u);
         glm::dvec3 total(0.0);
@@ -419,10 +425,7 @@ TEST(EnvironmentLight, ConstantSkyGivesAlbedoTimesRadiance) {
 TEST(EnvironmentLight, FewSamplesOfTallTexelsSpreadOverLatitudes) {
     for (const auto& [width, height, count] :
          {std::tuple{8u, 1u, 16u}, {8u, 1u, 100u}, {2u, 1u, 4u}, {1u, 1u, 2u}, {1u, 1u, 8u}, {64u, 32u, 3000u}}) {
-        Environment map;
-        map.width = width;
-        map.height = height;
-        map.rgb.assign(std::size_t(map.width) * map.height * 3, 1.5f);
+        const Environment map = constant_map(width, height, 1.5f);
         const std::vector<gpu::Light> lights = environment_lights(map, count);
         ASSERT_EQ(lights.size(), count);
         for (const glm::vec3 n : {glm::vec3(0, 1, 0), glm::vec3(0, -1, 0)}) {
@@ -438,10 +441,7 @@ TEST(EnvironmentLight, FewSamplesOfTallTexelsSpreadOverLatitudes) {
         }
     }
     for (const auto& [width, height] : {std::pair{4u, 2u}, {8u, 1u}, {64u, 32u}}) {
-        Environment map;
-        map.width = width;
-        map.height = height;
-        map.rgb.assign(std::size_t(map.width) * map.height * 3, 1.5f);
+        const Environment map = constant_map(width, height, 1.5f);
         const std::vector<gpu::Light> one = environment_lights(map, 1);
         ASSERT_EQ(one.size(), 1u);
         const glm::vec3 d(one[0].x, one[0].y, one[0].z);
@@ -453,10 +453,7 @@ TEST(EnvironmentLight, FewSamplesOfTallTexelsSpreadOverLatitudes) {
 // A map black but for one small texel acts as the directional light from
 // that texel's direction, carrying its irradiance L * solid angle.
 TEST(EnvironmentLight, SingleTexelIsADirectionalLight) {
-    Environment map;
-    map.width = 256;
-    map.height = 128;
-    map.rgb.assign(std::size_t(map.width) * map.height * 3, 0.0f);
+    Environment map = constant_map(256, 128, 0.0f);
     const std::uint32_t tx = 40, ty = 30;
     for (int c = 0; c < 3; ++c) map.rgb[(std::size_t(ty) * map.width + tx) * 3 + c] = 1000.0f;
     const std::vector<gpu::Light> lights = environment_lights(map, 300);
