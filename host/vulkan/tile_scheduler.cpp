@@ -26,10 +26,11 @@ TileScheduler::TileScheduler(std::string device_name, Submitter& submitter, Tile
 // most 2x per tile, as the next tile may be harder): starting small keeps
 // the first dispatch about one pixel's time (where a pixel's own work takes
 // longer than the target, the first dispatch does too; later ones are split
-// below), and a pass that the driver's loop limit spoils cheap. A tile never drops below min_tile_pixels (a CPU
-// device's threads each need workgroups, a GPU's multiprocessors many)
-// unless the buffers say so; with split_slow_tiles, a tile of that size that
-// takes over 4x the target splits the method's work finer instead.
+// below), and a pass that the driver's loop limit spoils cheap. After the
+// first, a tile never drops below min_tile_pixels (a CPU device's threads
+// each need workgroups, a GPU's multiprocessors many) unless the buffers say
+// so; with split_slow_tiles, a tile no larger than that whose shading takes
+// over 4x the target splits the method's work finer instead.
 //
 // Cuts shared by quads (ShadingMethod::quad_cuts) need every tile to start
 // at an even pixel, so tiles are then an even number of pixels wide and
@@ -67,8 +68,8 @@ void TileScheduler::render(RenderResult& result) {
             const bool last = x0 + w >= width && y0 + band >= height;
             if (split_slow_tiles_ && !last && budget <= min_budget) {
                 const std::uint32_t dispatches = method_.dispatch_count();
-                for (double t = slowest_shading_ms_; t > 4 * target_dispatch_ms_ && method_.split_finer(); t /= 4) {
-                }
+                double estimate = slowest_shading_ms_;
+                while (estimate > 4 * target_dispatch_ms_ && method_.split_finer()) estimate /= 4;
                 if (method_.dispatch_count() > dispatches) result.stats.work_splits += 1;
             }
             budget = next_budget(budget, double(w) * band, ms);
