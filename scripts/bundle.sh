@@ -50,4 +50,4 @@ d=$(cd "$(dirname "$0")" && pwd)
 LD_LIBRARY_PATH="$d/lib:$d/layers${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" VK_LAYER_PATH="$d/layers" exec "$@"
 RUN
 chmod +x "$out/run"
-du -sh "$out" | awk '{print "scripts/bundle.sh: " $1 " in " $2}'
+printf 'scripts/bundle.sh: %s in %s\n' "$(du -sh "$out" | cut -f1)" "$out"

@@ -20,8 +20,10 @@ missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-# node and npm fetch the bunny; any install of them will do.
-if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+# node and npm fetch the bunny; any install of them will do, and none is
+# needed once it is here.
+bunny="$(dirname "${BASH_SOURCE[0]}")/../scenes/bunny/bunny.obj"
+if [ ! -s "$bunny" ] && { ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; }; then
   missing+=(nodejs npm)
 fi
 
