@@ -17,6 +17,7 @@
 
 #include <stb_image_write.h>
 #include <tinyexr.h>
+#include <zlib.h>
 
 #include "lightcuts/error.h"
 #include "lightcuts/image.h"
@@ -136,12 +137,16 @@ void write_file(const fs::path& file, std::string_view bytes, const fs::path& sh
     if (!problem.empty()) throw std::runtime_error((shown_as.empty() ? file : shown_as).string() + ": " + problem);
 }
 
-// Concurrent writers (threads or processes) never share a temporary.
+// Concurrent writers (threads or processes) never share a temporary. The
+// name is the file's with a suffix, its start cut where the two would pass
+// the 255 bytes a file name may have on Linux's file systems.
 fs::path temporary_path_for(const fs::path& file) {
     static std::atomic<unsigned> counter{0};
-    fs::path tmp = file;
-    tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-    return tmp;
+    constexpr std::size_t kNameMax = 255;
+    const std::string suffix = ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+    std::string name = file.filename().native();
+    if (name.size() + suffix.size() > kNameMax) name.resize(kNameMax - suffix.size());
+    return file.parent_path() / (name + suffix);
 }
 
 std::string encode_exr(const Image& image, const fs::path& file) {
@@ -318,6 +323,26 @@ std::string encode_png_rgb8(std::uint32_t width, std::uint32_t height, const std
     };
     if (stbi_write_png_to_func(append, &encoded, int(width), int(height), 3, rgb8.data(), int(width * 3)) == 0)
         throw std::runtime_error(file.string() + ": cannot encode PNG image");
+    // The bytes are sRGB (the tone-mapped images and the heat maps' ramp
+    // alike), which stb does not say: an sRGB chunk, with the gAMA chunk the
+    // PNG specification asks to go with it for older readers, after IHDR.
+    constexpr std::size_t kAfterHeader = 8 + 25;  // the signature, then IHDR's length, type, 13 bytes and CRC
+    const auto chunk = [](const char* type, std::string data) {
+        std::string c(4, '\0');
+        const auto put32 = [](char* at, std::uint32_t v) {
+            for (int i = 0; i < 4; ++i) at[i] = char(v >> (24 - 8 * i));
+        };
+        put32(c.data(), std::uint32_t(data.size()));
+        c += type;
+        c += data;
+        const auto crc = std::uint32_t(::crc32(::crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(c.data() + 4),
+                                               uInt(c.size() - 4)));
+        c.resize(c.size() + 4);
+        put32(c.data() + c.size() - 4, crc);
+        return c;
+    };
+    encoded.insert(kAfterHeader, chunk("sRGB", std::string(1, '\0')) +  // rendering intent: perceptual
+                                     chunk("gAMA", std::string("\x00\x00\xb1\x8f", 4)));  // 45455: 1/2.2
     return encoded;
 }
 

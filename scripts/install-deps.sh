@@ -11,7 +11,7 @@ packages=(
   libglm-dev libtinyobjloader-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   nlohmann-json3-dev libcli11-dev
-  libstb-dev libtinyexr-dev libtinygltf-dev
+  libstb-dev libtinyexr-dev libtinygltf-dev zlib1g-dev
   python3 python3-numpy python3-matplotlib
   clang libclang-rt-14-dev
 )

@@ -219,6 +219,15 @@ TEST_F(ImageFiles, PngHasTheRightSizeAndPixels) {
     EXPECT_EQ(png.rgb, rgb);
     EXPECT_EQ(entries(), std::set<std::string>{"bytes.png"});
     EXPECT_THROW(lc::write_png_rgb8(dir_ / "short.png", w, h, std::vector<std::uint8_t>(5)), std::invalid_argument);
+    // The pixels are sRGB, and the file says so: an sRGB chunk (perceptual
+    // intent) and gAMA 45455 straight after IHDR, with their CRCs (from
+    // Python's zlib.crc32 of each chunk's type and data).
+    std::ifstream in(file, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_GT(bytes.size(), 33u + 13u + 16u);
+    EXPECT_EQ(bytes.substr(12, 4), "IHDR");
+    EXPECT_EQ(bytes.substr(33, 13), std::string("\0\0\0\x01sRGB\0\xae\xce\x1c\xe9", 13));
+    EXPECT_EQ(bytes.substr(46, 16), std::string("\0\0\0\x04gAMA\0\0\xb1\x8f\x0b\xfc\x61\x05", 16));
 }
 
 TEST_F(ImageFiles, TonemappedPngAppliesExposureAndSrgb) {
@@ -344,6 +353,13 @@ TEST(CompareImages, ZeroAndNonFiniteImagesDoNotCrash) {
     EXPECT_TRUE(std::isinf(lit.relative_rmse));
     EXPECT_DOUBLE_EQ(lit.fraction_above_5pct, 1.0);
     EXPECT_FALSE(std::isnan(lit.max_relative_error));
+    // The mean difference takes the image's sign against a black reference,
+    // and is relative to the magnitude of a negative one.
+    EXPECT_EQ(lit.mean_difference, std::numeric_limits<double>::infinity());
+    EXPECT_EQ(lc::compare_images(gray(3, 2, -1.0f), black).mean_difference, -std::numeric_limits<double>::infinity());
+    EXPECT_EQ(lc::compare_images(black, black).mean_difference, 0.0);
+    EXPECT_DOUBLE_EQ(lc::compare_images(gray(3, 2, -3.0f), gray(3, 2, -2.0f)).mean_difference, -0.5);
+    EXPECT_DOUBLE_EQ(lc::compare_images(gray(3, 2, -1.0f), gray(3, 2, -2.0f)).mean_difference, 0.5);
 
     lc::Image with_nan = gray(3, 2, 1.0f);
     with_nan.set(2, 1, {std::numeric_limits<float>::quiet_NaN(), 1.0f, 1.0f});

@@ -176,6 +176,28 @@ TEST_F(OutputSetTest, RefusesLinksDevicesPipesAndEmptyNames) {
     EXPECT_EQ(read(at("target.json")), "kept");
 }
 
+// A file name of 255 bytes, the most Linux's file systems take, is written,
+// over an existing file too (which is moved aside under a temporary's name
+// first): the temporaries' names are cut to fit. One of 256 is refused
+// before anything is created, with a message that names the output.
+TEST_F(OutputSetTest, LongestFileNamesAreWrittenAndLongerOnesRefused) {
+    const std::string longest(255, 'a');
+    write(at(longest), "old");
+    {
+        OutputSet set;
+        write(set.add(at(longest), "image"), "new");
+        set.commit();
+    }
+    EXPECT_EQ(entries(), (std::set<std::string>{longest}));
+    EXPECT_EQ(read(at(longest)), "new");
+    OutputSet set;
+    const std::string longer(256, 'b');
+    EXPECT_THAT(error_of([&] { set.add(at(longer), "image"); }),
+                HasSubstr("image " + at(longer).string() +
+                          ": the file name is 256 bytes long; a file system takes at most 255"));
+    EXPECT_EQ(entries(), (std::set<std::string>{longest}));
+}
+
 // The rename of the last output fails (its path became a folder during the
 // work): the outputs renamed before it are taken back, the file one of them
 // replaced is restored, and no temporary or moved-aside file remains.

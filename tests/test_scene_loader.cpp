@@ -238,7 +238,13 @@ TEST(SceneLoader, ObjAndMtlNumbersThatAreNotNumbersAreRefused) {
                          Bad{kVertices, "newmtl m\nKd nan 0.5 0.5\n", "m.mtl", "line 2 (Kd): 'nan' is not a number"},
                          Bad{kVertices, "newmtl m\nKd 0.5\n", "m.mtl", "line 2 (Kd): needs 3 numbers, has 1"},
                          Bad{kVertices, "newmtl m\nKd 0.5 0.5 0.5\nNs inf\n", "m.mtl", "line 3 (Ns): 'inf'"},
-                         Bad{kVertices, "newmtl m\n\tPm 0.5x\n", "m.mtl", "line 2 (Pm): '0.5x'"}}) {
+                         Bad{kVertices, "newmtl m\n\tPm 0.5x\n", "m.mtl", "line 2 (Pm): '0.5x'"},
+                         // Past float's range, which tinyobjloader reads as infinity; and a
+                         // value too small for to_string's six decimals.
+                         Bad{kVertices, "newmtl m\nKd 1e39 0.5 0.5\n", "m.obj",
+                             "material 'm'.Kd: components must be in [0, 1], got a number beyond float's range"},
+                         Bad{kVertices, "newmtl m\nKd -1e-7 0.5 0.5\n", "m.obj",
+                             "material 'm'.Kd: components must be in [0, 1], got -1e-07"}}) {
         TempDir dir;
         dir.write("m.obj", std::string("mtllib m.mtl\n") + b.vertices + "usemtl m\nf 1 2 3\n");
         dir.write("m.mtl", b.mtl);
@@ -367,6 +373,22 @@ TEST(ObjPolygons, ConcaveQuadLoadsInsideAndBadIndicesAreRefused) {
     dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 2 3 9\n");
     EXPECT_NE(input_error_of([&] { load_scene(scene); }).find("m.obj: face 2: vertex index 9 out of range (4 vertices)"),
               std::string::npos);
+    dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf -1 -2 -4\n");
+    EXPECT_NE(input_error_of([&] { load_scene(scene); })
+                  .find("m.obj: triangle 1: a relative (negative) vertex index reaches back before the first vertex"),
+              std::string::npos);
+    dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0 1\nf 1//1 2//1 3//-3\n");
+    EXPECT_NE(input_error_of([&] { load_scene(scene); })
+                  .find("m.obj: triangle 1: a relative (negative) normal index reaches back before the first normal"),
+              std::string::npos);
+    // Faces of one or two corners have no surface: skipped, with a note.
+    dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 3\nf 1 2\nf 3\n");
+    const Scene short_faces = load_scene(scene);
+    EXPECT_EQ(short_faces.triangles.size(), 1u);
+    EXPECT_TRUE(std::any_of(short_faces.load_notes.begin(), short_faces.load_notes.end(), [](const std::string& n) {
+        return n.find("m.obj: 2 faces have fewer than 3 corners (a point or a line, no surface): skipped") !=
+               std::string::npos;
+    }));
     std::string big = "v 0 0 0\nv 1 0 0\nv 1 1 0\nf";
     for (int k = 0; k < 256; ++k) big.append(" ").append(std::to_string(k % 3 + 1));
     dir.write("m.obj", big + "\n");

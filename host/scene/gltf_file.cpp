@@ -180,6 +180,9 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
     if (too_deep(json)) throw InputError(name, "", "JSON nested more than " + std::to_string(kMaxJsonDepth) + " levels deep");
     const std::string base = file.parent_path().empty() ? std::string(".") : file.parent_path().string();
     check_uri_files(json, base, name);
+    // Before tinygltf, whose messages for a value of the wrong JSON type
+    // name neither the value nor where it is.
+    check_gltf_types(json, name);
 
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(load_image_checked, nullptr);
@@ -198,7 +201,6 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
         ok = false;
     }
     if (!ok) throw InputError(name, "", "tinygltf: " + (err.empty() ? std::string("cannot parse the file") : trimmed(err)));
-    check_gltf_types(json, name);
     warn = trimmed(warn);
     for (std::size_t from = 0; from < warn.size();) {
         const std::size_t end = std::min(warn.find('\n', from), warn.size());

@@ -23,6 +23,12 @@ public:
         return path.empty() ? std::string(key) : path + "." + key;
     }
 
+    // "a string", "an array": a value's JSON type with its article.
+    static std::string a(const json& v) {
+        const std::string type = v.type_name();
+        return (type[0] == 'a' || type[0] == 'o' ? "an " : "a ") + type;
+    }
+
     // The member `key` of `object`, if both are there and it is an object.
     static const json* member(const json& object, const char* key) {
         if (!object.is_object()) return nullptr;
@@ -32,7 +38,7 @@ public:
 
     void number(const json& object, const char* key, const std::string& path) const {
         if (const json* v = member(object, key); v && !v->is_number())
-            fail(at(path, key), std::string("must be a number, not a ") + v->type_name());
+            fail(at(path, key), "must be a number, not " + a(*v));
     }
 
     void numbers(const json& object, const char* key, std::size_t count, const std::string& path) const {
@@ -43,13 +49,25 @@ public:
         for (std::size_t i = 0; i < count; ++i)
             if (!(*v)[i].is_number())
                 fail(at(path, key) + "[" + std::to_string(i) + "]",
-                     std::string("must be a number, not a ") + (*v)[i].type_name());
+                     "must be a number, not " + a((*v)[i]));
+    }
+
+    // Objects and arrays of the wrong JSON type, which tinygltf would skip
+    // (a KHR_lights_punctual that is not an object reads as no lights).
+    void object(const json& object, const char* key, const std::string& path) const {
+        if (const json* v = member(object, key); v && !v->is_object())
+            fail(at(path, key), "must be an object, not " + a(*v));
+    }
+
+    void array(const json& object, const char* key, const std::string& path) const {
+        if (const json* v = member(object, key); v && !v->is_array())
+            fail(at(path, key), "must be an array, not " + a(*v));
     }
 
     void index(const json& object, const char* key, const std::string& path) const {
         if (const json* v = member(object, key); v && !(v->is_number_unsigned()))
             fail(at(path, key), "must be a whole number >= 0, not " +
-                                       (v->is_number() ? v->dump() : std::string("a ") + v->type_name()));
+                                       (v->is_number() ? v->dump() : a(*v)));
     }
 
     void indices(const json& object, const char* key, const std::string& path) const {
@@ -129,6 +147,12 @@ public:
             index(n, "mesh", at);
             index(n, "camera", at);
             indices(n, "children", at);
+            object(n, "extensions", at);
+            if (const json* ext = member(n, "extensions")) {
+                object(*ext, "KHR_lights_punctual", at + ".extensions");
+                if (const json* light = member(*ext, "KHR_lights_punctual"))
+                    index(*light, "light", at + ".extensions.KHR_lights_punctual");
+            }
         });
         each(doc, "meshes", "", [&](const json& m, const std::string& at) {
             each(m, "primitives", at, [&](const json& p, const std::string& prim) {
@@ -153,18 +177,26 @@ public:
         });
         each(doc, "materials", "", [&](const json& m, const std::string& at) { material(m, at); });
         each(doc, "cameras", "", [&](const json& c, const std::string& at) { camera(c, at); });
+        object(doc, "extensions", "");
         const json* ext = member(doc, "extensions");
-        if (const json* lights = ext ? member(*ext, "KHR_lights_punctual") : nullptr)
+        if (ext) object(*ext, "KHR_lights_punctual", "extensions");
+        if (const json* lights = ext ? member(*ext, "KHR_lights_punctual") : nullptr) {
+            array(*lights, "lights", "extensions.KHR_lights_punctual");
             each(*lights, "lights", "extensions.KHR_lights_punctual",
                  [&](const json& l, const std::string& at) {
+                     if (!l.is_object()) fail(at, "must be an object, not " + a(l));
+                     if (const json* type = member(l, "type"); type && !type->is_string())
+                         fail(at + ".type", "must be a string, not " + a(*type));
                      numbers(l, "color", 3, at);
                      number(l, "intensity", at);
                      number(l, "range", at);
+                     object(l, "spot", at);
                      if (const json* spot = member(l, "spot")) {
                          number(*spot, "innerConeAngle", at + ".spot");
                          number(*spot, "outerConeAngle", at + ".spot");
                      }
                  });
+        }
     }
 
 private:

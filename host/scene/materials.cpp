@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include <tiny_obj_loader.h>
 
@@ -58,6 +60,19 @@ void set_emission(gpu::Material& m, glm::vec3 radiance, bool both_sides) {
 
 gpu::Material default_material() { return make_material(glm::vec3(kDefaultAlbedo), glm::vec3(0.0f), 1.0f); }
 
+namespace {
+
+// An MTL value as a message shows it: tinyobjloader has read it into a
+// float, so a number past float's range (1e39) arrives as infinity.
+std::string shown(tinyobj::real_t v) {
+    if (std::isinf(v)) return std::string(v > 0 ? "" : "-") + "a number beyond float's range";
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", static_cast<double>(v));
+    return text;
+}
+
+}  // namespace
+
 gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj_name) {
     const std::string field = "material '" + mtl.name + "'";
     const auto rgb = [&](const tinyobj::real_t* v, const char* key) {
@@ -65,7 +80,7 @@ gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj
         for (int i = 0; i < 3; ++i) {
             if (!std::isfinite(v[i]) || v[i] < 0.0 || v[i] > 1.0) {
                 throw InputError(obj_name, field + "." + key,
-                                 "components must be in [0, 1], got " + std::to_string(v[i]));
+                                 "components must be in [0, 1], got " + shown(v[i]));
             }
             c[i] = static_cast<float>(v[i]);
         }
@@ -76,13 +91,13 @@ gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj
     for (int i = 0; i < 3; ++i) {
         if (!std::isfinite(mtl.emission[i]) || mtl.emission[i] < 0.0 || mtl.emission[i] > 3.4e38) {
             throw InputError(obj_name, field + ".Ke",
-                             "components must be finite and >= 0, got " + std::to_string(mtl.emission[i]));
+                             "components must be finite and >= 0, got " + shown(mtl.emission[i]));
         }
         ke[i] = static_cast<float>(mtl.emission[i]);
     }
     const auto unit = [&](tinyobj::real_t v, const char* key) {
         if (!std::isfinite(v) || v < 0.0 || v > 1.0) {
-            throw InputError(obj_name, field + "." + key, "must be in [0, 1], got " + std::to_string(v));
+            throw InputError(obj_name, field + "." + key, "must be in [0, 1], got " + shown(v));
         }
         return static_cast<float>(v);
     };

@@ -33,6 +33,7 @@ struct ObjData {
     tinyobj::attrib_t attrib;
     std::vector<tinyobj::shape_t> shapes;
     std::vector<tinyobj::material_t> materials;
+    std::size_t short_faces = 0;  // of one or two corners, which tinyobj skips with a warning
 };
 
 // A std::istream over text that stays where it is (an OBJ may be hundreds
@@ -168,6 +169,9 @@ void read_obj(const std::filesystem::path& file, const std::string& obj_name, bo
         throw InputError(obj_name, "", "tinyobjloader: " + (err.empty() ? "parse failed" : err));
     }
     if (uses_mtl) check_usemtl_warnings(warning, obj_name, libraries.any());
+    for (std::size_t at = warning.find("Degenerated face found"); at != std::string::npos;
+         at = warning.find("Degenerated face found", at + 1))
+        ++obj.short_faces;
     for (const std::size_t n : non_finite_normals)
         if (3 * n + 2 < obj.attrib.normals.size())
             obj.attrib.normals[3 * n] = obj.attrib.normals[3 * n + 1] = obj.attrib.normals[3 * n + 2] = 0.0f;
@@ -289,11 +293,22 @@ private:
 
     // tinyobj keeps out-of-range indices (only its own triangulation of
     // quads skipped their faces, with a warning).
+    // A relative (negative) index that reaches back past the file's first
+    // element comes out of tinyobj below -1 (-1 itself is its "none", so
+    // an index one short of the first normal or vt reads as none).
     void check_index(const tinyobj::index_t& i, std::size_t f, const tinyobj::shape_t& shape) const {
         const std::size_t vertex_count = attrib_.vertices.size() / 3;
         const std::size_t normal_count = attrib_.normals.size() / 3;
         const std::size_t texcoord_count = attrib_.texcoords.size() / 2;
-        if (i.vertex_index < 0 || static_cast<std::size_t>(i.vertex_index) >= vertex_count) {
+        const auto before_first = [&](const char* what) {
+            throw InputError(obj_name_, face_name(f, shape),
+                             std::string("a relative (negative) ") + what + " index reaches back before the first " +
+                                 what);
+        };
+        if (i.vertex_index < 0) before_first("vertex");
+        if (i.normal_index < -1) before_first("normal");
+        if (i.texcoord_index < -1) before_first("texture coordinate");
+        if (static_cast<std::size_t>(i.vertex_index) >= vertex_count) {
             throw InputError(obj_name_, face_name(f, shape),
                              "vertex index " + std::to_string(i.vertex_index + 1) + " out of range (" +
                                  std::to_string(vertex_count) + " vertices)");
@@ -415,6 +430,9 @@ void load_obj(const std::filesystem::path& file, const MeshTransform& transform,
     FaceConverter faces(obj, transform, override_material, target, file, obj_name);
     std::size_t kept = 0;
     for (const tinyobj::shape_t& shape : obj.shapes) kept += faces.add_shape(shape);
+    if (const std::size_t n = obj.short_faces; n > 0)
+        target.scene.load_notes.push_back(obj_name + ": " + std::to_string(n) + (n == 1 ? " face has" : " faces have") +
+                                          " fewer than 3 corners (a point or a line, no surface): skipped");
     if (kept == 0 && faces.degenerate_by_transform() > 0 && !transform.field.empty())
         throw InputError(transform.scene_file, transform.field,
                          "makes every triangle of " + obj_name + " degenerate (a scale too small for floats?)");

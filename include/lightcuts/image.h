@@ -67,7 +67,8 @@ void write_file(const std::filesystem::path& file, std::string_view bytes,
 
 // The temporary the writers write before renaming onto `file`:
 // "<file>.tmp-<pid>-<n>", in the same folder so the rename stays within one
-// file system, and unique per process and call. Thread-safe. OutputSet names
+// file system, and unique per process and call; for a file name too long to
+// take the suffix within 255 bytes, its start. Thread-safe. OutputSet names
 // its temporaries with it too, so one pattern finds every leftover.
 std::filesystem::path temporary_path_for(const std::filesystem::path& file);
 

@@ -337,6 +337,9 @@ def bad_cases():
     # Values of the wrong JSON type, which tinygltf 2.7 would replace by its default.
     variant("bad_roughness_string", lambda d: (d.update(materials=[{"pbrMetallicRoughness": {
         "roughnessFactor": "0.5"}}]), d["meshes"][0]["primitives"][0].update(material=0)))
+    variant("bad_lights_array", lambda d: d["extensions"].update(KHR_lights_punctual=[1]))
+    variant("bad_light_string", lambda d: d["extensions"]["KHR_lights_punctual"]["lights"].__setitem__(0, "point"))
+    variant("bad_node_light_number", lambda d: d["nodes"][1]["extensions"].update(KHR_lights_punctual=0))
     variant("bad_negative_view", lambda d: d["accessors"][0].update(bufferView=-5))
     variant("bad_aspect_zero", lambda d: (d.update(cameras=[{"type": "perspective", "perspective": {
         "yfov": 0.8, "aspectRatio": 0, "znear": 0.1}}]), d["nodes"].append({"camera": 0, "translation": [0, 0, 3]}),
