@@ -147,6 +147,9 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
     if (options.method == "path") r.max_bounces = options.max_bounces;
     r.triangles = prepared.scene.triangles.size();
     r.lights = prepared.tree.lights.size();
+    for (const gpu::Triangle& t : prepared.scene.triangles)
+        if (prepared.scene.materials[t.material].flags & gpu::kMaterialEmissive) ++r.emissive_triangles;
+    r.environment_map = prepared.scene.environment.width > 0;
     r.bvh_nodes = prepared.bvh.nodes.size();
     r.black_lights = prepared.tree.black_lights;
     r.area_lights = prepared.area_lights;
@@ -156,7 +159,9 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
     r.seconds.light_tree_build = prepared.tree.build_seconds;
     r.seconds.light_sampling = prepared.light_sampling_seconds;
     r.seconds.vpls = prepared.vpl_seconds;
-    if (prepared.vpls > 0 && options.method != "path")
+    // Also where the paths left none (they all escaped, or met only black
+    // surfaces): the report says so rather than nothing.
+    if (prepared.scene.render.indirect.vpls > 0 && options.method != "path")
         r.indirect = IndirectReport{prepared.vpls, prepared.vpl_paths,
                                     prepared.scene.render.indirect.max_bounces, prepared.scene.render.indirect.clamp};
     r.seconds.render = s.seconds_total;
@@ -195,8 +200,13 @@ std::string report_text(const RenderReport& r) {
                                      : "of any length (Russian roulette)");
     const std::string black =
         r.black_lights ? format(" (and %zu black, left out of the tree)", r.black_lights) : std::string();
-    text += format("  triangles %zu, lights %zu%s, BVH %zu nodes built in %.3f s\n", r.triangles, r.lights,
-                   black.c_str(), r.bvh_nodes, r.seconds.bvh_build);
+    // The path tracer's lights are the scene's own; it samples the emissive
+    // triangles and the environment map themselves, so they are named here.
+    const std::string emissive =
+        r.emissive_triangles ? format(" (%zu emissive)", r.emissive_triangles) : std::string();
+    const char* environment = r.method == "path" && r.environment_map ? ", an environment map" : "";
+    text += format("  triangles %zu%s, lights %zu%s%s, BVH %zu nodes built in %.3f s\n", r.triangles,
+                   emissive.c_str(), r.lights, black.c_str(), environment, r.bvh_nodes, r.seconds.bvh_build);
     if (r.area_lights || r.environment_lights)
         text += format("  sampled: %zu area-light samples, %zu environment directions (%.3f s)%s\n", r.area_lights,
                        r.environment_lights, r.seconds.light_sampling,
@@ -244,6 +254,8 @@ std::string report_json(const RenderReport& r) {
         {"black_lights", r.black_lights},
         {"area_lights", r.area_lights},
         {"environment_lights", r.environment_lights},
+        {"emissive_triangles", r.emissive_triangles},
+        {"environment_map", r.environment_map},
         {"seconds", {{"load", r.seconds.load},
                      {"bvh_build", r.seconds.bvh_build},
                      {"light_tree_build", r.seconds.light_tree_build},

@@ -15,6 +15,14 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 constexpr std::size_t kMaxPathsPerVpl = 64;  // give up on scenes that paths mostly miss
+// Russian roulette's survival is at most this, as the path tracer's: an
+// albedo of 1 in a closed scene would otherwise never end a path.
+constexpr float kMaxSurvival = 0.95f;
+// The pilot paths, which measure how many VPLs a path leaves so that the
+// path count can be fixed before the VPLs are traced: a quarter of the VPLs
+// asked for, within these bounds. Their own VPLs are not kept.
+constexpr std::size_t kMinPilotPaths = 1024, kMaxPilotPaths = 16384;
+constexpr std::uint64_t kPilotIndexBase = std::uint64_t(1) << 62;  // apart from the paths' indices
 
 // A path's random numbers: a hash chain from (seed, path index).
 class PathRandom {
@@ -75,9 +83,10 @@ public:
     bool empty() const { return !(power_.total() > 0.0); }
 
     // A ray leaving a light in proportion to power: origin, direction and
-    // the flux it carries, I(w) / (P(light) pdf(w)). False when the draw
+    // the flux it carries, I(w) / (P(light) pdf(w)), in double (4 pi I of a
+    // float intensity may be past float's range). False when the draw
     // carries nothing.
-    bool start(cpu::ShadeKernel& k, PathRandom& rng, glm::vec3& org, glm::vec3& dir, glm::vec3& flux) const {
+    bool start(cpu::ShadeKernel& k, PathRandom& rng, glm::vec3& org, glm::vec3& dir, glm::dvec3& flux) const {
         const std::uint32_t i = power_.sample(rng.fine());  // never a light of zero power
         const gpu::Light& l = lights_[i];
         const double p_light = power_.pmf(i);
@@ -125,7 +134,7 @@ public:
             default:
                 return false;
         }
-        flux = intensity(l) * float(double(emitted) / p_light);
+        flux = glm::dvec3(intensity(l)) * (double(emitted) / p_light);
         return emitted > 0.0f;
     }
 
@@ -142,35 +151,39 @@ private:
     float radius_;
 };
 
-// One path's VPLs, intensities not yet divided by the path count.
+// One path's VPLs, their intensities times `scale` (1 / the path count),
+// appended to `out` where it is given; returns how many it left.
 // (`kernel` is the thread's own copy: its functions are non-const members.)
-void trace_path(cpu::ShadeKernel& kernel, const Emitters& emitters, std::uint32_t seed, std::uint64_t index,
-                std::uint32_t max_bounces, std::vector<gpu::Light>& out) {
+std::size_t trace_path(cpu::ShadeKernel& kernel, const Emitters& emitters, std::uint32_t seed, std::uint64_t index,
+                       std::uint32_t max_bounces, double scale, std::vector<gpu::Light>* out) {
     PathRandom rng(seed, index);
-    glm::vec3 org, dir, flux;
-    if (!emitters.start(kernel, rng, org, dir, flux)) return;
+    glm::vec3 org, dir;
+    glm::dvec3 flux;
+    if (!emitters.start(kernel, rng, org, dir, flux)) return 0;
     for (std::uint32_t bounce = 1;; ++bounce) {
         float t, b1, b2;
         const std::uint32_t tri = kernel.lc_trace_first_hit(org, dir, cpu::ShadeKernel::kRayInfinity, t, b1, b2);
-        if (tri == gpu::kInvalidIndex) return;
+        if (tri == gpu::kInvalidIndex) return bounce - 1;
         const auto sp = kernel.lc_surface_point(tri, b1, b2, dir);
         const gpu::Material& m = sp.mat;
         // Only the diffuse part re-emits: a Disney material's is its base
         // colour times (1 - metallic) (docs/lightcuts.md, "Indirect light").
         const glm::vec3 kd = glm::vec3(m.kd_r, m.kd_g, m.kd_b) *
                              ((m.flags & gpu::kMaterialDisney) != 0u ? 1.0f - m.metallic : 1.0f);
-        const float survive = std::min(1.0f, std::max({kd.x, kd.y, kd.z}));
-        if (!(survive > 0.0f)) return;
-        const glm::vec3 vpl = flux * kd * (1.0f / kPi);
-        gpu::Light l{};
-        l.x = sp.p.x; l.y = sp.p.y; l.z = sp.p.z;
-        l.r = vpl.x; l.g = vpl.y; l.b = vpl.z;
-        l.axis_x = sp.n.x; l.axis_y = sp.n.y; l.axis_z = sp.n.z;
-        l.type = gpu::kLightVpl;
-        out.push_back(l);
-        if (max_bounces != 0 && bounce >= max_bounces) return;
-        if (rng.next() >= survive) return;
-        flux *= kd / survive;
+        const float survive = std::min(kMaxSurvival, std::max({kd.x, kd.y, kd.z}));
+        if (!(survive > 0.0f)) return bounce - 1;
+        if (out) {
+            const glm::dvec3 vpl = flux * glm::dvec3(kd) * (scale / double(kPi));
+            gpu::Light l{};
+            l.x = sp.p.x; l.y = sp.p.y; l.z = sp.p.z;
+            l.r = float(vpl.x); l.g = float(vpl.y); l.b = float(vpl.z);
+            l.axis_x = sp.n.x; l.axis_y = sp.n.y; l.axis_z = sp.n.z;
+            l.type = gpu::kLightVpl;
+            out->push_back(l);
+        }
+        if (max_bounces != 0 && bounce >= max_bounces) return bounce;
+        if (rng.next() >= survive) return bounce;
+        flux *= glm::dvec3(kd) / double(survive);
         org = sp.p;
         dir = cosine_direction(kernel, sp.n, rng);
     }
@@ -186,6 +199,10 @@ VplSet trace_vpls(const Scene& scene, const Bvh& bvh, std::span<const gpu::Light
 
     cpu::ShadeKernel k;
     k.bvh_nodes = bvh.nodes.data();
+    if (cpu::cpu_has_avx2() && !bvh.wide8_nodes.empty()) {  // closest hits through the 8-wide tree, as make_shade_kernel
+        k.wide8_nodes = bvh.wide8_nodes.data();
+        k.wide8_leaves = bvh.wide8_leaves.data();
+    }
     k.triangles = scene.triangles.data();
     k.normals = scene.normals.data();
     k.uvs = scene.uvs.data();
@@ -195,50 +212,44 @@ VplSet trace_vpls(const Scene& scene, const Bvh& bvh, std::span<const gpu::Light
 
     if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
     const std::size_t wanted = settings.vpls;
+
+    // The pilot: how many VPLs a path leaves. The path count follows from
+    // it and is fixed before the paths are traced, so that dividing by it
+    // keeps the flux unbiased (stopping where the VPL count is reached
+    // would not: the count of paths would then depend on what they found).
+    const std::size_t pilot = std::clamp(wanted / 4, kMinPilotPaths, kMaxPilotPaths);
+    std::vector<std::size_t> pilot_vpls(threads, 0);
+    run_on_threads(threads, [&](unsigned t) {
+        cpu::ShadeKernel kernel = k;
+        for (std::size_t p = pilot * t / threads; p < pilot * (t + 1) / threads; ++p)
+            pilot_vpls[t] += trace_path(kernel, source, seed, kPilotIndexBase + p, settings.max_bounces, 0.0, nullptr);
+    });
+    std::size_t found = 0;
+    for (std::size_t n : pilot_vpls) found += n;
+    const double rate = double(found) / double(pilot);  // VPLs a path
     const std::size_t max_paths = kMaxPathsPerVpl * wanted;
-    // Rounds of paths, each split into one contiguous range per thread, so
-    // that the VPLs come out in path order whatever the thread count.
-    std::vector<std::vector<gpu::Light>> found(threads);
-    std::vector<std::vector<std::uint32_t>> per_path(threads);
-    std::size_t paths = 0;
-    while (set.lights.size() < wanted && paths < max_paths) {
-        // Enough paths for the VPLs still wanted at the rate seen so far.
-        const double rate = paths > 0 ? std::max(double(set.lights.size()) / double(paths), 0.05) : 1.0;
-        const std::size_t round =
-            std::min(max_paths - paths,
-                     std::max<std::size_t>(1024, std::size_t(double(wanted - set.lights.size()) / rate * 1.05)));
-        run_on_threads(threads, [&](unsigned t) {
-            found[t].clear();
-            per_path[t].clear();
-            const std::size_t first = paths + round * t / threads, last = paths + round * (t + 1) / threads;
-            // Room for the VPLs the rate so far expects, and a tenth more.
-            found[t].reserve(std::size_t(double(last - first) * rate * 1.1) + 16);
-            per_path[t].reserve(last - first);
-            cpu::ShadeKernel kernel = k;
-            for (std::size_t p = first; p < last; ++p) {
-                const std::size_t before = found[t].size();
-                trace_path(kernel, source, seed, p, settings.max_bounces, found[t]);
-                per_path[t].push_back(std::uint32_t(found[t].size() - before));
-            }
-        });
-        // Whole paths, in order, until the count is reached.
-        for (unsigned t = 0; t < threads && set.lights.size() < wanted; ++t) {
-            std::size_t at = 0;
-            for (std::uint32_t n : per_path[t]) {
-                set.lights.insert(set.lights.end(), found[t].begin() + at, found[t].begin() + at + n);
-                at += n;
-                ++paths;
-                if (set.lights.size() >= wanted) break;
-            }
-        }
+    const std::size_t paths =
+        rate > 0.0 ? std::clamp<std::size_t>(std::size_t(std::ceil(double(wanted) / rate)), 1, max_paths) : max_paths;
+
+    // The paths, one contiguous range per thread, joined in path order: the
+    // same VPLs whatever the thread count.
+    std::vector<std::vector<gpu::Light>> per_thread(threads);
+    const double scale = 1.0 / double(paths);
+    run_on_threads(threads, [&](unsigned t) {
+        const std::size_t first = paths * t / threads, last = paths * (t + 1) / threads;
+        per_thread[t].reserve(std::size_t(double(last - first) * rate * 1.1) + 16);
+        cpu::ShadeKernel kernel = k;
+        for (std::size_t p = first; p < last; ++p)
+            trace_path(kernel, source, seed, p, settings.max_bounces, scale, &per_thread[t]);
+    });
+    std::size_t total = 0;
+    for (const auto& v : per_thread) total += v.size();
+    set.lights.reserve(total);
+    for (auto& v : per_thread) {
+        set.lights.insert(set.lights.end(), v.begin(), v.end());
+        std::vector<gpu::Light>().swap(v);
     }
     set.paths = paths;
-    const float scale = 1.0f / float(paths);
-    for (gpu::Light& l : set.lights) {
-        l.r *= scale;
-        l.g *= scale;
-        l.b *= scale;
-    }
     return set;
 }
 

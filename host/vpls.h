@@ -20,9 +20,10 @@ struct VplSet {
     std::size_t paths = 0;           // light paths traced to leave them
 };
 
-// Traces light paths from `emitters` until they have left settings.vpls VPLs
-// (whole paths: the last may add a few more), or until 64 times as many
-// paths as VPLs found too few surfaces to stop at.
+// Traces light paths from `emitters` to leave about settings.vpls VPLs: the
+// number of paths is fixed before they are traced, from pilot paths'
+// count of VPLs a path (at most 64 paths a VPL, for scenes that paths
+// mostly miss), so that dividing by it keeps the flux unbiased.
 //
 // `emitters` are the lights the tree holds: the scene's, the area-light
 // samples and the environment's directions, so the VPLs carry exactly the
@@ -34,7 +35,7 @@ struct VplSet {
 // Where it hits a surface with Lambert albedo kd it leaves a one-sided
 // cosine emitter on the side it came from, of intensity Phi kd / pi along
 // the shading normal, divided by the number of paths; then it continues in
-// a cosine-weighted direction with flux Phi kd / q, where q = min(1,
+// a cosine-weighted direction with flux Phi kd / q, where q = min(0.95,
 // max(kd)) is the chance it survives Russian roulette, until it has left
 // settings.max_bounces VPLs (0: until roulette ends it).
 //

@@ -66,6 +66,8 @@ struct RenderReport {
     std::size_t black_lights = 0;             // zero-intensity lights left out of the tree
     std::size_t area_lights = 0;              // samples of the emissive surfaces (in `lights`, or black)
     std::size_t environment_lights = 0;       // directions of the environment (in `lights`)
+    std::size_t emissive_triangles = 0;       // of `triangles`, with an emissive material
+    bool environment_map = false;             // the scene has one (the path tracer samples it as it is)
     struct Seconds {
         double load = 0.0, bvh_build = 0.0, light_tree_build = 0.0, light_sampling = 0.0, vpls = 0.0;
         double render = 0.0, primary = 0.0, shading = 0.0;
