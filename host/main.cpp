@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <future>
 #include <limits>
+#include <new>
 #include <optional>
 #include <utility>
 
@@ -395,6 +396,13 @@ int main(int argc, char** argv) {
         if (*render) return run_render(r);
         if (*compare) return run_compare(cmp_image, cmp_ref, cmp_heatmap, cmp_json);
         if (*info) return run_info(info_scene, info_options, info_area_samples);
+    } catch (const std::bad_alloc&) {
+        // Where the memory went is not known here; what usually takes it is.
+        std::fprintf(stderr,
+                     "error: out of memory (the image's pixels and their statistics, the lights and the light tree, "
+                     "area-light samples and VPLs all grow with their settings; `lightcuts info SCENE` prints the "
+                     "buffers a scene needs)\n");
+        return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "error: %s\n", e.what());
         return 1;

@@ -60,9 +60,14 @@ void remove_temporaries_on_signal() {
     // SIGPIPE (a message to a pipe whose reader has gone, as in
     // `lightcuts render ... 2>&1 | head`) and SIGXFSZ (a write past the
     // file-size limit, `ulimit -f`).
-    for (int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGXFSZ}) {
+    // And the crashes, SIGABRT (a library's failed assertion: tinyexr's on
+    // a failed allocation), SIGSEGV and SIGBUS, where no other handler has
+    // them (a sanitizer's stays).
+    for (int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGXFSZ, SIGABRT, SIGSEGV, SIGBUS}) {
         struct sigaction current {};
         if (::sigaction(signal_number, nullptr, &current) != 0 || current.sa_handler == SIG_IGN) continue;
+        const bool crash = signal_number == SIGABRT || signal_number == SIGSEGV || signal_number == SIGBUS;
+        if (crash && ((current.sa_flags & SA_SIGINFO) != 0 || current.sa_handler != SIG_DFL)) continue;
         struct sigaction action {};
         action.sa_handler = remove_temporaries_and_reraise;
         sigemptyset(&action.sa_mask);

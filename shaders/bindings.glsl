@@ -143,6 +143,8 @@ LC_CONST uint kCutSelected = 4u;   // stochastic: the cut is final; its clusters
 LC_CONST uint kCutFreshKeys = 8u;  // quadcuts.comp: the heap's keys are from the current estimates
 LC_CONST uint kCutHeapMode = 16u;     // quadcuts.comp: the cut's list is a heap, refined largest first
 LC_CONST uint kCutPassUnderWay = 32u; // quadcuts.comp: a pass is under way (its marks in the keys' sign bits)
+LC_CONST uint kCutHitMaxCut = 64u;    // lightcuts.comp: refinement stopped at max_cut (a stochastic cut then
+                                      // goes on to shade its clusters, maybe in later dispatches)
 // quadcuts.comp keeps a quad's cut in the same record, one per lane: `shaded`
 // holds the bits of the quad's summed root bounds, `draw` those of the
 // lane's weight (host/quad_cut.h, update_weights).

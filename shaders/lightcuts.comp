@@ -54,6 +54,7 @@ void main() {
         stats.cut_indirect = s.cut_indirect;
         stats.shadow_rays = s.shadow_rays;
         stats.frozen = (s.flags & kCutFroze) != 0u ? 1u : 0u;
+        stats.hit_max_cut = (s.flags & kCutHitMaxCut) != 0u ? 1u : 0u;
         selected = (s.flags & kCutSelected) != 0u;
         shaded = s.shaded;
         draw = s.draw;
@@ -104,7 +105,8 @@ void main() {
         s.cut_size = stats.cut_size;
         s.cut_indirect = stats.cut_indirect;
         s.shadow_rays = stats.shadow_rays;
-        s.flags = (stats.frozen > 0u ? kCutFroze : 0u) | (selected ? kCutSelected : 0u);
+        s.flags = (stats.frozen > 0u ? kCutFroze : 0u) | (selected ? kCutSelected : 0u) |
+                  (stats.hit_max_cut > 0u ? kCutHitMaxCut : 0u);
         s.fixed_r = fixed_sum.x; s.fixed_g = fixed_sum.y; s.fixed_b = fixed_sum.z;
         s.heap_r = heap_sum.x; s.heap_g = heap_sum.y; s.heap_b = heap_sum.z;
         s.shaded = shaded;

@@ -82,6 +82,17 @@ public:
                 std::to_string(shared_memory_bytes) + ", so at most cut_heap " +
                 std::to_string(shared_memory_bytes / (gpu::kWorkgroupSize * entry_bytes()) / (quads ? 4u : 1u)) +
                 (quads ? " (or cut_sharing \"pixel\")" : ""));
+        // Private heaps are bounded too: a kernel with a huge private array
+        // takes the driver's compiler minutes and gigabytes, or fails.
+        const std::uint64_t private_bytes = std::uint64_t(heap_slots_) * entry_bytes();
+        if (tuning.heap_memory == Tuning::HeapMemory::kPrivate && private_bytes > Tuning::kMaxPrivateHeapBytes)
+            throw std::runtime_error(
+                "cut_heap " + std::to_string(cut_heap) + " with max_cut " + std::to_string(frame.max_cut) +
+                std::string(quads ? " shared by quads" : "") + " needs " + std::to_string(heap_slots_) +
+                " heap slots, " + std::to_string(private_bytes) + " bytes a pixel; the Vulkan kernels take at most " +
+                std::to_string(Tuning::kMaxPrivateHeapBytes / entry_bytes()) +
+                " slots: lower cut_heap or max_cut (a cut at the default max_cut needs at most 1000), or render on "
+                "the CPU");
         // A refinement adds one cluster to the cut and takes one interior
         // node off the heap for good, so a cut never sees more refinements
         // than either allows.

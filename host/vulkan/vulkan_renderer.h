@@ -58,6 +58,12 @@ struct Tuning {
     enum class SplitSlowTiles { kAuto, kOn, kOff };
     SplitSlowTiles split_slow_tiles = SplitSlowTiles::kAuto;
 
+    // The most private memory a Lightcuts invocation's heap may take: 8192
+    // slots of 8 bytes, more than a cut at the default max_cut (1000) can
+    // fill. An array of 8192 slots took lavapipe 6.9 s and 630 MB to compile
+    // and run at 8x8; one of 2^32 ran LLVM out of memory after 90 s.
+    static constexpr std::uint64_t kMaxPrivateHeapBytes = 64 * 1024;
+
     // One dispatch on a GPU stays well under any display watchdog.
     static constexpr double kGpuTargetMs = 30.0;
     // A GPU's smallest tile: 1024 workgroups, about a quarter of the 132 x

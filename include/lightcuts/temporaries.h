@@ -10,7 +10,9 @@
 namespace lc {
 
 // Makes SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE and SIGXFSZ remove every
-// tracked temporary before the signal ends the process as it would have. A signal the process
+// tracked temporary before the signal ends the process as it would have,
+// and the crashes SIGABRT, SIGSEGV and SIGBUS too where no handler has them
+// yet (a sanitizer's is left in place). A signal the process
 // ignores (SIGHUP under nohup, say) stays ignored. For programs, not
 // libraries: it replaces the signals' handlers. At most 64 temporaries are
 // tracked at a time; more are still removed on every other way out.

@@ -264,7 +264,17 @@ TEST_P(VulkanSampled, SampledAndStochasticSplitOverDispatches) {
                                                        kSplitRelative),
                   kSplitRelative);
         EXPECT_EQ(parts.stats.shadow_rays, whole.stats.shadow_rays) << method;
+        EXPECT_EQ(parts.stats.max_cut_pixels, whole.stats.max_cut_pixels) << method;
     }
+    // A stochastic cut that stops at max_cut goes on to shade its clusters,
+    // here in later dispatches: it still counts as having hit max_cut.
+    RenderOptions o = options("stochastic", 24, 16);
+    o.light_samples = 5;
+    o.max_cut = 8;
+    const RenderResult whole = gpu(p, o);
+    const RenderResult parts = gpu(p, o, split);
+    EXPECT_GT(whole.stats.max_cut_pixels, 0u);
+    EXPECT_EQ(parts.stats.max_cut_pixels, whole.stats.max_cut_pixels);
 }
 
 const Case kLightModelCases[] = {Case{"spots", true, false, false},          Case{"area", false, true, false},

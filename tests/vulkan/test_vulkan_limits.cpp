@@ -100,6 +100,27 @@ TEST_F(Vulkan, CutHeapLargerThanSharedMemoryIsRefusedThereOnly) {
     expect_lightcuts_matches(p, o, g);
 }
 
+// Private heaps have their own limit (Tuning::kMaxPrivateHeapBytes, 8192
+// slots): a heap that max_cut and the tree let grow past it is refused
+// before any kernel is compiled, naming both settings and the limit.
+TEST_F(Vulkan, CutHeapPastThePrivateLimitIsRefused) {
+    Scene s = random_scene(63, 0, 0, 8, 8);
+    s.lights = test::random_point_lights(20000, {-3, 0.5f, -3}, {3, 3, 3}, 20.0f, 63);
+    update_bounds(s);
+    PreparedScene p = prepare_scene(std::move(s), 1);
+    RenderOptions o = options("lightcuts", 8, 8);
+    o.cut_heap = 100000;
+    o.max_cut = 100000;
+    try {
+        gpu(p, o);
+        FAIL() << "expected an exception";
+    } catch (const std::runtime_error& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("cut_heap 100000 with max_cut 100000 needs "), std::string::npos) << what;
+        EXPECT_NE(what.find("the Vulkan kernels take at most 8192 slots"), std::string::npos) << what;
+    }
+}
+
 // Start every pixel's 64-bit counters at `start` (lo/hi words), run one
 // real pass of the shading kernel on top, and return the counters.
 std::vector<gpu::PixelStats> pass_over(vk::RenderSetup& setup, const gpu::FrameParams& frame,
