@@ -21,6 +21,7 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 side=128
 if [ "${1:-}" = "--size" ]; then side="$2"; shift 2; fi
 rounds="${1:-2}"
+[[ "$rounds" =~ ^[0-9]+$ ]] || { echo "usage: bench/lavapipe_vs_cpu.sh [--size N] [ROUNDS] [BINARY...]: ROUNDS is a number, not '$rounds'" >&2; exit 2; }
 shift || true
 binaries=("$@")
 [ ${#binaries[@]} -gt 0 ] || binaries=("$root/build/host/lightcuts")

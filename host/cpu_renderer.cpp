@@ -193,6 +193,11 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     // Walter's form for every refinement's children.
     const char* tightest = std::getenv("LC_CPU_TIGHTEST_BOUND");
     cpu::ShadeKernel::tightest_bound = tightest != nullptr && std::string(tightest) == "1";
+    // Benchmarks only (bench/speed.py): the camera rays alone, each pixel's
+    // first hit and what it sees there (emission, the environment), no light
+    // shaded; the per-ray cost the issue asks for leaves their time out.
+    const char* camera_only_env = std::getenv("LC_CPU_CAMERA_RAYS_ONLY");
+    const bool camera_only = camera_only_env != nullptr && std::string(camera_only_env) == "1";
     auto start = std::chrono::steady_clock::now();
 
     RenderResult result;
@@ -238,6 +243,21 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     for_each_tile(tile_count, workers, [&](std::uint32_t tile, Worker& t) {
         cpu::ShadeKernel k = cpu::make_shade_kernel(prepared, &t.heap);
         const std::uint32_t x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+        if (camera_only) {
+            for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); ++y)
+                for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); ++x) {
+                    glm::vec3 sum(0.0f);
+                    for (std::uint32_t s = 0; s < frame.spp; ++s) {
+                        cpu::ShadeKernel::SurfacePoint sp;
+                        glm::vec3 seen;
+                        k.lc_camera_sample(frame, x, y, s, sp, seen);
+                        sum += seen;
+                    }
+                    store(x, y, {sum / float(frame.spp), 0.0f, 0.0f});
+                }
+            progress.update(double(tiles_done.fetch_add(1) + 1) / tile_count);
+            return;
+        }
         if (cut_points == 8u) {
             shade_tile_by_octets(k, frame, x0, y0, t, store);
             progress.update(double(tiles_done.fetch_add(1) + 1) / tile_count);
