@@ -59,12 +59,14 @@ CompareResult compare_images(const Image& image, const Image& reference) {
     for (std::size_t p = 0; p < pixels; ++p) sum_image_lum += luminance_d(&image.rgb[p * 3]);
     // Relative to the reference's magnitude, so that an image darker than a
     // negative reference (an EXR from elsewhere) comes out negative too.
-    if (sum_ref_lum > 0.0)
+    if (std::isnan(sum_ref_lum) || std::isnan(sum_image_lum))
+        result.mean_difference = std::numeric_limits<double>::quiet_NaN();
+    else if (sum_ref_lum > 0.0)
         result.mean_difference = sum_image_lum / sum_ref_lum - 1.0;
     else if (sum_ref_lum < 0.0)
         result.mean_difference = (sum_image_lum - sum_ref_lum) / -sum_ref_lum;
-    else if (sum_image_lum == 0.0 || std::isnan(sum_image_lum))
-        result.mean_difference = sum_image_lum;  // 0, or NaN
+    else if (sum_image_lum == 0.0)
+        result.mean_difference = 0.0;
     else
         result.mean_difference = std::copysign(std::numeric_limits<double>::infinity(), sum_image_lum);
     std::size_t above1 = 0, above2 = 0, above5 = 0;

@@ -258,7 +258,7 @@ int run_info(const std::string& file, const lc::SceneOptions& options, std::opti
     std::printf("  image              %ux%u\n", scene.camera.width, scene.camera.height);
     const lc::PreparedScene prepared = lc::prepare_scene(std::move(scene), 1);
     std::printf("  area-light samples %zu\n", prepared.area_lights);
-    if (prepared.vpls)
+    if (prepared.scene.render.indirect.vpls > 0)  // also where the paths left none
         std::printf("  VPLs               %zu from %zu light paths (seed 1)\n", prepared.vpls, prepared.vpl_paths);
     std::printf("  buffers:\n%s", lc::buffer_table(lc::scene_buffer_bytes(prepared)).c_str());
     return 0;

@@ -366,6 +366,8 @@ TEST(CompareImages, ZeroAndNonFiniteImagesDoNotCrash) {
     const lc::CompareResult r = lc::compare_images(with_nan, gray(3, 2, 1.0f));
     EXPECT_TRUE(std::isnan(r.relative_rmse));
     EXPECT_TRUE(std::isnan(r.max_relative_error));
+    EXPECT_TRUE(std::isnan(r.mean_difference));
+    EXPECT_TRUE(std::isnan(lc::compare_images(black, with_nan).mean_difference));  // a NaN reference too
     EXPECT_DOUBLE_EQ(r.fraction_above_1pct, 1.0 / 6.0);  // the NaN pixel counts as wrong
 
     lc::Image with_inf = gray(3, 2, 1.0f);

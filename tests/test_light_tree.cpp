@@ -167,16 +167,30 @@ TEST(LightTree, InvariantsOnLargeDegenerateSets) {
     }
 }
 
-TEST(LightTree, ZeroIntensityChildIsNeverTheRepresentative) {
+// Black lights stay out of the tree; lights 10^40 times dimmer than their
+// neighbours (denormal floats) stay in, and are picked as a cluster's
+// representative in proportion to intensity: never, where a bright light
+// shares the cluster (a choice blind to the weights, or one whose
+// probability underflowed to a uniform draw, would pick them about half
+// the time).
+TEST(LightTree, RepresentativesFollowIntensityToTheSmallestFloats) {
     std::vector<gpu::Light> lights;
-    for (int i = 0; i < 200; ++i)
-        lights.push_back(test::point_light({float(i), 0, 0}, i % 2 ? glm::vec3(0.0f) : glm::vec3(1.0f)));
-    LightTree tree = build_light_tree(lights, 9);
-    for (const auto& n : tree.nodes) {
-        if (n.intensity_r > 0.0f) {
-            EXPECT_GT(tree.lights[n.rep_light].r, 0.0f);
-        }
+    for (int i = 0; i < 300; ++i) {
+        const glm::vec3 intensity = i % 3 == 0 ? glm::vec3(1.0f) : i % 3 == 1 ? glm::vec3(1e-40f) : glm::vec3(0.0f);
+        lights.push_back(test::point_light({float(i), 0, 0}, intensity));
     }
+    LightTree tree = build_light_tree(lights, 9);
+    EXPECT_EQ(tree.black_lights, 100u);
+    ASSERT_EQ(tree.lights.size(), 200u);
+    std::size_t dim_reps = 0, bright_subtrees = 0;
+    for (const auto& n : tree.nodes) {
+        if (n.flags & gpu::kNodeLeaf) continue;
+        if (n.intensity_r < 0.5f) continue;  // only dim lights below
+        ++bright_subtrees;
+        if (tree.lights[n.rep_light].r < 0.5f) ++dim_reps;
+    }
+    EXPECT_GT(bright_subtrees, 90u);
+    EXPECT_EQ(dim_reps, 0u);
 }
 
 TEST(LightTree, SameSeedSameTree) {

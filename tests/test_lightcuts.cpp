@@ -225,6 +225,8 @@ TEST(LightcutsBounds, TightestBoundLiesBetweenEveryLightAndTheBound) {
                 if ((node.flags & gpu::kNodeLeaf) != 0u) continue;
                 const float tightest = k.tightest_error(sp, node, f.min_distance2);
                 const float bound = k.lc_cluster_error(sp, sp.mat, node, f.min_distance2);
+                // The three are the same quantity's bounds by different float
+                // formulas: 1e-5 (about 80 ulps) covers their rounding.
                 ASSERT_GE(tightest, largest[i] * (1.0f - 1e-5f)) << "node " << i;
                 ASSERT_LE(tightest, bound * (1.0f + 1e-5f)) << "node " << i;
                 ++nodes;
@@ -543,6 +545,8 @@ TEST(BruteForce, ManyDimLightsBesideBrightOnesAllCount) {
     EXPECT_EQ(packets, loop);
     std::printf("[ measured ] brute force of 8 + 65536 lights: relative error %.2e against double\n",
                 std::abs(double(loop.x) / exact.x - 1.0));
+    // The sum is in double and rounded to float once at the end (2^-24 =
+    // 6e-8); 1e-6 allows the contributions' own float rounding besides.
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(loop[c], exact[c], 1e-6 * exact[c]);
 }
 

@@ -1,5 +1,6 @@
 // The render report (lightcuts/report.h): the JSON keeps every key scripts
 // read (bench/run) and adds the black lights; the text says what the JSON says.
+#include <algorithm>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -44,6 +45,10 @@ TEST(Report, JsonHasEveryKeyScriptsReadAndTheBlackLights) {
     EXPECT_THAT(json, HasSubstr("\"black_lights\": 3,"));
     EXPECT_THAT(json, HasSubstr("\"lights\": 20,"));
     EXPECT_THAT(json, HasSubstr("\"lights\": 7")) << "a device buffer replaces the scene array of its name";
+    // Replaces, not joins: the JSON's map would hide a second entry.
+    const auto named_lights = std::count_if(report.buffer_bytes.begin(), report.buffer_bytes.end(),
+                                            [](const BufferBytes& b) { return b.name == "lights"; });
+    EXPECT_EQ(named_lights, 1);
     EXPECT_THAT(json, HasSubstr("\"g_buffer\": 99"));
     EXPECT_THAT(json, HasSubstr("\"load\": 0.25"));
     EXPECT_THAT(report_text(report), HasSubstr("lights 20 (and 3 black, left out of the tree)"));

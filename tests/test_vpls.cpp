@@ -78,6 +78,9 @@ TEST(Vpls, OneBounceCarriesAlbedoTimesTheLightsPower) {
     EXPECT_EQ(set.lights.size(), set.paths);  // one VPL per path
     EXPECT_EQ(set.lights.size(), 5000u);
     const double emitted = 4.0 * kPi * 3.0;
+    // Each VPL carries the lights' total flux times rho / (pi N), rounded
+    // to float in a few operations (a few 2^-24 each), and vpl_power sums
+    // them in double: 1e-4 is hundreds of times that.
     EXPECT_NEAR(vpl_power(set.lights), 0.5 * emitted, 1e-4 * emitted);
     for (const gpu::Light& l : set.lights) ASSERT_EQ(l.type, gpu::kLightVpl);
 }

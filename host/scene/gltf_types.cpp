@@ -207,7 +207,7 @@ private:
 
 void check_gltf_types(std::string_view text, const std::string& name) {
     const json doc = json::parse(text.begin(), text.end(), nullptr, false);
-    if (doc.is_discarded()) return;  // tinygltf has parsed it; its own message stands
+    if (doc.is_discarded()) return;  // not JSON: tinygltf, which reads it next, says so
     TypeCheck(name).document(doc);
 }
 

@@ -13,8 +13,9 @@ namespace lc::loader {
 // must be a number, not a string" for the first value of the wrong type:
 // factors and transforms must be numbers (arrays of as many as the
 // specification says), indices and counts whole numbers >= 0, an aspect
-// ratio above 0. `json` is the glTF's JSON (a .glb's JSON chunk); it has
-// parsed already.
+// ratio above 0, the lights' extension objects and arrays. `json` is the
+// glTF's JSON (a .glb's JSON chunk), checked before tinygltf reads it;
+// JSON that does not parse is left to tinygltf's message.
 void check_gltf_types(std::string_view json, const std::string& name);
 
 }  // namespace lc::loader

@@ -3,7 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+#include <charconv>
 #include <string>
 
 #include <tiny_obj_loader.h>
@@ -65,10 +65,12 @@ namespace {
 // An MTL value as a message shows it: tinyobjloader has read it into a
 // float, so a number past float's range (1e39) arrives as infinity.
 std::string shown(tinyobj::real_t v) {
-    if (std::isinf(v)) return std::string(v > 0 ? "" : "-") + "a number beyond float's range";
+    if (std::isinf(v)) return v > 0 ? "a number beyond float's range" : "a negative number beyond float's range";
     char text[32];
-    std::snprintf(text, sizeof text, "%g", static_cast<double>(v));
-    return text;
+    // The shortest text that reads back as the same float: 1.0000001, not
+    // %g's 1; 1e-07, not 9.99999997e-08.
+    const auto end = std::to_chars(text, text + sizeof text, static_cast<float>(v)).ptr;
+    return std::string(text, end);
 }
 
 }  // namespace
@@ -91,7 +93,7 @@ gpu::Material convert_mtl(const tinyobj::material_t& mtl, const std::string& obj
     for (int i = 0; i < 3; ++i) {
         if (!std::isfinite(mtl.emission[i]) || mtl.emission[i] < 0.0 || mtl.emission[i] > 3.4e38) {
             throw InputError(obj_name, field + ".Ke",
-                             "components must be finite and >= 0, got " + shown(mtl.emission[i]));
+                             "components must be from 0 to 3.4e38, got " + shown(mtl.emission[i]));
         }
         ke[i] = static_cast<float>(mtl.emission[i]);
     }

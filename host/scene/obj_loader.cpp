@@ -292,23 +292,14 @@ private:
     }
 
     // tinyobj keeps out-of-range indices (only its own triangulation of
-    // quads skipped their faces, with a warning).
-    // A relative (negative) index that reaches back past the file's first
-    // element comes out of tinyobj below -1 (-1 itself is its "none", so
-    // an index one short of the first normal or vt reads as none).
+    // quads skipped their faces, with a warning). Relative indices reaching
+    // back before the first element are refused, with their line, by
+    // check_obj_numbers.
     void check_index(const tinyobj::index_t& i, std::size_t f, const tinyobj::shape_t& shape) const {
         const std::size_t vertex_count = attrib_.vertices.size() / 3;
         const std::size_t normal_count = attrib_.normals.size() / 3;
         const std::size_t texcoord_count = attrib_.texcoords.size() / 2;
-        const auto before_first = [&](const char* what) {
-            throw InputError(obj_name_, face_name(f, shape),
-                             std::string("a relative (negative) ") + what + " index reaches back before the first " +
-                                 what);
-        };
-        if (i.vertex_index < 0) before_first("vertex");
-        if (i.normal_index < -1) before_first("normal");
-        if (i.texcoord_index < -1) before_first("texture coordinate");
-        if (static_cast<std::size_t>(i.vertex_index) >= vertex_count) {
+        if (i.vertex_index < 0 || static_cast<std::size_t>(i.vertex_index) >= vertex_count) {
             throw InputError(obj_name_, face_name(f, shape),
                              "vertex index " + std::to_string(i.vertex_index + 1) + " out of range (" +
                                  std::to_string(vertex_count) + " vertices)");

@@ -73,8 +73,12 @@ bool is_int(std::string_view w) {
 }
 
 // A face's corners: v, v/vt, v//vn or v/vt/vn, each index an int; at most
-// 255 of them (tinyobjloader keeps a face's corner count in a byte).
-void check_face(const Line& line, const std::string& name) {
+// 255 of them (tinyobjloader keeps a face's corner count in a byte). A
+// relative (negative) index counts back from the elements read so far
+// (`seen`: vertices, texture coordinates, normals) and must not reach back
+// before the first: tinyobjloader would read one that reaches one too far
+// as "none" and drop the face's normal or texture coordinate.
+void check_face(const Line& line, const std::string& name, const std::size_t (&seen)[3]) {
     if (line.words.size() > 256)
         throw InputError(name, "line " + std::to_string(line.number) + " (f)",
                          "a face of " + std::to_string(line.words.size() - 1) + " corners; at most 255 are read");
@@ -87,6 +91,17 @@ void check_face(const Line& line, const std::string& name) {
                 throw InputError(name, "line " + std::to_string(line.number) + " (f)",
                                  "corner '" + std::string(line.words[k]) + "': index '" + std::string(index) +
                                      "' is not a whole number within 2^31");
+            if (!index.empty() && index[0] == '-') {
+                long long back = 0;
+                for (char c : index.substr(1)) back = back * 10 + (c - '0');
+                if (std::size_t(back) > seen[part]) {
+                    static constexpr const char* kWhat[3] = {"vertices", "texture coordinates", "normals"};
+                    throw InputError(name, "line " + std::to_string(line.number) + " (f)",
+                                     "corner '" + std::string(line.words[k]) + "': relative index " +
+                                         std::string(index) + " reaches back before the first of the " +
+                                         std::to_string(seen[part]) + " " + kWhat[part] + " read so far");
+                }
+            }
             corner = slash == std::string_view::npos ? std::string_view() : corner.substr(slash + 1);
         }
     }
@@ -106,10 +121,14 @@ void check_weights(const Line& line, const std::string& name) {
 
 std::vector<std::size_t> check_obj_numbers(std::string_view text, const std::string& name) {
     std::vector<std::size_t> non_finite_normals;
-    std::size_t normals = 0;
+    std::size_t seen[3] = {};  // vertices, texture coordinates, normals so far
+    std::size_t& normals = seen[2];
     for_each_line(text, [&](const Line& line) {
         const std::string_view key = line.words[0];
-        if (key == "v") check_numbers(line, 3, name);
+        if (key == "v") {
+            check_numbers(line, 3, name);
+            ++seen[0];
+        }
         // Some exporters write "vn nan nan nan" for a degenerate face;
         // tinyobjloader reads 0 and the loader takes the face normal for a
         // zero vertex normal, as documented. Words that are no number at
@@ -123,8 +142,11 @@ std::vector<std::size_t> check_obj_numbers(std::string_view text, const std::str
                 }
             ++normals;
         }
-        else if (key == "vt") check_numbers(line, 1, name);
-        else if (key == "f") check_face(line, name);
+        else if (key == "vt") {
+            check_numbers(line, 1, name);
+            ++seen[1];
+        }
+        else if (key == "f") check_face(line, name, seen);
         else if (key == "vw") check_weights(line, name);
     });
     return non_finite_normals;

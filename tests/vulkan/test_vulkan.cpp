@@ -459,7 +459,7 @@ TEST_F(Vulkan, TexturedSceneMatchesCpu) {
 // The shipped demo room (GGX torus, 1000 point lights) at reduced size.
 TEST_F(Vulkan, ShippedRoomSceneMatchesCpu) {
     const std::filesystem::path file = std::filesystem::path(LC_SOURCE_DIR) / "scenes/room/room.json";
-    if (!std::filesystem::exists(file)) GTEST_SKIP() << file << " is missing";
+    ASSERT_TRUE(std::filesystem::exists(file)) << file << " is committed";
     PreparedScene p = prepare_scene(load_scene(file), 1);
     {
         RenderOptions o = options("brute", 32, 32);
