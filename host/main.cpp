@@ -92,7 +92,7 @@ lc::RenderOptions render_options(const RenderArgs& a, const lc::Scene& scene) {
 
 // The options given on the command line that the method does not use, as
 // one note ("" if none): a render that ignores what it was told says so.
-std::string unused_options_note(const RenderArgs& a, const std::string& method) {
+std::string unused_options_note(const RenderArgs& a, const std::string& method, bool vpls) {
     const bool cuts = method == "lightcuts" || method == "stochastic";
     const struct {
         bool given, used;
@@ -109,13 +109,16 @@ std::string unused_options_note(const RenderArgs& a, const std::string& method) 
         {a.time_limit.has_value(), method == "path", "--time-limit"},
         {a.area_samples.has_value(), method != "path", "--area-samples"},
         {a.vpls.has_value(), method != "path", "--vpls"},
-        {a.vpl_bounces.has_value(), method != "path", "--vpl-bounces"},
-        {a.vpl_clamp.has_value(), method != "path", "--vpl-clamp"},
+        {a.vpl_bounces.has_value(), method != "path" && vpls, "--vpl-bounces"},
+        {a.vpl_clamp.has_value(), method != "path" && vpls, "--vpl-clamp"},
     };
     std::string unused;
     for (const auto& o : options)
         if (o.given && !o.used) unused += std::string(unused.empty() ? "" : ", ") + o.name;
-    return unused.empty() ? "" : "method " + method + " does not use " + unused;
+    if (unused.empty()) return "";
+    if (method != "path" && !vpls && (a.vpl_bounces || a.vpl_clamp))
+        return "this render makes no VPLs (no --vpls, nor render.indirect.vpls): it does not use " + unused;
+    return "method " + method + " does not use " + unused;
 }
 
 // What the loader dropped or left out, on stderr before anything else.
@@ -155,7 +158,8 @@ int run_render(RenderArgs a) {
         scene.environment.directions = 0;
     }
     lc::validate_render_options(options);
-    if (const std::string note = unused_options_note(a, options.method); !note.empty())
+    if (const std::string note = unused_options_note(a, options.method, scene.render.indirect.vpls > 0);
+        !note.empty())
         std::fprintf(stderr, "note: %s\n", note.c_str());
     if (const std::string problem = lc::vulkan_options_problem(a.device, options.method); !problem.empty())
         throw std::invalid_argument(problem);
@@ -265,17 +269,24 @@ int run_info(const std::string& file, const lc::SceneOptions& options, std::opti
 }
 
 // A file option given as "" (--stats "", say) names no file: refused, not
-// taken for the option's absence.
+// taken for the option's absence; so are an empty camera or device name.
 const CLI::Validator kFileName(
     [](std::string& name) { return name.empty() ? std::string("the file name is empty") : std::string(); }, "FILE",
     "file name");
+const CLI::Validator kCameraName(
+    [](std::string& name) { return name.empty() ? std::string("the camera name is empty") : std::string(); }, "NAME",
+    "camera name");
+const CLI::Validator kDeviceName(
+    [](std::string& name) { return name.empty() ? std::string("the device name is empty") : std::string(); },
+    "INDEX|NAME", "device name");
 
 CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
     auto* render = app.add_subcommand("render", "Render a scene to a linear OpenEXR image and a PNG preview");
     render->add_option("scene", r.scene, "Scene file (JSON, or glTF 2.0: .gltf or .glb)")->required()->check(kFileName);
     render->add_option("--camera", r.scene_options.camera,
                        "glTF scenes: the perspective camera of this name (default: the first in node order; "
-                       "none in the file: a default framing of the scene)");
+                       "none in the file: a default framing of the scene)")
+        ->check(kCameraName);
     render->add_option("-o,--output", r.outputs.image, "Output .exr (a tone-mapped .png is written beside it)")
         ->required()
         ->check(kFileName);
@@ -334,7 +345,7 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
     render->add_option("--device", r.device.device,
                        "auto (a hardware GPU through Vulkan, else the CPU path), cpu or vulkan")
         ->check(ask(lc::device_problem));
-    render->add_option("--gpu", r.device.vulkan.gpu, "Vulkan device index or name substring");
+    render->add_option("--gpu", r.device.vulkan.gpu, "Vulkan device index or name substring")->check(kDeviceName);
     render->add_flag("--validation", r.device.vulkan.validation, "Enable the Vulkan validation layer");
     render->add_option("--stats", r.outputs.stats, "Write statistics as JSON")->check(kFileName);
     render->add_option("--cut-heatmap", r.outputs.cut_heatmap, "Write per-pixel cut size as a false-colour PNG")
@@ -365,7 +376,8 @@ int main(int argc, char** argv) {
     lc::SceneOptions info_options;
     auto* info = app.add_subcommand("info", "Print what a scene holds and the memory it needs");
     info->add_option("scene", info_scene, "Scene file (JSON, or glTF 2.0: .gltf or .glb)")->required()->check(kFileName);
-    info->add_option("--camera", info_options.camera, "glTF scenes: the perspective camera of this name");
+    info->add_option("--camera", info_options.camera, "glTF scenes: the perspective camera of this name")
+        ->check(kCameraName);
     std::optional<std::uint32_t> info_area_samples;
     info->add_option("--area-samples", info_area_samples, "Point lights the emissive surfaces become, as render's")
         ->transform(setting(lc::kSettingAreaLightSamples));
@@ -387,6 +399,29 @@ int main(int argc, char** argv) {
         // --help and the like exit 0 and print as CLI11 does; errors read
         // as every other error does.
         if (e.get_exit_code() == 0) return app.exit(e);
+        // CLI11 reports a missing command or argument before an option it
+        // does not know: the unknown option, which is more likely the
+        // mistake, is named first.
+        if (dynamic_cast<const CLI::RequiredError*>(&e) != nullptr) {
+            const CLI::App* command = nullptr;
+            for (int i = 1; i < argc; ++i) {
+                const std::string word = argv[i];
+                if (command == nullptr && word.rfind("--", 0) != 0) {
+                    for (const CLI::App* c : app.get_subcommands([](CLI::App*) { return true; }))
+                        if (c->check_name(word)) command = c;
+                    continue;
+                }
+                if (word.rfind("--", 0) != 0 || word == "--") continue;
+                const std::string name = word.substr(0, word.find('='));
+                const CLI::App* in = command != nullptr ? command : &app;
+                if (in->get_option_no_throw(name) == nullptr && app.get_option_no_throw(name) == nullptr) {
+                    std::fprintf(stderr, "error: unknown option %s%s\nRun with --help for more information.\n",
+                                 name.c_str(),
+                                 command == nullptr ? " (a command comes first: render, compare or info)" : "");
+                    return e.get_exit_code();
+                }
+            }
+        }
         std::fprintf(stderr, "error: %s\nRun with --help for more information.\n", e.what());
         return e.get_exit_code();
     }

@@ -237,8 +237,18 @@ expect_error '--device: must be "auto", "cpu" or "vulkan"' render "$mini" -o "$t
   fail "unused options: $(cat "$tmp/unused.txt")"
 grep -qx "note: method brute does not use --error, --light-pick, --time-limit" "$tmp/unused.txt" ||
   fail "unused options said: $(cat "$tmp/unused.txt")"
+# The VPLs' options where the render makes none.
+"$exe" render "$mini" -o "$tmp/unused.exr" --no-png --device cpu --width 2 --height 2 --method brute \
+  --vpl-bounces 2 >/dev/null 2>"$tmp/unused.txt" || fail "unused VPL options: $(cat "$tmp/unused.txt")"
+grep -qx "note: this render makes no VPLs (no --vpls, nor render.indirect.vpls): it does not use --vpl-bounces" \
+  "$tmp/unused.txt" || fail "unused VPL options said: $(cat "$tmp/unused.txt")"
 # The command line's own errors read as the others do.
 expect_error "error: unknown command 'frobnicate' (the commands are render, compare, info)" frobnicate "$mini"
+# An unknown option is named before a missing command or argument.
+expect_error "error: unknown option --bogus (a command comes first: render, compare or info)" --bogus
+expect_error "error: unknown option --bogus" render --spp 2 --bogus
+expect_error "--camera: the camera name is empty" info "$mini" --camera ""
+expect_error "--gpu: the device name is empty" render "$mini" -o "$tmp/edge2.exr" --gpu ""
 expect_error "error: --width: must be an integer from 1 to 16384" render "$mini" -o "$tmp/edge2.exr" --width=+8
 [ -e "$tmp/edge2.exr" ] && fail "a refused render left edge2.exr behind"
 
