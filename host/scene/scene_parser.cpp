@@ -103,12 +103,9 @@ private:
         if (const json* v = JsonReader::find(j, "fov_y_degrees")) {
             cam.fov_y_degrees = in_.number_in(*v, "camera.fov_y_degrees", 0.0f, 180.0f, true, true);
         }
-        if (const json* v = JsonReader::find(j, "width")) {
-            cam.width = in_.unsigned_int(*v, "camera.width", 1, kMaxImageSide);
-        }
-        if (const json* v = JsonReader::find(j, "height")) {
-            cam.height = in_.unsigned_int(*v, "camera.height", 1, kMaxImageSide);
-        }
+        // Checked as --width and --height are, with the same message.
+        if (const auto v = number_setting(j, path, kSettingWidth)) cam.width = static_cast<std::uint32_t>(*v);
+        if (const auto v = number_setting(j, path, kSettingHeight)) cam.height = static_cast<std::uint32_t>(*v);
 
         // The camera basis is cross(forward, up): both must be usable.
         const glm::vec3 forward = cam.look_at - cam.position;
