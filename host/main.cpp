@@ -341,7 +341,8 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
         ->transform(setting(lc::kSettingSeed));
     render->add_option("--threads", r.threads,
                        "CPU threads of the render, the reading of light lists, the area-light sampling, the VPLs "
-                       "and the light tree's build (0 = all cores)");
+                       "and the light tree's build (0 = all cores; at most 1024)")
+        ->transform(setting(lc::kSettingThreads));
     render->add_option("--device", r.device.device,
                        "auto (a hardware GPU through Vulkan, else the CPU path), cpu or vulkan")
         ->check(ask(lc::device_problem));

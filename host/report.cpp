@@ -144,7 +144,12 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
     r.spp = s.spp_done ? s.spp_done : options.spp;
     // The path tracer's samples are paths: light_samples along each camera ray.
     r.spp_requested = options.method == "path" ? options.spp * options.light_samples : options.spp;
-    if (options.method == "path") r.max_bounces = options.max_bounces;
+    if (options.method == "path") {
+        r.max_bounces = options.max_bounces;
+        r.time_limit = options.time_limit;
+        // light_samples paths along each camera ray (spp x light_samples paths a pixel)
+        r.sampling = SamplingReport{options.light_samples, ""};
+    }
     r.triangles = prepared.scene.triangles.size();
     r.lights = prepared.tree.lights.size();
     for (const gpu::Triangle& t : prepared.scene.triangles)
@@ -194,10 +199,14 @@ std::string report_text(const RenderReport& r) {
                               r.method.c_str(), r.device.c_str());
     if (r.spp != r.spp_requested)
         text += format("  stopped at the time limit after %u of %u spp\n", r.spp, r.spp_requested);
-    if (r.method == "path")
-        text += format("  %u path(s) per pixel, %s\n", r.spp,
+    if (r.method == "path") {
+        const std::uint32_t along = r.sampling ? r.sampling->light_samples : 1u;
+        const std::string split =
+            along > 1 ? format(" (%u along each camera ray)", along) : std::string();
+        text += format("  %u path(s) per pixel%s, %s\n", r.spp, split.c_str(),
                        r.max_bounces ? format("at most %u bounce(s)", r.max_bounces).c_str()
                                      : "of any length (Russian roulette)");
+    }
     const std::string black =
         r.black_lights ? format(" (and %zu black, left out of the tree)", r.black_lights) : std::string();
     // The path tracer's lights are the scene's own; it samples the emissive
@@ -231,7 +240,7 @@ std::string report_text(const RenderReport& r) {
     if (r.lightcuts) text += lightcuts_text(r, *r.lightcuts);
     if (r.sampling && r.method == "stochastic")
         text += format("  %u fresh representative(s) per cluster of the cut\n", r.sampling->light_samples);
-    else if (r.sampling)
+    else if (r.sampling && r.method == "sampled")
         text += format("  %u light sample(s) per camera sample, picked by %s\n", r.sampling->light_samples,
                        r.sampling->light_pick.c_str());
     return text;
@@ -274,7 +283,10 @@ std::string report_json(const RenderReport& r) {
         {"buffer_bytes", buffers},
     };
     if (r.lightcuts) j["lightcuts"] = lightcuts_json(*r.lightcuts, r.device == "cpu");
-    if (r.method == "path") j["max_bounces"] = r.max_bounces;
+    if (r.method == "path") {
+        j["max_bounces"] = r.max_bounces;
+        j["time_limit"] = r.time_limit;
+    }
     if (r.indirect)
         j["indirect"] = {{"vpls", r.indirect->vpls},
                          {"paths", r.indirect->paths},

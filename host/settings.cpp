@@ -38,6 +38,7 @@ std::string setting_problem(std::string_view key, double value) {
         return integer_problem(value, 1, kMaxLightSamples);
     if (key == kSettingVpls) return integer_problem(value, 0, kMaxVpls);
     if (key == kSettingMaxBounces) return integer_problem(value, 0, kMaxBounces);
+    if (key == kSettingThreads) return integer_problem(value, 0, kMaxThreads);
     if (key == kSettingTimeLimit || key == kSettingClamp) {
         if (!(value >= 0.0 && value <= double(std::numeric_limits<float>::max())))
             return "must be a number from 0 to 3.4e38 (the largest float)";
@@ -91,6 +92,7 @@ void validate_render_options(const RenderOptions& o) {
         {kSettingLightSamples, o.light_samples},
         {kSettingMaxBounces, o.max_bounces},
         {kSettingTimeLimit, o.time_limit},
+        {kSettingThreads, o.threads},
     };
     for (const auto& [key, value] : values) {
         problem = setting_problem(key, value);

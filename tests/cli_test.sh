@@ -249,6 +249,7 @@ expect_error "error: unknown option --bogus (a command comes first: render, comp
 expect_error "error: unknown option --bogus" render --spp 2 --bogus
 expect_error "--camera: the camera name is empty" info "$mini" --camera ""
 expect_error "--gpu: the device name is empty" render "$mini" -o "$tmp/edge2.exr" --gpu ""
+expect_error "--threads: must be an integer from 0 to 1024" render "$mini" -o "$tmp/edge2.exr" --threads 2000
 expect_error "error: --width: must be an integer from 1 to 16384" render "$mini" -o "$tmp/edge2.exr" --width=+8
 [ -e "$tmp/edge2.exr" ] && fail "a refused render left edge2.exr behind"
 

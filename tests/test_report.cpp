@@ -99,6 +99,17 @@ TEST(Report, StochasticMethodsReportTheirSampling) {
     EXPECT_THAT(report_json(report), HasSubstr("\"light_samples\": 3"));
     EXPECT_THAT(report_json(report), Not(HasSubstr("\"light_pick\"")));
     EXPECT_THAT(report_text(report), HasSubstr("3 fresh representative(s) per cluster of the cut"));
+    // The path tracer: its paths along each camera ray and its time limit,
+    // without which spp 1 x 4 and spp 4 x 1 would read the same.
+    o.method = "path";
+    o.spp = 1;
+    o.light_samples = 4;
+    o.time_limit = 2.5f;
+    report = make_report("room.json", o, p, render_cpu(p, o), 0.0);
+    EXPECT_THAT(report_json(report), HasSubstr("\"light_samples\": 4"));
+    EXPECT_THAT(report_json(report), HasSubstr("\"time_limit\": 2.5"));
+    EXPECT_THAT(report_text(report), HasSubstr("4 path(s) per pixel (4 along each camera ray)"));
+    EXPECT_THAT(report_text(report), Not(HasSubstr("light sample(s) per camera sample")));
 }
 
 TEST(Report, BruteForceHasNoLightcutsPart) {

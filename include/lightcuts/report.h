@@ -62,6 +62,7 @@ struct RenderReport {
     std::uint32_t width = 0, height = 0, spp = 0, seed = 0;
     std::uint32_t spp_requested = 0;         // spp is what was rendered (path: less at a time limit)
     std::uint32_t max_bounces = 0;           // path only
+    double time_limit = 0.0;                 // path only: seconds, 0 = none
     std::size_t triangles = 0, lights = 0, bvh_nodes = 0;
     std::size_t black_lights = 0;             // zero-intensity lights left out of the tree
     std::size_t area_lights = 0;              // samples of the emissive surfaces (in `lights`, or black)
