@@ -409,6 +409,8 @@ TEST(LightcutsHeap, BoundedHeapKeepsTheLargestAndFreezesTheRest) {
             }
         }
         EXPECT_EQ(ss.frozen, frozen);
+        // The kernel sums the frozen bounds in float, this test in double:
+        // each float addition is off by at most 2^-24 relative.
         EXPECT_NEAR(double(ss.frozen_error), frozen_error, 1e-4 * frozen_error);
     }
 }
@@ -434,6 +436,9 @@ TEST(Lightcuts, ZeroErrorReproducesBruteForce) {
         o.cut_heap = o.max_cut;  // nothing frozen
         RenderResult lc = render_cpu(p, o);
         EXPECT_EQ(lc.stats.max_cut_pixels, 0u) << sharing;
+        // The same contributions summed in another order (a cut's clusters,
+        // not the lights one by one): float rounding, about 2^-24 per
+        // addition of similar terms; 1e-5 relative, 1e-9 absolute for black.
         for (std::size_t i = 0; i < brute.image.rgb.size(); ++i)
             ASSERT_NEAR(lc.image.rgb[i], brute.image.rgb[i], 1e-5f * brute.image.rgb[i] + 1e-9f) << sharing << " " << i;
         // It also never needs more shadow rays than brute force.

@@ -111,6 +111,9 @@ TEST_P(TreeDescent, ProbabilitiesSumToOneAndAreTheProductOfTheBranches) {
                 }
             }
             if (pick == gpu::kLightPickPower) {
+                // The kernel's probability is a product of float ratios of
+                // the nodes' float intensity sums down the tree; the test's
+                // a double ratio: 1e-4 covers the sums' and products' rounding.
                 const gpu::Light& l = tree.lights[j];
                 ASSERT_NEAR(prob[j], gpu::lc_luminance({l.r, l.g, l.b}) / luminance_total, 1e-4 * prob[j])
                     << "light " << j;
@@ -123,6 +126,8 @@ TEST_P(TreeDescent, ProbabilitiesSumToOneAndAreTheProductOfTheBranches) {
             continue;
         }
         ++points_with_light;
+        // Probabilities are float products down the tree (a few ulps each,
+        // about 20 levels), summed here in double: 1e-5 is about 80 ulps.
         ASSERT_NEAR(sum, 1.0, 1e-5) << "trial " << trial;
         for (std::uint32_t s = 0; s < 20; ++s) {
             float pdf = -1.0f;

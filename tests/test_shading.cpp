@@ -41,6 +41,7 @@ TEST(ShadingGgx, NormalIncidenceRadianceIsAnalytic) {
             const double kd = (&materials[0].kd_r)[c];
             const double ks = (&materials[0].ks_r)[c];
             const double expected = double(irradiance[c]) * (kd / kPi + ks / (4.0 * kPi * a2));
+            // A handful of float operations on values near 1 (16 ulps).
             EXPECT_NEAR(radiance[c], expected, 2e-6 * expected) << "alpha " << alpha << " channel " << c;
         }
     }
@@ -62,7 +63,10 @@ TEST(ShadingGgx, NormalDistributionIsNormalised) {
             const double mu = 1.0 - t;
             integral += double(k.lc_ggx_d(float(mu), float(t * (2.0 - t)), alpha)) * mu * (2.0 * kPi / steps);
         }
-        EXPECT_NEAR(integral, 1.0, 2e-3) << "alpha " << alpha;
+        // The midpoint rule with D in double is off by 3.3e-7 at alpha =
+        // 0.05 and less above (computed in Python); D in float adds its
+        // rounding, about 1e-7 relative a step. 1e-5 allows both.
+        EXPECT_NEAR(integral, 1.0, 1e-5) << "alpha " << alpha;
     }
 }
 
@@ -74,6 +78,8 @@ TEST(ShadingGgx, SmithMaskingMatchesTheTangentForm) {
         for (double theta = 0.0; theta < 0.5 * kPi - 1e-3; theta += 0.01) {
             const double tan_t = std::tan(theta);
             const double expected = 2.0 / (1.0 + std::sqrt(1.0 + double(alpha) * alpha * tan_t * tan_t));
+            // G1 lies in [0, 1]; a few float operations and a sqrt: 1e-5
+            // absolute is about 80 ulps at 1.
             EXPECT_NEAR(k.lc_smith_g1(float(std::cos(theta)), alpha), expected, 1e-5)
                 << "alpha " << alpha << " theta " << theta;
         }
