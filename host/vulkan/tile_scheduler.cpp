@@ -9,7 +9,8 @@ namespace lc::vk {
 TileScheduler::TileScheduler(std::string device_name, Submitter& submitter, TilePass& pass,
                              ShadingMethod& method, const GpuResources& resources,
                              const gpu::FrameParams& frame, double target_dispatch_ms,
-                             std::uint32_t min_tile_pixels, bool split_slow_tiles, bool progress)
+                             std::uint32_t min_tile_pixels, bool split_slow_tiles, double shading_ms_for_split,
+                             bool progress)
     : device_name_(std::move(device_name)),
       submitter_(submitter),
       pass_(pass),
@@ -19,6 +20,7 @@ TileScheduler::TileScheduler(std::string device_name, Submitter& submitter, Tile
       target_dispatch_ms_(target_dispatch_ms),
       min_tile_pixels_(min_tile_pixels),
       split_slow_tiles_(split_slow_tiles),
+      shading_ms_for_split_(shading_ms_for_split),
       progress_(progress) {}
 
 // Tiles: bands of rows, each cut into tiles of about `budget` pixels. The
@@ -116,7 +118,8 @@ double TileScheduler::render_samples(const Tile& tile, RenderStats& stats) {
         stats.seconds_primary += t.seconds_primary;
         stats.seconds_shading += t.seconds_shading;
         slowest_ms = std::max(slowest_ms, t.slowest_dispatch_ms);
-        slowest_shading_ms_ = std::max(slowest_shading_ms_, t.slowest_shading_ms);
+        slowest_shading_ms_ = std::max(slowest_shading_ms_,
+                                       shading_ms_for_split_ > 0.0 ? shading_ms_for_split_ : t.slowest_shading_ms);
         samples_done_ += tile.pixels();
         progress_.update(samples_total_ ? double(samples_done_) / double(samples_total_) : 1.0);
     }

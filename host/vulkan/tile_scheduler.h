@@ -26,7 +26,8 @@ public:
     TileScheduler(std::string device_name, Submitter& submitter, TilePass& pass,
                   ShadingMethod& method, const GpuResources& resources,
                   const gpu::FrameParams& frame, double target_dispatch_ms,
-                  std::uint32_t min_tile_pixels, bool split_slow_tiles, bool progress);
+                  std::uint32_t min_tile_pixels, bool split_slow_tiles, double shading_ms_for_split,
+                  bool progress);
 
     // Renders the whole image into result.image and adds to result.stats:
     // shadow rays, max-cut and spill counts, cut sizes (when the method
@@ -55,6 +56,7 @@ private:
     const double target_dispatch_ms_;
     const std::uint32_t min_tile_pixels_;  // unless the buffers allow fewer
     const bool split_slow_tiles_;
+    const double shading_ms_for_split_;  // > 0: taken as every shading dispatch's time (tests)
     double slowest_shading_ms_ = 0.0;  // the current tile's slowest shading dispatch
     Progress progress_;
     std::uint64_t samples_done_ = 0, samples_total_ = 0;

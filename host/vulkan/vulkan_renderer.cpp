@@ -74,7 +74,7 @@ RenderResult render(const Context& ctx, const PreparedScene& prepared,
     TileScheduler scheduler(ctx.device_name(), setup.submitter, setup.pass, *setup.method,
                             setup.resources, frame, tuning.target_dispatch_ms,
                             min_tile_pixels(ctx, tuning), tuning.split_slow_tiles == Tuning::SplitSlowTiles::kOn,
-                            options.progress);
+                            tuning.shading_ms_for_split, options.progress);
     scheduler.render(result);
 
     stats.spp_done = frame.spp;

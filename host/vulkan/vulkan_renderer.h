@@ -57,6 +57,10 @@ struct Tuning {
     // is for; a CPU device has none.
     enum class SplitSlowTiles { kAuto, kOn, kOff };
     SplitSlowTiles split_slow_tiles = SplitSlowTiles::kAuto;
+    // Tests only: the split rule above reads this many milliseconds as
+    // every shading dispatch's time instead of the measured one (0: the
+    // measured time), so that what it decides does not hang on a clock.
+    double shading_ms_for_split = 0.0;
 
     // The most private memory a Lightcuts invocation's heap may take: 8192
     // slots of 8 bytes, more than a cut at the default max_cut (1000) can

@@ -329,16 +329,18 @@ TEST_F(Vulkan, WorkSplitOverDispatchesMatchesCpu) {
 }
 
 // Tiles of the smallest size whose shading takes over 4x the dispatch
-// target (here every tile: a target of a microsecond) split each pixel's
-// work over more dispatches for the tiles after them, as on GPUs, where a
-// tile too small to fill the device takes one pixel's time whatever its
-// size: the images stay the CPU's. An image of one tile has no tile after
-// it, and switched off nothing is split.
+// target (here every tile: each shading dispatch taken as 100 ms against a
+// target of 1 ms, whatever the clock says) split each pixel's work over
+// more dispatches for the tiles after them, as on GPUs, where a tile too
+// small to fill the device takes one pixel's time whatever its size: the
+// images stay the CPU's. An image of one tile has no tile after it, and
+// switched off nothing is split.
 TEST_F(Vulkan, SlowSmallTilesSplitTheWorkFiner) {
     PreparedScene p = prepare_scene(random_scene(72, 300, 2, 24, 20), 9);
     vk::Tuning slow;
     slow.split_slow_tiles = vk::Tuning::SplitSlowTiles::kOn;
-    slow.target_dispatch_ms = 1e-3;
+    slow.target_dispatch_ms = 1.0;
+    slow.shading_ms_for_split = 100.0;
     slow.min_tile_pixels = 64;
     slow.max_tile_pixels = 64;
     {
