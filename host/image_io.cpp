@@ -142,10 +142,9 @@ void write_file(const fs::path& file, std::string_view bytes, const fs::path& sh
 // the 255 bytes a file name may have on Linux's file systems.
 fs::path temporary_path_for(const fs::path& file) {
     static std::atomic<unsigned> counter{0};
-    constexpr std::size_t kNameMax = 255;
     const std::string suffix = ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
     std::string name = file.filename().native();
-    if (name.size() + suffix.size() > kNameMax) name.resize(kNameMax - suffix.size());
+    if (name.size() + suffix.size() > kMaxFileNameBytes) name.resize(kMaxFileNameBytes - suffix.size());
     return file.parent_path() / (name + suffix);
 }
 

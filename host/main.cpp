@@ -270,15 +270,14 @@ int run_info(const std::string& file, const lc::SceneOptions& options, std::opti
 
 // A file option given as "" (--stats "", say) names no file: refused, not
 // taken for the option's absence; so are an empty camera or device name.
-const CLI::Validator kFileName(
-    [](std::string& name) { return name.empty() ? std::string("the file name is empty") : std::string(); }, "FILE",
-    "file name");
-const CLI::Validator kCameraName(
-    [](std::string& name) { return name.empty() ? std::string("the camera name is empty") : std::string(); }, "NAME",
-    "camera name");
-const CLI::Validator kDeviceName(
-    [](std::string& name) { return name.empty() ? std::string("the device name is empty") : std::string(); },
-    "INDEX|NAME", "device name");
+CLI::Validator non_empty(const std::string& what, const std::string& type) {
+    return CLI::Validator(
+        [what](std::string& value) { return value.empty() ? "the " + what + " is empty" : std::string(); }, type,
+        what);
+}
+const CLI::Validator kFileName = non_empty("file name", "FILE");
+const CLI::Validator kCameraName = non_empty("camera name", "NAME");
+const CLI::Validator kDeviceName = non_empty("device name", "INDEX|NAME");
 
 CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
     auto* render = app.add_subcommand("render", "Render a scene to a linear OpenEXR image and a PNG preview");

@@ -99,10 +99,9 @@ fs::path OutputSet::add(const fs::path& file, std::string_view what) {
     const std::string label = std::string(what) + " " + file.string();
     // Found here rather than by the first file system call, whose message
     // would not name the output.
-    constexpr std::size_t kNameMax = 255;  // Linux's file systems' limit, in bytes
-    if (file.filename().native().size() > kNameMax)
+    if (file.filename().native().size() > kMaxFileNameBytes)
         throw std::invalid_argument(label + ": the file name is " + std::to_string(file.filename().native().size()) +
-                                    " bytes long; a file system takes at most " + std::to_string(kNameMax));
+                                    " bytes long; a file system takes at most " + std::to_string(kMaxFileNameBytes));
     fs::path folder = file.parent_path();
     if (folder.empty()) folder = ".";
     if (!fs::is_directory(folder))

@@ -1,6 +1,7 @@
 // Linear RGB float images, OpenEXR and PNG files, and image comparison.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -71,6 +72,9 @@ void write_file(const std::filesystem::path& file, std::string_view bytes,
 // take the suffix within 255 bytes, its start. Thread-safe. OutputSet names
 // its temporaries with it too, so one pattern finds every leftover.
 std::filesystem::path temporary_path_for(const std::filesystem::path& file);
+
+// The longest file name (one path component) Linux's file systems take, in bytes.
+inline constexpr std::size_t kMaxFileNameBytes = 255;
 
 struct CompareResult {
     double relative_rmse = 0.0;       // sqrt(sum (a-r)^2 / sum r^2), all pixels and channels
