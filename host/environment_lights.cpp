@@ -26,15 +26,71 @@ struct Totals {
     glm::dvec3 direction{0.0};
 };
 
+// The splitter works on the map's texel rows each cut into `sub` bands
+// ("rows" below) of equal solid angle, their boundaries evenly spaced in
+// cos theta, so that no row is much taller in angle than the part of the
+// sphere one direction stands for (a square of 4 pi / count steradians):
+// a part of the map with one direction is then compact, and its mean
+// direction stands for it. (Whole texel rows of a map 1 to 8 texels tall
+// reach from pole to pole, or most of the way; a part of one such row put
+// its light on the row's middle latitude: under a constant 65536 x 1 sky
+// an upward plane was black, under a 4096 x 2 one 41% too bright.) Maps of
+// the usual 2:1 shape with fewer directions than texels have sub = 1.
 class Splitter {
 public:
-    Splitter(const Environment& map, std::vector<gpu::Light>& out) : map_(map), out_(out) {
-        // Exact solid angle of a texel of each row: (2 pi / W)(cos top - cos bottom).
-        row_solid_angle_.resize(map.height);
+    Splitter(const Environment& map, std::uint32_t count, std::vector<gpu::Light>& out) : map_(map), out_(out) {
+        // The tallest texel row in cos theta (the one at the equator).
+        double tallest = 0.0;
         for (std::uint32_t y = 0; y < map.height; ++y)
-            row_solid_angle_[y] = 2.0 * kPi / map.width *
-                                  (std::cos(kPi * y / map.height) - std::cos(kPi * (y + 1) / map.height));
+            tallest = std::max(tallest, std::cos(kPi * y / map.height) - std::cos(kPi * (y + 1) / map.height));
+        const double wanted = std::ceil(tallest * std::sqrt(count / (4.0 * kPi)) - 1e-9);
+        // At most 2^22 rows x columns beyond the map's own (each level of the
+        // split passes over them all).
+        const double texels = double(map.width) * map.height;
+        sub_ = std::uint32_t(std::clamp(std::min(wanted, std::floor(std::max(texels, 4194304.0) / texels)), 1.0,
+                                        double(count)));
+        // Where a texel row straddles the equator (an odd number of rows),
+        // an even number of bands puts a boundary on it, the horizon of a
+        // plane facing a pole.
+        if (sub_ > 1 && map.height % 2 == 1) sub_ += sub_ % 2;
+        rows_ = map.height * sub_;
+        // Each row's top and bottom (cos theta, theta), the exact solid angle
+        // of a texel of it, (2 pi / W)(cos top - cos bottom), and the sines
+        // and cosines of each row's and column's middle, computed as
+        // environment_direction computes them.
+        cos_.resize(rows_ + 1);
+        theta_.resize(rows_ + 1);
+        for (std::uint32_t y = 0; y <= rows_; ++y) {
+            const std::uint32_t t = y / sub_, k = y % sub_;
+            const double top = std::cos(kPi * t / map.height), bottom = std::cos(kPi * (t + 1) / map.height);
+            cos_[y] = top + (bottom - top) * k / sub_;
+            theta_[y] = k == 0 ? kPi * t / map.height : std::acos(std::clamp(cos_[y], -1.0, 1.0));
+        }
+        cos_[rows_] = -1.0;
+        row_solid_angle_.resize(rows_);
+        row_v_.resize(rows_);
+        row_sin_.resize(rows_);
+        row_cos_.resize(rows_);
+        for (std::uint32_t y = 0; y < rows_; ++y) {
+            row_solid_angle_[y] = 2.0 * kPi / map.width * (cos_[y] - cos_[y + 1]);
+            // The texel row's middle where it is whole (as the maps of sub =
+            // 1 always did); a band's middle cosine where it is cut.
+            row_v_[y] = sub_ == 1 ? (y + 0.5) / rows_
+                                  : std::acos(std::clamp(0.5 * (cos_[y] + cos_[y + 1]), -1.0, 1.0)) / kPi;
+            const double theta = kPi * double(float(row_v_[y]));
+            row_sin_[y] = std::sin(theta);
+            row_cos_[y] = std::cos(theta);
+        }
+        column_sin_.resize(map.width);
+        column_cos_.resize(map.width);
+        for (std::uint32_t x = 0; x < map.width; ++x) {
+            const double phi = 2.0 * kPi * (double(float((x + 0.5) / map.width)) - 0.5);
+            column_sin_[x] = std::sin(phi);
+            column_cos_[x] = std::cos(phi);
+        }
     }
+
+    std::uint32_t rows() const { return rows_; }
 
     void split(Region r, std::uint32_t samples) {
         const Totals t = totals(r);
@@ -49,9 +105,9 @@ public:
         }
         if (r.x1 - r.x0 == 1 && r.y1 - r.y0 == 1) return emit_texel(r, t, samples);
         // Halve the side that is longer in angle.
-        const double mid_sin = std::sin(kPi * 0.5 * (r.y0 + r.y1) / map_.height);
+        const double mid_sin = std::sin(sub_ == 1 ? kPi * 0.5 * (r.y0 + r.y1) / rows_ : 0.5 * (theta_[r.y0] + theta_[r.y1]));
         const double width = (r.x1 - r.x0) * 2.0 * kPi / map_.width * mid_sin;
-        const double height = (r.y1 - r.y0) * kPi / map_.height;
+        const double height = sub_ == 1 ? (r.y1 - r.y0) * kPi / rows_ : theta_[r.y1] - theta_[r.y0];
         Region a = r, b = r;
         if ((width >= height && r.x1 - r.x0 > 1) || r.y1 - r.y0 == 1) {
             a.x1 = b.x0 = (r.x0 + r.x1) / 2;
@@ -75,16 +131,25 @@ private:
         return {d[0], d[1], d[2]};
     }
 
+    // texel_direction of the middle of row y's texel x, from the tables.
+    glm::dvec3 middle_direction(std::uint32_t x, std::uint32_t y) const {
+        return {float(row_sin_[y] * column_sin_[x]), float(row_cos_[y]), float(-row_sin_[y] * column_cos_[x])};
+    }
+
+    const float* texel(std::uint32_t x, std::uint32_t y) const {
+        return &map_.rgb[(std::size_t(y / sub_) * map_.width + x) * 3];
+    }
+
     glm::dvec3 brightest_direction(Region r) const {
         double most = -1.0;
         glm::dvec3 towards(0.0, 1.0, 0.0);
         for (std::uint32_t y = r.y0; y < r.y1; ++y)
             for (std::uint32_t x = r.x0; x < r.x1; ++x) {
-                const float* c = &map_.rgb[(std::size_t(y) * map_.width + x) * 3];
+                const float* c = texel(x, y);
                 const double power = gpu::lc_luminance(glm::vec3(c[0], c[1], c[2])) * row_solid_angle_[y];
                 if (power > most) {
                     most = power;
-                    towards = texel_direction((x + 0.5) / map_.width, (y + 0.5) / map_.height);
+                    towards = middle_direction(x, y);
                 }
             }
         return towards;
@@ -94,12 +159,12 @@ private:
         Totals t;
         for (std::uint32_t y = r.y0; y < r.y1; ++y)
             for (std::uint32_t x = r.x0; x < r.x1; ++x) {
-                const float* c = &map_.rgb[(std::size_t(y) * map_.width + x) * 3];
+                const float* c = texel(x, y);
                 const glm::dvec3 e = glm::dvec3(c[0], c[1], c[2]) * row_solid_angle_[y];
                 const double power = gpu::lc_luminance(glm::vec3(e));
                 t.irradiance += e;
                 t.power += power;
-                t.direction += power * texel_direction((x + 0.5) / map_.width, (y + 0.5) / map_.height);
+                t.direction += power * middle_direction(x, y);
             }
         return t;
     }
@@ -122,9 +187,9 @@ private:
     // 31 x 25 instead of 28 x 28 and, for reasons not looked into, its
     // Lightcuts error against brute force went from 0.0100 to 0.0184.)
     void emit_texel(Region r, const Totals& t, std::uint32_t samples) {
-        const double cos_top = std::cos(kPi * r.y0 / map_.height);
-        const double cos_bottom = std::cos(kPi * (r.y0 + 1) / map_.height);
-        const double height = kPi / map_.height;
+        const double cos_top = cos_[r.y0];
+        const double cos_bottom = cos_[r.y0 + 1];
+        const double height = sub_ == 1 ? kPi / rows_ : theta_[r.y0 + 1] - theta_[r.y0];
         const double mean_width = row_solid_angle_[r.y0] / height;
         const auto rows_wanted = std::uint32_t(
             std::clamp(std::ceil(std::sqrt(samples * height / mean_width) - 1e-9), 1.0, double(samples)));
@@ -153,7 +218,8 @@ private:
 
     const Environment& map_;
     std::vector<gpu::Light>& out_;
-    std::vector<double> row_solid_angle_;
+    std::uint32_t sub_ = 1, rows_ = 0;
+    std::vector<double> cos_, theta_, row_solid_angle_, row_v_, row_sin_, row_cos_, column_sin_, column_cos_;
 };
 
 }  // namespace
@@ -170,7 +236,8 @@ std::vector<gpu::Light> environment_lights(const Environment& map, std::uint32_t
     std::vector<gpu::Light> lights;
     if (map.width == 0 || map.height == 0 || count == 0) return lights;
     lights.reserve(count);
-    Splitter(map, lights).split({0, map.width, 0, map.height}, count);
+    Splitter splitter(map, count, lights);
+    splitter.split({0, map.width, 0, splitter.rows()}, count);
     return lights;
 }
 

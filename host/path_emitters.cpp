@@ -16,10 +16,14 @@ double luminance(double r, double g, double b) { return 0.2126 * r + 0.7152 * g 
 
 // The texel lc_environment_radiance reads for `dir`, computed with the same
 // float operations, so that pdf() and the radiance agree on every direction.
+// theta is atan2(sin, cos): acos of a float cos(theta), whose values are
+// 6e-8 apart near 1, put samples drawn near the poles of a tall map in the
+// next row (with a bright texel one row from the pole of a 2 x 8192 map,
+// the path tracer came out 19% dark).
 void texel_of(glm::vec3 d, std::uint32_t width, std::uint32_t height, std::uint32_t& row, std::uint32_t& column) {
     constexpr float kPiF = 3.14159265358979f;  // the kernels' kPi
     const float u = 0.5f + std::atan2(d.x, -d.z) * (0.5f / kPiF);
-    const float v = std::acos(std::clamp(d.y, -1.0f, 1.0f)) * (1.0f / kPiF);
+    const float v = std::atan2(std::sqrt(d.x * d.x + d.z * d.z), d.y) * (1.0f / kPiF);
     column = std::min(std::uint32_t(std::max(u, 0.0f) * float(width)), width - 1u);
     row = std::min(std::uint32_t(std::max(v, 0.0f) * float(height)), height - 1u);
 }

@@ -125,8 +125,10 @@ SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) 
 // docs/scene-format.md; black without one).
 vec3 lc_environment_radiance(LC_IN(FrameParams) f, vec3 d) {
     if (f.env_width == 0u || f.env_height == 0u) return vec3(0.0f);
+    // theta from atan2 rather than acos(d.y): near the poles a float d.y
+    // is too coarse to tell a tall map's rows apart (host/path_emitters.cpp).
     float u = 0.5f + atan(d.x, -d.z) * (0.5f / kPi);
-    float v = acos(clamp(d.y, -1.0f, 1.0f)) * (1.0f / kPi);
+    float v = atan(sqrt(d.x * d.x + d.z * d.z), d.y) * (1.0f / kPi);
     uint col = min(uint(max(u, 0.0f) * float(f.env_width)), f.env_width - 1u);
     uint row = min(uint(max(v, 0.0f) * float(f.env_height)), f.env_height - 1u);
     return LC_ENVIRONMENT_TEXEL(row * f.env_width + col);
