@@ -3,6 +3,7 @@
 // --method sampled and --method stochastic against brute force.
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -235,6 +236,14 @@ TEST(TreeDescent, BranchStepsGiveEverySideWithWeightAShare) {
     EXPECT_EQ(k.lc_branch_steps(1.0f, 1e-9f), (1u << 24) - 1u);
     EXPECT_EQ(k.lc_branch_steps(0.0f, 1.0f), 0u);
     EXPECT_EQ(k.lc_branch_steps(1.0f, 0.0f), 1u << 24);
+    // Weights whose sum overflows a float, each in range (it was 1, the
+    // least share, for two equal ones), and infinite ones.
+    EXPECT_EQ(k.lc_branch_steps(3e38f, 3e38f), 1u << 23);
+    EXPECT_EQ(k.lc_branch_steps(1e38f, 3e38f), 1u << 22);
+    const float inf = std::numeric_limits<float>::infinity();
+    EXPECT_EQ(k.lc_branch_steps(inf, 1.0f), (1u << 24) - 1u);
+    EXPECT_EQ(k.lc_branch_steps(1.0f, inf), 1u);
+    EXPECT_EQ(k.lc_branch_steps(inf, inf), 1u << 23);
     // The draw takes the side k < n: its frequency over the 2^24 values of
     // k is n / 2^24, the probability it reports.
     for (const std::uint32_t n : {1u, 12345u, (1u << 24) - 1u}) {

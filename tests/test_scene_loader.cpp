@@ -861,14 +861,15 @@ TEST(SceneLoader, TinyTrianglesKeepUnitNormals) {
             EXPECT_NEAR(glm::length(v), 1.0f, 1e-6f);
 }
 
-TEST(SceneLoader, UpdateBoundsRefusesAnExtentBeyondFloat) {
+TEST(SceneLoader, UpdateBoundsRefusesAnExtentBeyondTheLimit) {
     Scene scene;
     scene.file = "hand_built.json";
-    scene.triangles.push_back(gpu::Triangle{2e38f, 0, 0, 3e38f, 0, 0, 2e38f, 1, 0, 0, 0, 0});
-    scene.triangles.push_back(gpu::Triangle{-2e38f, 0, 0, -2e38f, 1, 0, -3e38f, 0, 0, 0, 0, 0});
+    // Each triangle 1e18 across; together 1.2e19.
+    scene.triangles.push_back(gpu::Triangle{2e18f, 0, 0, 3e18f, 0, 0, 2e18f, 1, 0, 0, 0, 0});
+    scene.triangles.push_back(gpu::Triangle{-8e18f, 0, 0, -8e18f, 1, 0, -9e18f, 0, 0, 0, 0, 0});
     const std::string message = input_error_of([&] { update_bounds(scene); });
     EXPECT_NE(message.find("hand_built.json: triangles[1]: "), std::string::npos) << message;
-    EXPECT_NE(message.find("extent along x exceeds the float range"), std::string::npos) << message;
+    EXPECT_NE(message.find("extent along x exceeds 1e19"), std::string::npos) << message;
 }
 
 // ---------------------------------------------------------------------------
@@ -959,7 +960,7 @@ const BadInput kBadInputs[] = {
     {"bad_csv_total.json", "total_overflow.csv", "line 5: ",
      "total red intensity of the point lights exceeds the float range (3.4e38)"},
     {"bad_light_far.json", "bad_light_far.json", "lights[1].position: ",
-     "extent along y exceeds the float range (3.4e38)"},
+     "extent along y exceeds 1e19 (the square of a distance past it overflows a float)"},
     // Camera.
     {"bad_zero_width.json", "bad_zero_width.json", "camera.width: ", "must be an integer from 1 to 16384"},
     {"bad_negative_width.json", "bad_negative_width.json", "camera.width: ", "must be an integer from 1 to 16384"},
@@ -976,7 +977,7 @@ const BadInput kBadInputs[] = {
     {"bad_obj_no_faces.json", "no_faces.obj", "", "no usable triangles"},
     {"bad_obj_all_degenerate.json", "all_degenerate.obj", "", "no usable triangles"},
     {"bad_obj_index.json", "bad_index.obj", "triangle 1: ", "vertex index 9 out of range"},
-    {"bad_obj_far_apart.json", "far_apart.obj", "triangle 2: ", "extent along x exceeds the float range (3.4e38)"},
+    {"bad_obj_far_apart.json", "far_apart.obj", "triangle 2: ", "extent along x exceeds 1e19 (the square of a distance past it overflows a float)"},
     {"bad_obj_missing_mtl.json", "missing_mtl.obj", "mtllib: ", "'not_there.mtl' not found"},
     {"bad_obj_unknown_usemtl.json", "unknown_usemtl.obj", "usemtl: ", "no_such_material"},
     {"bad_mtl_kd.json", "bad_kd.obj", "material 'hot'.Kd: ", "[0, 1]"},
@@ -1008,7 +1009,7 @@ TEST(SceneLoader, LightTotalsAreKeptPerTypeUpToFloatMax) {
     const Scene scene = load_scene(kFixtures / "large_totals.json");
     EXPECT_EQ(scene.count_lights(gpu::kLightPoint), 2u);
     EXPECT_EQ(scene.count_lights(gpu::kLightDirectional), 1u);
-    EXPECT_FLOAT_EQ(scene.lights[2].x, 3e38f);
+    EXPECT_FLOAT_EQ(scene.lights[2].x, 9e18f);  // within the extent limit, 1e19
 }
 
 // ---------------------------------------------------------------------------
@@ -1274,8 +1275,8 @@ const CsvError kCsvErrors[] = {
     {"negative", "1,2,3,4,-5,6\n", "line 1: ", "column 5 (g): intensity must not be negative"},
     {"total_overflow", "0,0,0,0,0,3e38\n1,1,1,0,0,1\n2,2,2,0,0,3e38\n", "line 3: ",
      "total blue intensity of the point lights exceeds the float range (3.4e38)"},
-    {"far_apart", "0,2e38,0,1,1,1\n0,0,0,1,1,1\n0,-2e38,0,1,1,1\n", "line 3: ",
-     "extent along y exceeds the float range (3.4e38)"},
+    {"far_apart", "0,6e18,0,1,1,1\n0,0,0,1,1,1\n0,-6e18,0,1,1,1\n", "line 3: ",
+     "extent along y exceeds 1e19 (the square of a distance past it overflows a float)"},
 };
 
 // The reader parses a file in chunks on every core (host/scene/csv_lights.cpp);

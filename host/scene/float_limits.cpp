@@ -9,6 +9,7 @@ namespace {
 constexpr const char* kAxisNames[] = {"x", "y", "z"};
 constexpr const char* kChannelNames[] = {"red", "green", "blue"};
 constexpr const char* kFloatRange = "the float range (3.4e38)";
+constexpr const char* kExtentRange = "1e19 (the square of a distance past it overflows a float)";
 
 }  // namespace
 
@@ -18,8 +19,8 @@ std::string extent_problem(const Box& box) {
         if (!fits_float(box.lo[a]) || !fits_float(box.hi[a])) {
             return std::string("the ") + kAxisNames[a] + " coordinate is outside " + kFloatRange;
         }
-        if (!fits_float(box.hi[a] - box.lo[a])) {
-            return std::string("the extent along ") + kAxisNames[a] + " exceeds " + kFloatRange;
+        if (!(box.hi[a] - box.lo[a] <= kMaxExtent)) {
+            return std::string("the extent along ") + kAxisNames[a] + " exceeds " + kExtentRange;
         }
     }
     return {};

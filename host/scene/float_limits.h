@@ -80,8 +80,16 @@ struct Box {
     }
 };
 
-// "" when the box's corners and its extent (max - min) along every axis are
-// finite as floats; otherwise which axis is not, for an error message.
+// The largest extent of the scene along an axis, geometry and lights
+// together: the kernels square distances and sums of three squared
+// coordinates in float (3 x 1e38 still fits). Past it a cluster's cosine
+// bound came out 0 (inf under a square root) and its lights were skipped,
+// and the light tree's metric NaN, which built a chain in O(n^2).
+inline constexpr double kMaxExtent = 1e19;
+
+// "" when the box's corners are finite as floats and its extent (max -
+// min) along every axis at most kMaxExtent; otherwise which axis is not,
+// for an error message.
 std::string extent_problem(const Box& box);
 
 // Running totals over the lights of a scene, in file order: intensity per

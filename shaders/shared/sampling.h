@@ -90,10 +90,21 @@ float lc_pick_weight(LC_IN(SurfacePoint) sp, uint node_index, uint pick, float m
 LC_KCONST uint kBranchSteps = 16777216u;  // 2^24
 LC_KCONST float kBranchStep = 1.0f / 16777216.0f;
 
+LC_KCONST float kLargestFloat = 3.40282347e38f;
+
 uint lc_branch_steps(float a, float b) {
     if (!(a > 0.0f)) return 0u;
     if (!(b > 0.0f)) return kBranchSteps;
-    uint n = uint(a / (a + b) * float(kBranchSteps) + 0.5f);
+    float sum = a + b;
+    float share = a / sum;
+    // Where a + b overflows (two lights of 1.7e38, each in range: the
+    // share came out 0, and sampled lightcuts 9% dark) the halves are
+    // summed; an infinite weight takes all but the least share.
+    if (!(sum <= kLargestFloat)) {
+        bool a_inf = a > kLargestFloat, b_inf = b > kLargestFloat;
+        share = a_inf ? (b_inf ? 0.5f : 1.0f) : (b_inf ? 0.0f : 0.5f * a / (0.5f * a + 0.5f * b));
+    }
+    uint n = uint(share * float(kBranchSteps) + 0.5f);
     return min(max(n, 1u), kBranchSteps - 1u);
 }
 
