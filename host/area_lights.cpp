@@ -40,22 +40,24 @@ float radical_inverse(std::uint32_t k) {
     return float(bits) * 2.3283064e-10f;
 }
 
-// m stratified samples on one triangle, written to out[0, samples).
+// m stratified samples on one triangle, written to out[0, samples), each
+// carrying its point's emission times area / `share`.
 void sample_triangle(const TriangleEmission& source, std::size_t index, const gpu::Triangle& t,
-                     const gpu::Material& m, std::uint32_t samples, std::uint32_t hash, gpu::Light* out) {
+                     const gpu::Material& m, std::uint32_t samples, float share, std::uint32_t hash,
+                     gpu::Light* out) {
     const glm::vec3 a = vertex(t, 0), b = vertex(t, 1), c = vertex(t, 2);
     const glm::vec3 cross = glm::cross(b - a, c - a);
     const float area = 0.5f * glm::length(cross);
     const glm::vec3 normal = glm::normalize(cross);
     const bool textured = has_emissive_texture(m);
-    const glm::vec3 constant = emission(m) * (area / float(samples));
+    const glm::vec3 constant = emission(m) * (area / share);
     // A random shift of the whole pattern (Cranley-Patterson rotation).
     const float shift_u = gpu::lc_unit_float(hash), shift_v = gpu::lc_unit_float(gpu::lc_hash(hash));
     for (std::uint32_t k = 0; k < samples; ++k) {
         const glm::vec2 bary = triangle_sample_barycentrics(k, samples, shift_u, shift_v);
         const glm::vec3 p = (1.0f - bary.x - bary.y) * a + bary.x * b + bary.y * c;
         const glm::vec3 intensity =
-            textured ? source.at(index, bary.x, bary.y) * (area / float(samples)) : constant;
+            textured ? source.at(index, bary.x, bary.y) * (area / share) : constant;
         gpu::Light l{};
         l.x = p.x; l.y = p.y; l.z = p.z;
         l.r = intensity.x; l.g = intensity.y; l.b = intensity.z;
@@ -123,6 +125,8 @@ UninitializedVector<gpu::Light> sample_area_lights(const TriangleEmission& emiss
                                                    std::span<const gpu::Triangle> triangles,
                                                    std::span<const gpu::Material> materials, std::uint32_t count,
                                                    std::uint32_t seed, unsigned threads) {
+    UninitializedVector<gpu::Light> lights;
+    if (count == 0) return lights;  // before the powers: a textured one takes 256 texture reads
     // Power of each emitting triangle, in double: many small triangles add up.
     std::vector<double> power(triangles.size(), 0.0);
     double total = 0.0;
@@ -130,8 +134,7 @@ UninitializedVector<gpu::Light> sample_area_lights(const TriangleEmission& emiss
         power[i] = emission.power(i);
         total += power[i];
     }
-    UninitializedVector<gpu::Light> lights;
-    if (!(total > 0.0) || count == 0) return lights;
+    if (!(total > 0.0)) return lights;
     // Systematic sampling: sample k stands at (k + offset) / count of the
     // cumulative power; a triangle gets the samples that fall on its share.
     const double offset = gpu::lc_unit_float(gpu::lc_hash(seed ^ 0x9E3779B9u));
@@ -141,6 +144,7 @@ UninitializedVector<gpu::Light> sample_area_lights(const TriangleEmission& emiss
     struct Share {
         std::size_t triangle, first;  // its samples are lights [first, first + samples)
         std::uint32_t samples;
+        float share;                  // what each sample's area is divided by
     };
     std::vector<Share> shares;
     std::size_t placed = 0;
@@ -151,10 +155,17 @@ UninitializedVector<gpu::Light> sample_area_lights(const TriangleEmission& emiss
         const double after = i == last_emitter ? total : before + power[i];
         const double first = std::floor(before / total * count - offset + 1.0);
         const double last = std::floor(after / total * count - offset + 1.0);
+        // A triangle expecting e >= 1 samples gets floor(e) or ceil(e), each
+        // carrying 1/m of its power, so exactly its power. One expecting e < 1
+        // gets one sample with probability e (systematic sampling), which
+        // carries 1/e of its power, so its power in expectation (with 1/m it
+        // was e times its power: an emitter of 80,000 triangles lit the room
+        // 18% too dimly with 65,536 samples).
+        const double expected = (after - before) / total * count;
         before = after;
         const auto samples = std::uint32_t(std::max(0.0, last - first));
         if (samples == 0) continue;
-        shares.push_back({i, placed, samples});
+        shares.push_back({i, placed, samples, expected < 1.0 ? float(expected) : float(samples)});
         placed += samples;
     }
     // The triangles' samples on every core, each thread the shares that
@@ -173,7 +184,7 @@ UninitializedVector<gpu::Light> sample_area_lights(const TriangleEmission& emiss
         auto it = std::lower_bound(shares.begin(), shares.end(), begin, starts_before);
         for (; it != shares.end() && it->first < end; ++it) {
             const gpu::Triangle& tri = triangles[it->triangle];
-            sample_triangle(emission, it->triangle, tri, materials[tri.material], it->samples,
+            sample_triangle(emission, it->triangle, tri, materials[tri.material], it->samples, it->share,
                             gpu::lc_hash(seed ^ gpu::lc_hash(std::uint32_t(it->triangle))), lights.data() + it->first);
         }
     };

@@ -57,7 +57,9 @@ glm::vec2 triangle_sample_barycentrics(std::uint32_t k, std::uint32_t m, float s
 // I = Le(x) * A / m along its triangle's geometric normal (counter-clockwise
 // winding, right-handed), Le(x) the radiance at its point (the emissive
 // texture's there) and m the samples its triangle got, so the samples'
-// total power is the emitters'. Deterministic for a seed; as count grows the
+// power is its triangle's; where a triangle's share of the count is e < 1
+// it gets one sample with probability e, carrying Le(x) * A / e, its
+// power in expectation. Deterministic for a seed; as count grows the
 // lighting converges to the exact area-light integral. Empty when nothing
 // emits or count is 0. Made on up to `threads` threads (0: every core; one
 // below 65,536 samples), the same lights whatever their number.

@@ -369,6 +369,57 @@ TEST(AreaLight, SquareEmitterMatchesTheClosedForm) {
     EXPECT_EQ(plane_radiance(lights, {0, 2, 0}, {0, -1, 0}).x, 0.0);
 }
 
+// An emitter of more triangles than samples: a triangle expecting e < 1
+// samples gets one with probability e, which must carry 1/e of its power.
+// The square emitter as a 100 x 100 grid (20,000 triangles) with 1,000
+// samples lights the floor as the two-triangle square does, averaged over
+// seeds. (Each sample carried 1/1 of its triangle's power: the floor got
+// 5% of the light.)
+TEST(AreaLight, MoreTrianglesThanSamplesKeepTheirPower) {
+    std::vector<gpu::Material> materials = {test::lambert(glm::vec3(0.0f))};
+    materials[0].emission_r = materials[0].emission_g = materials[0].emission_b = 2.0f;
+    materials[0].flags |= gpu::kMaterialEmissive;
+    auto tri = [](glm::vec3 p, glm::vec3 q, glm::vec3 r) {
+        return gpu::Triangle{p.x, p.y, p.z, q.x, q.y, q.z, r.x, r.y, r.z, 0u, 0u, 0u};
+    };
+    const int n = 100;
+    std::vector<gpu::Triangle> triangles;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            // Cells of two sizes, so that the triangles' shares differ.
+            const float x0 = -0.5f + float(i) / n, x1 = -0.5f + float(i + 1) / n;
+            const float z0 = -0.5f + float(j) / n, z1 = -0.5f + float(j + 1) / n;
+            const glm::vec3 a(x0, 1, z0), b(x1, 1, z0), c(x1, 1, z1), d(x0, 1, z1);
+            // Counter-clockwise seen from below: the normal is -y.
+            const glm::vec3 m = (j % 3 == 0) ? 0.5f * (a + c) : c;
+            triangles.push_back(tri(a, b, m));
+            triangles.push_back(tri(a, m, d));
+            if (m != c) {
+                triangles.push_back(tri(b, c, m));
+                triangles.push_back(tri(m, c, d));
+            }
+        }
+    const std::vector<glm::dvec3> square = {{-0.5, 1, -0.5}, {0.5, 1, -0.5}, {0.5, 1, 0.5}, {-0.5, 1, 0.5}};
+    const glm::vec3 x(0.2f, 0.0f, -0.1f);
+    const double expected = 0.5 / 3.14159265358979 * polygon_irradiance(square, glm::dvec3(x), {0, 1, 0}, 2.0);
+    double sum = 0.0, power = 0.0;
+    const int seeds = 64;
+    for (int seed = 1; seed <= seeds; ++seed) {
+        const auto sampled =
+            sample_area_lights(TriangleEmission(triangles, materials), triangles, materials, 1000, seed);
+        const std::vector<gpu::Light> lights(sampled.begin(), sampled.end());
+        ASSERT_EQ(lights.size(), 1000u);
+        sum += plane_radiance(lights, x).x;
+        for (const gpu::Light& l : lights) power += l.r;
+    }
+    // The samples' intensities sum to Le A = 2 (their power over pi), in
+    // expectation; the floor's radiance is the closed form's.
+    std::printf("[ measured ] %zu triangles, 1000 samples, %d seeds: intensity %.5f of 2, floor %.5f of %.5f\n",
+                triangles.size(), seeds, power / seeds, sum / seeds, expected);
+    EXPECT_NEAR(power / seeds, 2.0, 0.01 * 2.0);
+    EXPECT_NEAR(sum / seeds, expected, 0.02 * expected);
+}
+
 // Each triangle's samples depend on it alone, so the threads that make
 // them do not change them: the same bytes from one thread as from three
 // (whose ranges of samples start and end inside triangles' shares) and as
