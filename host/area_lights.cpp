@@ -106,6 +106,33 @@ glm::vec3 TriangleEmission::mean(std::size_t i) const {
     return glm::vec3(sum / double(kMeanPoints));
 }
 
+double TriangleEmission::brightest_in_footprint(std::size_t i) const {
+    const gpu::Material& m = materials_[triangles_[i].material];
+    const gpu::TriangleUvs& uv = uvs_[i];
+    const gpu::TextureInfo& info = textures_[m.emissive_texture];
+    const float u_lo = std::min({uv.u0, uv.u1, uv.u2}), u_hi = std::max({uv.u0, uv.u1, uv.u2});
+    const float v_lo = std::min({uv.v0, uv.v1, uv.v2}), v_hi = std::max({uv.v0, uv.v1, uv.v2});
+    // The texels the bilinear filter may read anywhere in the box: from
+    // the one left of (below) the first centre to the one right of the last.
+    const double x0 = std::floor(double(u_lo) * info.width - 0.5), x1 = std::floor(double(u_hi) * info.width - 0.5) + 1;
+    const double y0 = std::floor(double(v_lo) * info.height - 0.5), y1 = std::floor(double(v_hi) * info.height - 0.5) + 1;
+    const double columns = std::min(x1 - x0 + 1, double(info.width)), rows = std::min(y1 - y0 + 1, double(info.height));
+    if (!(columns * rows <= 65536.0)) return -1.0;  // too many to look at (or NaN uvs)
+    cpu::TextureKernel k;
+    k.textures = textures_.data();
+    k.texels = texels_.data();
+    float brightest = 0.0f;
+    for (double y = 0; y < rows; ++y)
+        for (double x = 0; x < columns; ++x) {
+            const auto wrap = [](double p, std::uint32_t n) {
+                return std::uint32_t(std::fmod(std::fmod(p, double(n)) + n, double(n)));
+            };
+            const glm::vec4 c = k.lc_texel(info, wrap(x0 + x, info.width), wrap(y0 + y, info.height), true);
+            brightest = std::max(brightest, gpu::lc_luminance(emission(m) * glm::vec3(c)));
+        }
+    return brightest;
+}
+
 double TriangleEmission::power(std::size_t i) const {
     const gpu::Triangle& t = triangles_[i];
     const gpu::Material& m = materials_[t.material];
@@ -113,7 +140,20 @@ double TriangleEmission::power(std::size_t i) const {
     const glm::dvec3 a(vertex(t, 0)), b(vertex(t, 1)), c(vertex(t, 2));
     const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
     const double sides = (m.flags & gpu::kMaterialEmitsBothSides) ? 2.0 : 1.0;
-    return 3.14159265358979323846 * area * sides * double(gpu::lc_luminance(mean(i)));
+    double luminance = gpu::lc_luminance(mean(i));
+    // The points can all miss a texture's small bright features; a triangle
+    // with no power gets no samples, so its light would be lost (a black
+    // 64 x 64 emissive texture with one white texel lit nothing). Where
+    // the texels under the triangle's uv box are not all black it gets as
+    // much as one of the points would have found on the brightest of them:
+    // its samples carry the texture at their own points, so any share
+    // that is not zero keeps the estimate unbiased.
+    if (luminance == 0.0 && has_emissive_texture(m) && uvs_.size() == triangles_.size()) {
+        const double brightest = brightest_in_footprint(i);
+        const double floor = brightest < 0.0 ? gpu::lc_luminance(emission(m)) : brightest;
+        luminance = floor / kMeanPoints;
+    }
+    return 3.14159265358979323846 * area * sides * luminance;
 }
 
 UninitializedVector<gpu::Light> sample_area_lights(const Scene& scene, std::uint32_t count, std::uint32_t seed,

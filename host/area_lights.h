@@ -32,12 +32,20 @@ public:
     // The mean of `at` over the triangle: exact without an emissive texture;
     // with one, the mean over kMeanPoints stratified points.
     glm::vec3 mean(std::size_t i) const;
-    // Emitted power pi A lum(mean) per emitting side (0: does not emit).
+    // Emitted power pi A lum(mean) per emitting side (0: does not emit);
+    // where the points of `mean` all found black but a texel the triangle's
+    // uv box covers is not, as if one of them had found the brightest such
+    // texel (or, past 65,536 texels, the material's emission).
     double power(std::size_t i) const;
 
     static constexpr std::uint32_t kMeanPoints = 256;
 
 private:
+    // The largest luminance of emission x texel over the texels the
+    // bilinear filter may read in triangle i's uv box; -1 where that is
+    // more than 65,536 texels.
+    double brightest_in_footprint(std::size_t i) const;
+
     std::span<const gpu::Triangle> triangles_;
     std::span<const gpu::Material> materials_;
     std::span<const gpu::TriangleUvs> uvs_;

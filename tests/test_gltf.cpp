@@ -415,6 +415,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_json.gltf", "tinygltf: "},
         BadCase{"bad_roughness_string.gltf",
                 "materials[0].pbrMetallicRoughness.roughnessFactor: must be a number, not a string"},
+        BadCase{"bad_emissive_strength_number.gltf",
+                "materials[0].extensions.KHR_materials_emissive_strength: must be an object, not a number"},
         BadCase{"bad_lights_array.gltf", "extensions.KHR_lights_punctual: must be an object, not an array"},
         BadCase{"bad_light_string.gltf", "extensions.KHR_lights_punctual.lights[0]: must be an object, not a string"},
         BadCase{"bad_node_light_number.gltf",

@@ -110,9 +110,14 @@ public:
         numbers(m, "emissiveFactor", 3, path);
         number(m, "alphaCutoff", path);
         for (const char* t : {"normalTexture", "occlusionTexture", "emissiveTexture"}) texture_info(m, t, path);
+        object(m, "extensions", path);
         const json* ext = member(m, "extensions");
         if (!ext) return;
         const std::string at = path + ".extensions";
+        // A supported extension that is not an object was ignored
+        // ("KHR_materials_emissive_strength": 5 rendered at strength 1).
+        for (const char* name : {"KHR_materials_emissive_strength", "KHR_materials_clearcoat", "KHR_materials_sheen"})
+            object(*ext, name, at);
         if (const json* e = member(*ext, "KHR_materials_emissive_strength"))
             number(*e, "emissiveStrength", at + ".KHR_materials_emissive_strength");
         if (const json* e = member(*ext, "KHR_materials_clearcoat")) {
