@@ -52,9 +52,15 @@ void TileScheduler::render(RenderResult& result) {
         split_slow_tiles_ ? 4 * gpu::kWorkgroupSize : std::max(4 * gpu::kWorkgroupSize, min_tile_pixels_),
         max_pixels);
     const double min_budget = std::min<double>(min_tile_pixels_, max_pixels);
+    // A quad tile is at least two columns, all of whose rows must fit.
+    const std::uint32_t tallest = quads ? std::max(2u, resources_.tiles().invocations / 2u) : max_pixels;
     for (std::uint32_t y0 = 0; y0 < height;) {
+        // About square, or as tall as the budget where the image is narrower
+        // than that (a band of sqrt(budget) rows made a 1 x 16384 image 129
+        // tiles of 128 pixels, its render 1.5 times a 16384 x 1 one's).
+        const double rows = std::max(std::sqrt(budget), budget / width);
         const std::uint32_t band = std::min<std::uint32_t>(
-            height - y0, even(std::max<std::uint32_t>(1, std::uint32_t(std::sqrt(budget)))));
+            height - y0, even(std::clamp<std::uint32_t>(std::uint32_t(rows), 1u, tallest)));
         for (std::uint32_t x0 = 0; x0 < width;) {
             std::uint32_t w = even(std::max<std::uint32_t>(1, std::uint32_t(budget / band)));
             std::uint32_t fit = std::max<std::uint32_t>(1, max_pixels / band);
