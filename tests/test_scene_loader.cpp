@@ -575,6 +575,26 @@ TEST(SceneLoader, EnvironmentMapLargerThanTheLimitIsRefusedFromItsHeader) {
         << message;
 }
 
+// A black environment, a map of zeros or a black colour, is left out with a
+// note, as black lights are (it was accepted in silence).
+TEST(SceneLoader, BlackEnvironmentGetsANote) {
+    TempDir dir;
+    fs::copy_file(kFixtures / "tri.obj", dir.path() / "tri.obj");
+    lc::write_exr(dir.path() / "black.exr", lc::Image(4, 2));
+    for (const std::string sky : {R"({"type": "environment", "file": "black.exr"})",
+                                  R"({"type": "environment", "color": [0, 0, 0]})"}) {
+        const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "tri.obj"}], "lights": [)" + sky + "]}");
+        const Scene loaded = load_scene(scene);
+        EXPECT_TRUE(std::any_of(loaded.load_notes.begin(), loaded.load_notes.end(), [](const std::string& n) {
+            return n.find("s.json: lights[0]: the environment is black; it adds no light") != std::string::npos;
+        })) << sky;
+    }
+    const fs::path lit = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "tri.obj"}], "lights": [{"type": "environment", "color": [0, 0, 1e-30]}]})");
+    EXPECT_TRUE(load_scene(lit).load_notes.empty());
+}
+
 TEST(SceneLoader, MaterialOverrideReplacesMtlForWholeMesh) {
     const Scene scene = load_scene(kFixtures / "override.json");
     ASSERT_EQ(scene.materials.size(), 2u);  // one per overridden mesh, none from the MTL
