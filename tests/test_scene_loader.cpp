@@ -1235,11 +1235,12 @@ TEST(PointsCsv, SkipsHeaderCommentsAndBlankLines) {
 
 TEST(PointsCsv, AcceptsCrLfMissingFinalNewlineAndTinyNumbers) {
     TempDir dir;
-    const fs::path file = dir.write("crlf.csv", "x,y,z,r,g,b\r\n1,2,3,4,5,6\r\n7,8,9,1e-60,0,1");
+    const fs::path file = dir.write("crlf.csv", "x,y,z,r,g,b\r\n1,2,3,4,5,6\r\n7,8,9,1e-60,1e-40,1");
     const std::vector<gpu::Light> lights = load_points_csv(file);
     ASSERT_EQ(lights.size(), 2u);
     expect_near({lights[0].r, lights[0].g, lights[0].b}, {4, 5, 6});
     EXPECT_EQ(lights[1].r, 0.0f);  // underflow is zero, not an error
+    EXPECT_EQ(lights[1].g, 0.0f);  // and so is a subnormal float
     EXPECT_FLOAT_EQ(lights[1].b, 1.0f);
 }
 
