@@ -156,6 +156,17 @@ double TriangleEmission::power(std::size_t i) const {
     return 3.14159265358979323846 * area * sides * luminance;
 }
 
+std::vector<double> TriangleEmission::powers(unsigned threads) const {
+    std::vector<double> power(triangles_.size(), 0.0);
+    const unsigned most = threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency());
+    threads = triangles_.size() < 16384 ? 1u : std::min(16u, most);
+    run_on_threads(threads, [&](unsigned t) {
+        const std::size_t begin = power.size() * t / threads, end = power.size() * (t + 1) / threads;
+        for (std::size_t i = begin; i < end; ++i) power[i] = this->power(i);
+    });
+    return power;
+}
+
 UninitializedVector<gpu::Light> sample_area_lights(const Scene& scene, std::uint32_t count, std::uint32_t seed,
                                                    unsigned threads) {
     return sample_area_lights(TriangleEmission(scene), scene.triangles, scene.materials, count, seed, threads);
@@ -168,12 +179,9 @@ UninitializedVector<gpu::Light> sample_area_lights(const TriangleEmission& emiss
     UninitializedVector<gpu::Light> lights;
     if (count == 0) return lights;  // before the powers: a textured one takes 256 texture reads
     // Power of each emitting triangle, in double: many small triangles add up.
-    std::vector<double> power(triangles.size(), 0.0);
+    const std::vector<double> power = emission.powers(threads);
     double total = 0.0;
-    for (std::size_t i = 0; i < triangles.size(); ++i) {
-        power[i] = emission.power(i);
-        total += power[i];
-    }
+    for (const double p : power) total += p;
     if (!(total > 0.0)) return lights;
     // Systematic sampling: sample k stands at (k + offset) / count of the
     // cumulative power; a triangle gets the samples that fall on its share.

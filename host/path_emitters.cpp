@@ -132,9 +132,9 @@ EmitterTable::EmitterTable(const Scene& scene) : environment_(scene.environment)
         emitters_.push_back({EmitterKind::kLight, i});
         weights.push_back(w);
     }
-    const TriangleEmission emission(scene);
+    const std::vector<double> power = TriangleEmission(scene).powers();
     for (std::uint32_t i = 0; i < scene.triangles.size(); ++i) {
-        const double w = emission.power(i);
+        const double w = power[i];
         if (!(w > 0.0)) continue;
         emitters_.push_back({EmitterKind::kTriangle, i});
         weights.push_back(w);
