@@ -141,7 +141,8 @@ def main():
              "Rows `pixel`: a cut per pixel, K slots per pixel (the Vulkan kernels' heap). Row `quad`: a cut "
              "per 2x2 quad with its pixels' 4 x 64 slots pooled. Row `octet`: the defaults, a cut per 4x2 "
              "octet with its pixels' 8 x 64 slots pooled (a tile's blocks after an octet whose cut reached "
-             "max_cut cut as quads).", "",
+             "max_cut cut as quads). Mean cut and samples that froze: of the pixels that shade a surface "
+             "(the sky's background has no cut).", "",
              "| scene | cuts | K | relative RMSE | above 2% | mean cut | rays/px | samples that froze | time s |",
              "|---|---|---|---|---|---|---|---|---|"]
     for scene in [] if a.vulkan_only else scenes:
@@ -171,7 +172,7 @@ def main():
             row = {"scene": scene, "cut_sharing": sharing, "cut_heap": lc["cut_heap"],
                    "heap_slots": lc["heap_slots"], "seconds": s["seconds"]["render"],
                    "rays_per_pixel": s["shadow_rays"] / pixels, "cut_mean": lc["cut_size_mean"],
-                   "frozen": lc["heap_frozen_samples"] / pixels, **c}
+                   "frozen": lc["heap_frozen_samples"] / max(lc.get("shaded_pixels", pixels), 1), **c}
             results["heaps"].append(row)
             label = "as needed" if k == UNBOUNDED else str(lc["cut_heap"])
             table.append(f"| {name} | {sharing} | {label} | {c['rmse']:.4f} | {100 * c['above_2pct']:.1f}% | "

@@ -47,7 +47,14 @@ LightcutsReport lightcuts_report(const RenderOptions& o, const PreparedScene& p,
     l.max_cut = o.max_cut;
     l.tree_nodes = p.tree.nodes.size();
     l.tree_bytes = p.tree.nodes.size() * sizeof(gpu::LightNode);
-    const std::vector<float>& cuts = s.cut_size;
+    // Over the pixels that shade a surface (a cut of at least the root):
+    // those that see only the background have none, and counting them as
+    // 0 made the sky's mean cut and frozen share a pixel-count average.
+    std::vector<float> cuts;
+    cuts.reserve(s.cut_size.size());
+    for (const float c : s.cut_size)
+        if (c > 0.0f) cuts.push_back(c);
+    l.shaded_pixels = cuts.size();
     if (!cuts.empty()) {
         l.cut_size_mean = std::accumulate(cuts.begin(), cuts.end(), 0.0) / double(cuts.size());
         l.cut_size_max = *std::max_element(cuts.begin(), cuts.end());
@@ -74,13 +81,19 @@ std::string lightcuts_text(const RenderReport& r, const LightcutsReport& l) {
     // Above 1 spp the percentiles and the largest are of each pixel's mean
     // cut, which can stay below max_cut while samples reach it.
     const std::string per_pixel = r.spp > 1 ? format(" (each pixel's mean over its %u samples)", r.spp) : "";
-    text += format("  cut size%s mean %.1f, p50 %.0f, p99 %.0f, max %.0f; %llu samples hit max_cut %u\n",
-                   per_pixel.c_str(), l.cut_size_mean, l.cut_size_p50, l.cut_size_p99, l.cut_size_max,
+    const std::uint64_t pixels = std::uint64_t(r.width) * r.height;
+    const std::string over = l.shaded_pixels < pixels
+                                 ? format(" (over the %zu of %llu pixels that shade a surface)", l.shaded_pixels,
+                                          static_cast<unsigned long long>(pixels))
+                                 : "";
+    text += format("  cut size%s mean %.1f, p50 %.0f, p99 %.0f, max %.0f%s; %llu samples hit max_cut %u\n",
+                   per_pixel.c_str(), l.cut_size_mean, l.cut_size_p50, l.cut_size_p99, l.cut_size_max, over.c_str(),
                    static_cast<unsigned long long>(l.max_cut_samples), l.max_cut);
     if (r.indirect)
         text += format("  of the cut: %.1f direct, %.1f indirect (VPL) clusters on average\n",
                        l.cut_size_mean - l.cut_indirect_mean, l.cut_indirect_mean);
-    const double samples = double(std::max<std::uint64_t>(r.camera_rays, 1));
+    // The shares below are of the samples of pixels that shade a surface.
+    const double samples = double(std::max<std::uint64_t>(l.shaded_pixels * std::max(r.spp, 1u), 1));
     const char* const shared_by = l.cut_points == 8u ? "octet" : l.cut_points == 4u ? "quad" : "point";
     if (l.cut_points == 4u) text += "  cuts shared by the pixels of each 2x2 quad (cut_sharing)\n";
     if (l.cut_points == 8u) text += "  cuts shared by the eight pixels of each 4x2 octet (cut_sharing)\n";
@@ -121,7 +134,8 @@ json lightcuts_json(const LightcutsReport& l, bool on_cpu) {
             {"heap_bytes_per_workgroup", l.heap_bytes},
             {"heap_memory", on_cpu ? "cpu" : l.heap_private ? "private" : "shared"},
             {"heap_frozen_samples", l.heap_frozen_samples},
-            {"heap_paused_samples", l.heap_paused_samples}};
+            {"heap_paused_samples", l.heap_paused_samples},
+            {"shaded_pixels", l.shaded_pixels}};
 }
 
 }  // namespace

@@ -54,6 +54,21 @@ TEST(Report, JsonHasEveryKeyScriptsReadAndTheBlackLights) {
     EXPECT_THAT(report_text(report), HasSubstr("lights 20 (and 3 black, left out of the tree)"));
     EXPECT_THAT(report_text(report), HasSubstr("cut size mean"));
     EXPECT_THAT(json, HasSubstr("\"bounce_rays\": 0,"));
+    // Cut sizes and the frozen share are of the pixels that shade a
+    // surface: background pixels have no cut (they counted as 0, and the
+    // sky's K table read "59.1% froze" where 99.99% of its shaded did).
+    RenderResult background = r;
+    ASSERT_EQ(background.stats.cut_size.size(), 64u);
+    for (std::size_t i = 0; i < 64; ++i) background.stats.cut_size[i] = i < 16 ? 0.0f : 10.0f + float(i % 2);
+    background.stats.heap_frozen_samples = 24;
+    const RenderReport sky = make_report("room.json", o, p, background, 0.25);
+    ASSERT_TRUE(sky.lightcuts.has_value());
+    EXPECT_DOUBLE_EQ(sky.lightcuts->cut_size_mean, 10.5);
+    EXPECT_EQ(sky.lightcuts->shaded_pixels, 48u);
+    EXPECT_THAT(report_text(sky), HasSubstr("(over the 48 of 64 pixels that shade a surface)"));
+    EXPECT_THAT(report_text(sky), HasSubstr("24 samples (50.00%) froze"));
+    EXPECT_THAT(report_json(sky), HasSubstr("\"shaded_pixels\": 48"));
+    EXPECT_THAT(report_text(report), Not(HasSubstr("pixels that shade a surface")));
     // Above 1 spp the cut sizes' percentiles are of each pixel's mean.
     RenderOptions two = o;
     two.spp = 2;

@@ -23,10 +23,11 @@ struct LightcutsReport {
     std::uint32_t max_cut = 0;
     std::size_t tree_nodes = 0;
     std::uint64_t tree_bytes = 0;
-    // Over the pixels, each pixel's mean cut over its samples (at 1 spp its
-    // cut): so above 1 spp the largest can be below max_cut where samples
-    // reached it.
+    // Over the pixels that shade a surface, each pixel's mean cut over its
+    // samples (at 1 spp its cut): so above 1 spp the largest can be below
+    // max_cut where samples reached it.
     double cut_size_mean = 0.0, cut_size_p50 = 0.0, cut_size_p99 = 0.0, cut_size_max = 0.0;
+    std::size_t shaded_pixels = 0;            // pixels with a cut (the others see only background)
     double cut_indirect_mean = 0.0;           // of cut_size_mean, VPL clusters (indirect light)
     std::uint64_t max_cut_samples = 0;        // samples whose refinement stopped at max_cut
     std::uint32_t cut_heap = 0;               // render.cut_heap, the heap's capacity K
