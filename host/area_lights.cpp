@@ -10,6 +10,7 @@
 #include "cpu_kernel.h"
 #include "run_on_threads.h"
 #include "scene/huge_pages.h"
+#include "scene/light_records.h"
 #include "shared/color.h"
 
 namespace lc {
@@ -60,7 +61,8 @@ void sample_triangle(const TriangleEmission& source, std::size_t index, const gp
             textured ? source.at(index, bary.x, bary.y) * (area / share) : constant;
         gpu::Light l{};
         l.x = p.x; l.y = p.y; l.z = p.z;
-        l.r = intensity.x; l.g = intensity.y; l.b = intensity.z;
+        const glm::vec3 c = loader::without_subnormals(intensity);
+        l.r = c.r; l.g = c.g; l.b = c.b;
         l.axis_x = normal.x; l.axis_y = normal.y; l.axis_z = normal.z;
         l.type = gpu::kLightOriented | ((m.flags & gpu::kMaterialEmitsBothSides) ? gpu::kLightTwoSided : 0u);
         out[k] = l;

@@ -6,6 +6,7 @@
 
 #include <glm/glm.hpp>
 
+#include "scene/light_records.h"
 #include "shared/color.h"
 
 namespace lc {
@@ -34,8 +35,13 @@ struct Totals {
 // direction stands for it. (Whole texel rows of a map 1 to 8 texels tall
 // reach from pole to pole, or most of the way; a part of one such row put
 // its light on the row's middle latitude: under a constant 65536 x 1 sky
-// an upward plane was black, under a 4096 x 2 one 41% too bright.) Maps of
-// the usual 2:1 shape with fewer directions than texels have sub = 1.
+// an upward plane was black, under a 4096 x 2 one 41% too bright.) Only
+// where there are fewer directions than texels: with more, a texel's
+// several samples spread over its latitudes (emit_texel), which was
+// better for a few directions over a whole sphere (a 1 x 1 map's 8 in
+// two bands lit a tilted plane 14.5% wrong, against 4.8%). So maps of the
+// usual 2:1 shape with fewer directions than texels keep sub = 1 (the
+// shipped sky's 512 x 256 with 3000), and so do those with more.
 class Splitter {
 public:
     Splitter(const Environment& map, std::uint32_t count, std::vector<gpu::Light>& out) : map_(map), out_(out) {
@@ -47,8 +53,10 @@ public:
         // At most 2^22 rows x columns beyond the map's own (each level of the
         // split passes over them all).
         const double texels = double(map.width) * map.height;
-        sub_ = std::uint32_t(std::clamp(std::min(wanted, std::floor(std::max(texels, 4194304.0) / texels)), 1.0,
-                                        double(count)));
+        sub_ = count >= texels ? 1u
+                               : std::uint32_t(std::clamp(
+                                     std::min(wanted, std::floor(std::max(texels, 4194304.0) / texels)), 1.0,
+                                     double(count)));
         // Where a texel row straddles the equator (an odd number of rows),
         // an even number of bands puts a boundary on it, the horizon of a
         // plane facing a pole.
@@ -211,7 +219,8 @@ private:
     void emit(glm::dvec3 towards, glm::dvec3 irradiance) {
         gpu::Light l{};
         l.x = float(towards.x); l.y = float(towards.y); l.z = float(towards.z);
-        l.r = float(irradiance.x); l.g = float(irradiance.y); l.b = float(irradiance.z);
+        const glm::vec3 c = loader::without_subnormals(glm::vec3(irradiance));
+        l.r = c.r; l.g = c.g; l.b = c.b;
         l.type = gpu::kLightDirectional;
         out_.push_back(l);
     }

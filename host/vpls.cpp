@@ -8,6 +8,7 @@
 #include "cpu_kernel.h"
 #include "path_emitters.h"
 #include "run_on_threads.h"
+#include "scene/light_records.h"
 #include "shared/color.h"
 
 namespace lc {
@@ -178,7 +179,8 @@ std::size_t trace_path(cpu::ShadeKernel& kernel, const Emitters& emitters, std::
             const glm::dvec3 vpl = flux * glm::dvec3(kd) * (scale / double(kPi));
             gpu::Light l{};
             l.x = sp.p.x; l.y = sp.p.y; l.z = sp.p.z;
-            l.r = float(vpl.x); l.g = float(vpl.y); l.b = float(vpl.z);
+            const glm::vec3 c = loader::without_subnormals(glm::vec3(vpl));
+            l.r = c.r; l.g = c.g; l.b = c.b;
             l.axis_x = sp.n.x; l.axis_y = sp.n.y; l.axis_z = sp.n.z;
             l.type = gpu::kLightVpl;
             out->push_back(l);

@@ -371,10 +371,10 @@ TEST(AreaLight, SquareEmitterMatchesTheClosedForm) {
 
 // An emitter of more triangles than samples: a triangle expecting e < 1
 // samples gets one with probability e, which must carry 1/e of its power.
-// The square emitter as a 100 x 100 grid (20,000 triangles) with 1,000
-// samples lights the floor as the two-triangle square does, averaged over
-// seeds. (Each sample carried 1/1 of its triangle's power: the floor got
-// 5% of the light.)
+// The square emitter as a 100 x 100 grid of cells of two or four
+// triangles (26,800 of two sizes) with 1,000 samples lights the floor as
+// the two-triangle square does, averaged over seeds. (Each sample carried
+// 1/1 of its triangle's power: the floor got 4% of the light.)
 TEST(AreaLight, MoreTrianglesThanSamplesKeepTheirPower) {
     std::vector<gpu::Material> materials = {test::lambert(glm::vec3(0.0f))};
     materials[0].emission_r = materials[0].emission_g = materials[0].emission_b = 2.0f;
@@ -386,7 +386,7 @@ TEST(AreaLight, MoreTrianglesThanSamplesKeepTheirPower) {
     std::vector<gpu::Triangle> triangles;
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
-            // Cells of two sizes, so that the triangles' shares differ.
+            // Every third cell in four triangles, so that the triangles' shares differ.
             const float x0 = -0.5f + float(i) / n, x1 = -0.5f + float(i + 1) / n;
             const float z0 = -0.5f + float(j) / n, z1 = -0.5f + float(j + 1) / n;
             const glm::vec3 a(x0, 1, z0), b(x1, 1, z0), c(x1, 1, z1), d(x0, 1, z1);
@@ -486,8 +486,8 @@ TEST(EnvironmentLight, FewSamplesOfTallTexelsSpreadOverLatitudes) {
             // The samples of a texel cover it in a few rows, each at its
             // middle cosine: where a row straddles the plane's horizon the
             // plane misses that row's upper part. Measured: exact but for
-            // 4.4% (8 x 1, 16 directions, whose texel rows are cut into
-            // four bands of one direction each); before, 0.
+            // 0.3% (8 x 1, 100 directions) and 6.25% (1 x 1, 8 directions:
+            // three rows, the middle one across the horizon); before, 0.
             EXPECT_NEAR(got, 0.75, 0.07 * 0.75) << width << "x" << height << ", " << count;
         }
     }

@@ -226,6 +226,28 @@ TEST(TreeDescent, LightsFarDimmerThanTheirSiblingsKeepAProbability) {
     }
 }
 
+// Three light types of 2e38 each: their weights' sum overflows a float, but
+// each type is still drawn with its share (the sum of the types after the
+// first was infinite, and the first drawn with probability 6e-8).
+TEST(TreeDescent, RootsOfHugeWeightsKeepTheirShares) {
+    const glm::vec3 huge(2e38f);
+    std::vector<gpu::Light> lights = {test::point_light({0.0f, 1.9f, 0.0f}, huge),
+                                      test::spot_light({0.1f, 1.9f, 0.0f}, {0, -1, 0}, huge, 80.0f, 89.0f),
+                                      test::oriented_light({-0.1f, 1.9f, 0.0f}, {0, -1, 0}, huge)};
+    PreparedScene p = prepare_scene(test::room_scene(lights, 8), 1);
+    gpu::FrameParams f = make_frame_params(p, test::options("sampled", 8));
+    Kernel k = cpu::make_shade_kernel(p, nullptr);
+    const Kernel::SurfacePoint sp = k.lc_make_surface({0, 0, 0}, {0, 1, 0}, {0, 1, 0}, 0, glm::vec2(0.0f));
+    double sum = 0.0;
+    for (const std::uint32_t type : {gpu::kLightPoint, gpu::kLightSpot, gpu::kLightOriented}) {
+        const float probability = k.lc_root_probability(sp, f, type, gpu::kLightPickPower);
+        std::printf("[ measured ] type %u of three of 2e38: probability %.4f\n", type, probability);
+        EXPECT_GT(probability, 0.1f) << type;
+        sum += probability;
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-6);
+}
+
 // A branch's steps of 2^24: in proportion to the weights, rounded, and never
 // 0 (or all) where both sides have weight.
 TEST(TreeDescent, BranchStepsGiveEverySideWithWeightAShare) {
@@ -244,6 +266,9 @@ TEST(TreeDescent, BranchStepsGiveEverySideWithWeightAShare) {
     EXPECT_EQ(k.lc_branch_steps(inf, 1.0f), (1u << 24) - 1u);
     EXPECT_EQ(k.lc_branch_steps(1.0f, inf), 1u);
     EXPECT_EQ(k.lc_branch_steps(inf, inf), 1u << 23);
+    // Tiny weights too (their sum's division is accurate on every device).
+    EXPECT_EQ(k.lc_branch_steps(1e-40f, 1e-40f), 1u << 23);
+    EXPECT_EQ(k.lc_branch_steps(1e-38f, 3e-38f), 1u << 22);
     // The draw takes the side k < n: its frequency over the 2^24 values of
     // k is n / 2^24, the probability it reports.
     for (const std::uint32_t n : {1u, 12345u, (1u << 24) - 1u}) {

@@ -575,8 +575,8 @@ TEST(SceneLoader, EnvironmentMapLargerThanTheLimitIsRefusedFromItsHeader) {
         << message;
 }
 
-// A black environment, a map of zeros or a black colour, is left out with a
-// note, as black lights are (it was accepted in silence).
+// A black environment, a map of zeros or a black colour, gets a note, as
+// black lights get a word in the report (it was accepted in silence).
 TEST(SceneLoader, BlackEnvironmentGetsANote) {
     TempDir dir;
     fs::copy_file(kFixtures / "tri.obj", dir.path() / "tri.obj");
@@ -980,7 +980,7 @@ const BadInput kBadInputs[] = {
     {"bad_csv_total.json", "total_overflow.csv", "line 5: ",
      "total red intensity of the point lights exceeds the float range (3.4e38)"},
     {"bad_light_far.json", "bad_light_far.json", "lights[1].position: ",
-     "extent along y exceeds 1e19 (the square of a distance past it overflows a float)"},
+     "extent along y exceeds 1e19 (the renderer squares distances in float and sums three such squares)"},
     // Camera.
     {"bad_zero_width.json", "bad_zero_width.json", "camera.width: ", "must be an integer from 1 to 16384"},
     {"bad_negative_width.json", "bad_negative_width.json", "camera.width: ", "must be an integer from 1 to 16384"},
@@ -997,7 +997,7 @@ const BadInput kBadInputs[] = {
     {"bad_obj_no_faces.json", "no_faces.obj", "", "no usable triangles"},
     {"bad_obj_all_degenerate.json", "all_degenerate.obj", "", "no usable triangles"},
     {"bad_obj_index.json", "bad_index.obj", "triangle 1: ", "vertex index 9 out of range"},
-    {"bad_obj_far_apart.json", "far_apart.obj", "triangle 2: ", "extent along x exceeds 1e19 (the square of a distance past it overflows a float)"},
+    {"bad_obj_far_apart.json", "far_apart.obj", "triangle 2: ", "extent along x exceeds 1e19 (the renderer squares distances in float and sums three such squares)"},
     {"bad_obj_missing_mtl.json", "missing_mtl.obj", "mtllib: ", "'not_there.mtl' not found"},
     {"bad_obj_unknown_usemtl.json", "unknown_usemtl.obj", "usemtl: ", "no_such_material"},
     {"bad_mtl_kd.json", "bad_kd.obj", "material 'hot'.Kd: ", "[0, 1]"},
@@ -1297,7 +1297,7 @@ const CsvError kCsvErrors[] = {
     {"total_overflow", "0,0,0,0,0,3e38\n1,1,1,0,0,1\n2,2,2,0,0,3e38\n", "line 3: ",
      "total blue intensity of the point lights exceeds the float range (3.4e38)"},
     {"far_apart", "0,6e18,0,1,1,1\n0,0,0,1,1,1\n0,-6e18,0,1,1,1\n", "line 3: ",
-     "extent along y exceeds 1e19 (the square of a distance past it overflows a float)"},
+     "extent along y exceeds 1e19 (the renderer squares distances in float and sums three such squares)"},
 };
 
 // The reader parses a file in chunks on every core (host/scene/csv_lights.cpp);

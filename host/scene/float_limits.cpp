@@ -9,7 +9,7 @@ namespace {
 constexpr const char* kAxisNames[] = {"x", "y", "z"};
 constexpr const char* kChannelNames[] = {"red", "green", "blue"};
 constexpr const char* kFloatRange = "the float range (3.4e38)";
-constexpr const char* kExtentRange = "1e19 (the square of a distance past it overflows a float)";
+constexpr const char* kExtentRange = "1e19 (the renderer squares distances in float and sums three such squares)";
 
 }  // namespace
 

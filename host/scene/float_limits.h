@@ -105,7 +105,8 @@ public:
         std::string text;  // for the InputError; empty when fault is none
     };
 
-    // Adds one light; reports the first total or extent it pushes past FLT_MAX.
+    // Adds one light; reports the first total it pushes past FLT_MAX, or
+    // extent past kMaxExtent.
     Problem add(const gpu::Light& light);
 
 private:

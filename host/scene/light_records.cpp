@@ -2,7 +2,6 @@
 #include "light_records.h"
 
 #include <cmath>
-#include <limits>
 
 namespace lc::loader {
 namespace {
@@ -34,11 +33,8 @@ const char* light_total_name(std::uint32_t type) {
 gpu::Light point_light(glm::vec3 position, glm::vec3 intensity) {
     gpu::Light l{};
     l.x = position.x; l.y = position.y; l.z = position.z;
-    // Subnormal intensities are zero: their bounds lose the last bit (one
-    // in 10^4 came out below its lights' contribution), and arithmetic on
-    // them took brute force twice as long; 1e-60 already reads as zero.
-    const auto normal = [](float v) { return std::abs(v) < std::numeric_limits<float>::min() ? 0.0f : v; };
-    l.r = normal(intensity.r); l.g = normal(intensity.g); l.b = normal(intensity.b);
+    const glm::vec3 c = without_subnormals(intensity);
+    l.r = c.r; l.g = c.g; l.b = c.b;
     l.type = gpu::kLightPoint;
     return l;
 }

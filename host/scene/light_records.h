@@ -3,6 +3,8 @@
 // same words.
 #pragma once
 
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -23,6 +25,17 @@ struct LightProblem {
 // What a light type's r, g, b sum to, in words: "intensity of the point
 // lights", "irradiance of the directional lights", ...
 const char* light_total_name(std::uint32_t type);
+
+// A colour with its subnormal channels (below the smallest normal float,
+// 1.2e-38) made zero: every light's intensity goes through it, the loaded
+// ones' (point_light) and the generated ones' (area-light samples, the
+// environment's directions, VPLs). Their bounds lost the last bit (one in
+// 10^4 came out below its lights' contribution), and arithmetic on them
+// took brute force twice as long.
+inline glm::vec3 without_subnormals(glm::vec3 c) {
+    const auto normal = [](float v) { return std::abs(v) < std::numeric_limits<float>::min() ? 0.0f : v; };
+    return {normal(c.r), normal(c.g), normal(c.b)};
+}
 
 gpu::Light point_light(glm::vec3 position, glm::vec3 intensity);
 

@@ -448,8 +448,9 @@ private:
             if (const std::string p = setting_problem(kSettingDirections, n); !p.empty()) in_.fail(field, p);
             env.directions = static_cast<std::uint32_t>(n);
         }
-        // Black lights are left out with a word; so is a black sky (it was
-        // accepted in silence, the only light of a scene that rendered black).
+        // A black sky gets a note, as black lights get a word in the report
+        // (it was accepted in silence, the only light of a scene that
+        // rendered black).
         if (std::all_of(env.rgb.begin(), env.rgb.end(), [](float v) { return v == 0.0f; }))
             scene_.load_notes.push_back(in_.file() + ": " + path + ": the environment is black; it adds no light");
         scene_.environment = std::move(env);

@@ -103,17 +103,18 @@ struct SceneOptions {
 // field on any problem; never returns a half-loaded scene. Also refuses what
 // would overflow the renderer's float sums: a per-type, per-channel light
 // intensity total above FLT_MAX, or a box around the geometry and the point
-// lights whose extent along an axis exceeds FLT_MAX.
+// lights whose extent along an axis exceeds 1e19 (loader::kMaxExtent).
 Scene load_scene(const std::filesystem::path& file, const SceneOptions& options = {});
 
 // Parses "x,y,z,r,g,b" lines into point lights (optional header line, '#'
 // comments). Throws InputError naming the file and line number, also for the
-// first line where the lights' total intensity or extent overflows a float.
+// first line where the lights' total intensity overflows a float or their
+// extent passes 1e19.
 std::vector<gpu::Light> load_points_csv(const std::filesystem::path& file);
 
 // Recomputes scene.bounds_min/max from the triangles alone (lights are left
-// out). Throws InputError naming scene.file and the triangle when a vertex or
-// the extent along an axis is not finite as a float.
+// out). Throws InputError naming scene.file and the triangle when a vertex is
+// not finite as a float or the extent along an axis passes 1e19.
 void update_bounds(Scene& scene);
 
 }  // namespace lc

@@ -90,20 +90,24 @@ float lc_pick_weight(LC_IN(SurfacePoint) sp, uint node_index, uint pick, float m
 LC_KCONST uint kBranchSteps = 16777216u;  // 2^24
 LC_KCONST float kBranchStep = 1.0f / 16777216.0f;
 
-LC_KCONST float kLargestFloat = 3.40282347e38f;
-
 uint lc_branch_steps(float a, float b) {
     if (!(a > 0.0f)) return 0u;
     if (!(b > 0.0f)) return kBranchSteps;
-    float sum = a + b;
-    float share = a / sum;
-    // Where a + b overflows (two lights of 1.7e38, each in range: the
-    // share came out 0, and sampled lightcuts 9% dark) the halves are
-    // summed; an infinite weight takes all but the least share.
-    if (!(sum <= kLargestFloat)) {
-        bool a_inf = a > kLargestFloat, b_inf = b > kLargestFloat;
-        share = a_inf ? (b_inf ? 0.5f : 1.0f) : (b_inf ? 0.0f : 0.5f * a / (0.5f * a + 0.5f * b));
+    // Weights far from 1 are scaled by 2^-64 or 2^64 first (exactly, a
+    // power of two): a + b must not overflow (two lights of 1.7e38: the
+    // share came out 0, and sampled lightcuts 9% dark), and Vulkan's
+    // division is accurate only for divisors from 2^-126 to 2^126. An
+    // infinite weight takes all but the least share.
+    float larger = max(a, b);
+    if (larger > 1.26765060e30f) {  // 2^100
+        a *= 5.42101086e-20f;       // 2^-64
+        b *= 5.42101086e-20f;
+    } else if (larger < 7.88860905e-31f) {  // 2^-100
+        a *= 1.84467441e19f;                // 2^64
+        b *= 1.84467441e19f;
     }
+    bool a_inf = a > 3.40282347e38f, b_inf = b > 3.40282347e38f;
+    float share = a_inf ? (b_inf ? 0.5f : 1.0f) : (b_inf ? 0.0f : a / (a + b));
     uint n = uint(share * float(kBranchSteps) + 0.5f);
     return min(max(n, 1u), kBranchSteps - 1u);
 }
@@ -146,10 +150,14 @@ struct RootWeights {
     float after[kLightTypeCount];
 };
 
+// The weights are the roots' over 8 (exactly, a power of two), so that the
+// sums of five stay finite (three of 2e38 made `after` infinite, and the
+// first type was drawn with probability 6e-8 instead of 1/3).
 RootWeights lc_root_weights(LC_IN(SurfacePoint) sp, LC_IN(FrameParams) f, uint pick) {
     RootWeights r;
     for (uint t = 0u; t < kLightTypeCount; ++t)
-        r.weight[t] = f.roots[t] == kInvalidIndex ? 0.0f : lc_pick_weight(sp, f.roots[t], pick, f.min_distance2);
+        r.weight[t] =
+            f.roots[t] == kInvalidIndex ? 0.0f : 0.125f * lc_pick_weight(sp, f.roots[t], pick, f.min_distance2);
     float rest = 0.0f;
     for (uint i = 0u; i < kLightTypeCount; ++i) {
         uint t = kLightTypeCount - 1u - i;
