@@ -11,7 +11,10 @@
 #define LC_OUT(T) T&
 #define LC_INOUT(T) T&
 #define LC_KCONST static constexpr
+// No multiply-add is fused on the CPU (-ffp-contract=off): nothing to mark.
+#define LC_PRECISE
 #else
+#define LC_PRECISE precise
 #define LC_KCONST const
 #define LC_IN(T) in T
 #define LC_OUT(T) out T

@@ -64,9 +64,13 @@ float lc_intersect_sheared(vec3 org, LC_IN(ShearedRay) r, LC_IN(Triangle) tri, f
     float cx = c[r.kx] - r.sx * c[r.kz];
     float cy = c[r.ky] - r.sy * c[r.kz];
 
-    float u = cx * by - cy * bx;
-    float v = ax * cy - ay * cx;
-    float w = bx * ay - by * ax;
+    // `precise` (LC_PRECISE): a shared edge's function in the two triangles beside it
+    // must come out exactly negated (Woop et al.'s watertightness), which
+    // a multiply-add fused in one and not the other breaks; the CPU build
+    // fuses none (-ffp-contract=off), a GPU compiler may.
+    LC_PRECISE float u = cx * by - cy * bx;
+    LC_PRECISE float v = ax * cy - ay * cx;
+    LC_PRECISE float w = bx * ay - by * ax;
     if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return -1.0f;
     float det = u + v + w;
     if (det == 0.0f) return -1.0f;
