@@ -242,10 +242,21 @@ int run_compare(const std::string& image, const std::string& reference, const st
     return 0;
 }
 
-int run_info(const std::string& file, const lc::SceneOptions& options, std::optional<std::uint32_t> area_samples) {
+// What `info` takes of render's options: those that change what is
+// prepared (the lights made from emissive surfaces and light paths).
+struct InfoArgs {
+    std::optional<std::uint32_t> area_samples, vpls, vpl_bounces, seed;
+};
+
+int run_info(const std::string& file, const lc::SceneOptions& options, const InfoArgs& a) {
     lc::Scene scene = lc::load_scene(file, options);
     print_load_notes(file, scene);
-    if (area_samples) scene.render.area_light_samples = *area_samples;
+    if (a.area_samples) scene.render.area_light_samples = *a.area_samples;
+    if (a.vpls) scene.render.indirect.vpls = *a.vpls;
+    if (a.vpl_bounces) scene.render.indirect.max_bounces = *a.vpl_bounces;
+    // The render's seed, which places the area-light samples and the VPLs
+    // (with seed 1 always, a scene of another seed got other VPL counts).
+    const std::uint32_t seed = a.seed.value_or(scene.render.seed);
     std::printf("%s\n", file.c_str());
     std::printf("  triangles          %zu (%zu degenerate dropped)\n", scene.triangles.size(),
                 scene.degenerate_triangles_dropped);
@@ -260,11 +271,17 @@ int run_info(const std::string& file, const lc::SceneOptions& options, std::opti
     std::printf("  bounds             [%g %g %g] - [%g %g %g]\n", scene.bounds_min.x, scene.bounds_min.y,
                 scene.bounds_min.z, scene.bounds_max.x, scene.bounds_max.y, scene.bounds_max.z);
     std::printf("  image              %ux%u\n", scene.camera.width, scene.camera.height);
-    const lc::PreparedScene prepared = lc::prepare_scene(std::move(scene), 1);
+    const lc::PreparedScene prepared = lc::prepare_scene(std::move(scene), seed);
     std::printf("  area-light samples %zu\n", prepared.area_lights);
     if (prepared.scene.render.indirect.vpls > 0)  // also where the paths left none
-        std::printf("  VPLs               %zu from %zu light paths (seed 1)\n", prepared.vpls, prepared.vpl_paths);
-    std::printf("  buffers:\n%s", lc::buffer_table(lc::scene_buffer_bytes(prepared)).c_str());
+        std::printf("  VPLs               %zu from %zu light paths (seed %u)\n", prepared.vpls, prepared.vpl_paths,
+                    seed);
+    // The arrays the kernels read, not all the process holds: the host
+    // keeps the scene's own lights as well, and the tree's build holds its
+    // clusters (docs/results/scale.md, "Memory per light").
+    std::printf("  buffers the kernels read (the host holds the scene's lights too, 48 B a light, and at the "
+                "tree's build about 330 B a light in all):\n%s",
+                lc::buffer_table(lc::scene_buffer_bytes(prepared)).c_str());
     return 0;
 }
 
@@ -374,13 +391,18 @@ int main(int argc, char** argv) {
 
     std::string info_scene;
     lc::SceneOptions info_options;
-    auto* info = app.add_subcommand("info", "Print what a scene holds and the memory it needs");
+    auto* info = app.add_subcommand("info", "Print what a scene holds and the buffers its render reads");
     info->add_option("scene", info_scene, "Scene file (JSON, or glTF 2.0: .gltf or .glb)")->required()->check(kFileName);
     info->add_option("--camera", info_options.camera, "glTF scenes: the perspective camera of this name")
         ->check(kCameraName);
-    std::optional<std::uint32_t> info_area_samples;
-    info->add_option("--area-samples", info_area_samples, "Point lights the emissive surfaces become, as render's")
+    InfoArgs info_args;
+    info->add_option("--area-samples", info_args.area_samples, "Point lights the emissive surfaces become, as render's")
         ->transform(setting(lc::kSettingAreaLightSamples));
+    info->add_option("--vpls", info_args.vpls, "Virtual point lights for indirect light, as render's")
+        ->transform(setting(lc::kSettingVpls));
+    info->add_option("--vpl-bounces", info_args.vpl_bounces, "VPLs per light path at most, as render's")
+        ->transform(setting(lc::kSettingMaxBounces));
+    info->add_option("--seed", info_args.seed, "Seed of the area-light samples and VPLs, as render's");
 
     // A first word that is neither a subcommand nor an option: CLI11 would
     // say only that a subcommand is required.
@@ -430,7 +452,7 @@ int main(int argc, char** argv) {
     try {
         if (*render) return run_render(r);
         if (*compare) return run_compare(cmp_image, cmp_ref, cmp_heatmap, cmp_json);
-        if (*info) return run_info(info_scene, info_options, info_area_samples);
+        if (*info) return run_info(info_scene, info_options, info_args);
     } catch (const std::bad_alloc&) {
         // Where the memory went is not known here; what usually takes it is.
         std::fprintf(stderr,

@@ -169,7 +169,7 @@ LC_CONST uint kCutLastDispatch = 2u;   // every cut must be final by the end of 
 LC_CONST uint kUnlimitedRefinements = 0xFFFFFFFFu;
 
 // Push constants of every kernel: what changes from dispatch to dispatch
-// (40 bytes; the frame's constants are in the kBindingFrame buffer).
+// (44 bytes; the frame's constants are in the kBindingFrame buffer).
 struct PushConstants {
     uint tile_x, tile_y;    // first pixel of the dispatched tile
     uint tile_width, tile_height;

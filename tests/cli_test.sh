@@ -41,6 +41,11 @@ awk '/^relative RMSE/ { found = 1; ok = ($3 > 0 && $3 < 0.1) } END { exit !(foun
 "$exe" info "$root/scenes/panels/panels.json" --area-samples 5000 | grep "area-light samples 5000$" >/dev/null ||
   fail "info --area-samples"
 "$exe" info "$root/scenes/panels/panels.json" --area-samples 0 2>/dev/null && fail "info --area-samples 0 accepted"
+# ... and for the VPLs render would make with the same options and seed.
+v_info=$("$exe" info "$root/scenes/cornell/cornell.json" --vpls 2000 --seed 7 | sed -n 's/^  VPLs *\([0-9]*\) from.*/\1/p')
+v_render=$("$exe" render "$root/scenes/cornell/cornell.json" --vpls 2000 --seed 7 --width 8 --height 8 --no-png \
+  -o "$tmp/vpls.exr" 2>&1 | sed -n 's/.*and \([0-9]*\) VPLs from.*/\1/p')
+[ -n "$v_info" ] && [ "$v_info" = "$v_render" ] || fail "info --vpls --seed: $v_info VPLs, render $v_render"
 
 # Bad input: message names the file and the field, exit is non-zero, no output.
 expect_error() {  # expected-substring, then the command's arguments
