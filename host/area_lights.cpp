@@ -116,19 +116,23 @@ double TriangleEmission::brightest_in_footprint(std::size_t i) const {
     const float v_lo = std::min({uv.v0, uv.v1, uv.v2}), v_hi = std::max({uv.v0, uv.v1, uv.v2});
     // The texels the bilinear filter may read anywhere in the box: from
     // the one left of (below) the first centre to the one right of the last.
-    const double x0 = std::floor(double(u_lo) * info.width - 0.5), x1 = std::floor(double(u_hi) * info.width - 0.5) + 1;
-    const double y0 = std::floor(double(v_lo) * info.height - 0.5), y1 = std::floor(double(v_hi) * info.height - 0.5) + 1;
-    const double columns = std::min(x1 - x0 + 1, double(info.width)), rows = std::min(y1 - y0 + 1, double(info.height));
+    const double x0 = std::floor(double(u_lo) * info.width - 0.5);
+    const double x1 = std::floor(double(u_hi) * info.width - 0.5) + 1;
+    const double y0 = std::floor(double(v_lo) * info.height - 0.5);
+    const double y1 = std::floor(double(v_hi) * info.height - 0.5) + 1;
+    const double columns = std::min(x1 - x0 + 1, double(info.width));
+    const double rows = std::min(y1 - y0 + 1, double(info.height));
     if (!(columns * rows <= 65536.0)) return -1.0;  // too many to look at (or NaN uvs)
     cpu::TextureKernel k;
     k.textures = textures_.data();
     k.texels = texels_.data();
+    // Texel p of n, the pattern repeating outside [0, n) as lc_texture_sample's does.
+    const auto wrap = [](double p, std::uint32_t n) {
+        return std::uint32_t(std::fmod(std::fmod(p, double(n)) + n, double(n)));
+    };
     float brightest = 0.0f;
-    for (double y = 0; y < rows; ++y)
-        for (double x = 0; x < columns; ++x) {
-            const auto wrap = [](double p, std::uint32_t n) {
-                return std::uint32_t(std::fmod(std::fmod(p, double(n)) + n, double(n)));
-            };
+    for (std::uint32_t y = 0; y < std::uint32_t(rows); ++y)
+        for (std::uint32_t x = 0; x < std::uint32_t(columns); ++x) {
             const glm::vec4 c = k.lc_texel(info, wrap(x0 + x, info.width), wrap(y0 + y, info.height), true);
             brightest = std::max(brightest, gpu::lc_luminance(emission(m) * glm::vec3(c)));
         }

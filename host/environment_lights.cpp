@@ -113,8 +113,10 @@ public:
         }
         if (r.x1 - r.x0 == 1 && r.y1 - r.y0 == 1) return emit_texel(r, t, samples);
         // Halve the side that is longer in angle.
-        const double mid_sin = std::sin(sub_ == 1 ? kPi * 0.5 * (r.y0 + r.y1) / rows_ : 0.5 * (theta_[r.y0] + theta_[r.y1]));
-        const double width = (r.x1 - r.x0) * 2.0 * kPi / map_.width * mid_sin;
+        // (Where no row is cut, in the arithmetic it always had, so that
+        // those maps' lights stay the same to the last bit.)
+        const double mid_theta = sub_ == 1 ? kPi * 0.5 * (r.y0 + r.y1) / rows_ : 0.5 * (theta_[r.y0] + theta_[r.y1]);
+        const double width = (r.x1 - r.x0) * 2.0 * kPi / map_.width * std::sin(mid_theta);
         const double height = sub_ == 1 ? (r.y1 - r.y0) * kPi / rows_ : theta_[r.y1] - theta_[r.y0];
         Region a = r, b = r;
         if ((width >= height && r.x1 - r.x0 > 1) || r.y1 - r.y0 == 1) {
