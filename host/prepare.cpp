@@ -58,10 +58,43 @@ void check_generated_totals(const Scene& scene, loader::LightLimits& limits, std
     }
 }
 
+// Moves a scene that lies far from the origin, compared with its size, to
+// the origin (by its bounds' centre, in float): the renderer's precision
+// then follows the scene's size, not its position. A hit point is shaded
+// where it was moved off its surface, 2^-20 of its largest coordinate
+// (lc_offset_hit_point), and every float step grows with the coordinates:
+// the shipped room moved by 1e4 came out 30% off (relative RMSE), a light
+// 0.25 above a floor moved by 16384 13.5% brighter under it. (pbrt-v4
+// renders in camera-centred coordinates for the same reason.) A scene
+// within 16 times its diagonal of the origin is left as it is, to the bit.
+// The camera, the triangles and every light with a position move; nothing
+// the renderer reports depends on where the scene is.
+void centre_far_scene(Scene& scene) {
+    const glm::dvec3 lo(scene.bounds_min), hi(scene.bounds_max);
+    const double diagonal = glm::length(hi - lo);
+    const double farthest = std::max({std::abs(lo.x), std::abs(lo.y), std::abs(lo.z), std::abs(hi.x), std::abs(hi.y),
+                                      std::abs(hi.z)});
+    if (!(farthest > 16.0 * diagonal) || scene.triangles.empty()) return;
+    const glm::vec3 c(0.5 * (lo + hi));
+    auto move = [&c](float& x, float& y, float& z) { x -= c.x, y -= c.y, z -= c.z; };
+    for (gpu::Triangle& t : scene.triangles) {
+        move(t.v0_x, t.v0_y, t.v0_z);
+        move(t.v1_x, t.v1_y, t.v1_z);
+        move(t.v2_x, t.v2_y, t.v2_z);
+    }
+    for (gpu::Light& l : scene.lights)
+        if ((l.type & gpu::kLightTypeMask) != gpu::kLightDirectional) move(l.x, l.y, l.z);
+    scene.camera.position -= c;
+    scene.camera.look_at -= c;
+    scene.bounds_min -= c;
+    scene.bounds_max -= c;
+}
+
 }  // namespace
 
 PreparedScene prepare_scene(Scene scene, std::uint32_t seed, unsigned threads) {
     PreparedScene prepared;
+    centre_far_scene(scene);
     prepared.has_occluders = !all_coplanar(scene.triangles);
     // A scene without texture coordinates gets zeros: every kernel reads them.
     if (scene.uvs.empty()) scene.uvs.assign(scene.triangles.size(), gpu::TriangleUvs{});

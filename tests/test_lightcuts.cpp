@@ -560,6 +560,40 @@ TEST(BruteForce, ManyDimLightsBesideBrightOnesAllCount) {
 // of two scales every bound, estimate and cluster sum exactly (no rounding,
 // far from overflow and denormals), so every cut must stay the same and the
 // image must scale exactly.
+// A scene far from the origin renders as the same scene at the origin:
+// prepare_scene moves it there. Every coordinate here is a multiple of
+// 1/8 and the translation 16384, so both scenes hold exactly the same
+// shapes in float. (Rendered where it lay, hit points were shaded 2^-20 of
+// 16384 off their surfaces, 0.016, and lights 0.25 above the floor lit it
+// up to 14% more.)
+TEST(PrepareScene, AFarSceneRendersAsAtTheOrigin) {
+    auto scene_at = [](glm::vec3 t) {
+        Scene s;
+        s.materials = {test::lambert({0.7f, 0.7f, 0.7f})};
+        test::add_quad(s, glm::vec3(-1, 0, -1) + t, glm::vec3(-1, 0, 1) + t, glm::vec3(1, 0, 1) + t,
+                       glm::vec3(1, 0, -1) + t, 0);
+        test::add_box(s, glm::vec3(-0.25f, 0.0f, -0.25f) + t, glm::vec3(0.25f, 0.5f, 0.25f) + t, 0);
+        for (const glm::vec3 p : {glm::vec3(0.5f, 0.25f, 0.375f), glm::vec3(-0.625f, 0.25f, -0.5f),
+                                  glm::vec3(0.125f, 1.5f, -0.75f)})
+            s.lights.push_back(test::point_light(p + t, glm::vec3(1.0f)));
+        s.camera = test::camera(glm::vec3(0.0f, 1.5f, 2.0f) + t, t, 60.0f, 16, 16);
+        update_bounds(s);
+        return s;
+    };
+    const glm::vec3 far(16384.0f, 16384.0f, -16384.0f);
+    const PreparedScene here = prepare_scene(scene_at(glm::vec3(0.0f)), 1);
+    const PreparedScene there = prepare_scene(scene_at(far), 1);
+    EXPECT_LT(glm::length(there.scene.camera.position), 4.0f);  // moved
+    EXPECT_EQ(here.scene.camera.position, glm::vec3(0.0f, 1.5f, 2.0f));  // near the origin: left as it is
+    for (const char* method : {"brute", "lightcuts"}) {
+        const RenderOptions o = test::options(method, 16);
+        const CompareResult c = compare_images(render_cpu(there, o).image, render_cpu(here, o).image);
+        std::printf("[ measured ] %s, the scene at 16384 against at the origin: relative RMSE %.2e\n", method,
+                    c.relative_rmse);
+        EXPECT_LT(c.relative_rmse, 1e-5) << method;
+    }
+}
+
 TEST(Lightcuts, ThresholdIsRelativeToTheEstimate) {
     auto base = test::random_point_lights(500, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 8);
     PreparedScene p0 = prepare_scene(test::room_scene(base, 24), 1);
