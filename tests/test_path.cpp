@@ -146,6 +146,17 @@ TEST(PathEmitters, DistributionNeverPicksZeroWeights) {
     EXPECT_EQ(d.sample(std::nextafter(1.0, 0.0)), 3u);
 }
 
+// A kernel and frame that look up `map` (lc_environment_radiance).
+struct MapLookup {
+    Kernel k{};
+    gpu::FrameParams f{};
+    explicit MapLookup(const Environment& map) {
+        k.environment = map.rgb.data();
+        f.env_width = map.width;
+        f.env_height = map.height;
+    }
+};
+
 // A map with black texels and one bright one: every sampled direction has
 // the density pdf() reports, lies in a texel that shines, and the texel's
 // luminance over that density is the map's luminance integral (the sampler
@@ -161,11 +172,9 @@ TEST(PathEmitters, EnvironmentSamplingFollowsLuminanceTimesSolidAngle) {
     }
     map.rgb[3 * 37] = 40.0f;  // a sun
     const path::EnvironmentSampler sampler(map);
-    Kernel k{};
-    k.environment = map.rgb.data();
-    gpu::FrameParams f{};
-    f.env_width = map.width;
-    f.env_height = map.height;
+    MapLookup lookup(map);
+    Kernel& k = lookup.k;
+    const gpu::FrameParams& f = lookup.f;
 
     double integral = 0.0;
     for (std::uint32_t r = 0; r < map.height; ++r) {
@@ -207,11 +216,9 @@ TEST(PathEmitters, SamplesNearThePolesLookUpTheirOwnTexel) {
         for (std::uint32_t c = 0; c < map.width; ++c)
             for (int k = 0; k < 3; ++k) map.rgb[(std::size_t(r) * map.width + c) * 3 + k] = 1.0f + float(r % 7 + c);
     const path::EnvironmentSampler sampler(map);
-    Kernel k{};
-    k.environment = map.rgb.data();
-    gpu::FrameParams f{};
-    f.env_width = map.width;
-    f.env_height = map.height;
+    MapLookup lookup(map);
+    Kernel& k = lookup.k;
+    const gpu::FrameParams& f = lookup.f;
     std::uint32_t elsewhere = 0;
     const std::uint32_t samples = 20000;
     for (std::uint32_t i = 0; i < samples; ++i) {
