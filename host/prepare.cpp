@@ -76,6 +76,15 @@ void centre_far_scene(Scene& scene) {
                                       std::abs(hi.z)});
     if (!(farthest > 16.0 * diagonal) || scene.triangles.empty()) return;
     const glm::vec3 c(0.5 * (lo + hi));
+    // The camera's forward vector is kept as it was: look_at moved on its
+    // own rounds apart from the position where the camera is much farther
+    // from c than the scene is wide (a camera 1e7 out with a 0.04 degree
+    // view turned by half its tilt). Where even that rounds to nothing,
+    // the scene stays where it is.
+    const glm::vec3 position = scene.camera.position - c;
+    const glm::dvec3 forward = glm::dvec3(scene.camera.look_at) - glm::dvec3(scene.camera.position);
+    const glm::vec3 look_at(glm::dvec3(position) + forward);
+    if (look_at == position) return;
     auto move = [&c](float& x, float& y, float& z) { x -= c.x, y -= c.y, z -= c.z; };
     for (gpu::Triangle& t : scene.triangles) {
         move(t.v0_x, t.v0_y, t.v0_z);
@@ -84,8 +93,8 @@ void centre_far_scene(Scene& scene) {
     }
     for (gpu::Light& l : scene.lights)
         if ((l.type & gpu::kLightTypeMask) != gpu::kLightDirectional) move(l.x, l.y, l.z);
-    scene.camera.position -= c;
-    scene.camera.look_at -= c;
+    scene.camera.position = position;
+    scene.camera.look_at = look_at;
     scene.bounds_min -= c;
     scene.bounds_max -= c;
 }

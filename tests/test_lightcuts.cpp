@@ -555,11 +555,6 @@ TEST(BruteForce, ManyDimLightsBesideBrightOnesAllCount) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(loop[c], exact[c], 1e-6 * exact[c]);
 }
 
-// The seed report compared the bound with the estimate in absolute terms;
-// the threshold here is relative. Scaling every intensity by an exact power
-// of two scales every bound, estimate and cluster sum exactly (no rounding,
-// far from overflow and denormals), so every cut must stay the same and the
-// image must scale exactly.
 // A scene far from the origin renders as the same scene at the origin:
 // prepare_scene moves it there. Every coordinate here is a multiple of
 // 1/8 and the translation 16384, so both scenes hold exactly the same
@@ -585,6 +580,17 @@ TEST(PrepareScene, AFarSceneRendersAsAtTheOrigin) {
     const PreparedScene there = prepare_scene(scene_at(far), 1);
     EXPECT_LT(glm::length(there.scene.camera.position), 4.0f);  // moved
     EXPECT_EQ(here.scene.camera.position, glm::vec3(0.0f, 1.5f, 2.0f));  // near the origin: left as it is
+    // A camera far from the scene keeps its forward vector: its look_at is
+    // not moved on its own (which rounded (-1, 2e-4, 0) to (-2, 2e-4, 0)
+    // 1e7 out, where floats are 1 apart).
+    Scene distant = scene_at(glm::vec3(100000.5f, 0.0f, 0.0f));
+    distant.camera.position = glm::vec3(1e7f, 0.0f, 0.0f);
+    distant.camera.look_at = glm::vec3(9999999.0f, 0.0002f, 0.0f);
+    const Camera moved = prepare_scene(distant, 1).scene.camera;
+    const glm::vec3 forward = moved.look_at - moved.position;  // rounded once, near the scene
+    EXPECT_EQ(forward.x, -1.0f);
+    EXPECT_NEAR(forward.y, 0.0002f, 1e-7f);
+    EXPECT_EQ(forward.z, 0.0f);
     for (const char* method : {"brute", "lightcuts"}) {
         const RenderOptions o = test::options(method, 16);
         const CompareResult c = compare_images(render_cpu(there, o).image, render_cpu(here, o).image);
@@ -594,6 +600,11 @@ TEST(PrepareScene, AFarSceneRendersAsAtTheOrigin) {
     }
 }
 
+// The seed report compared the bound with the estimate in absolute terms;
+// the threshold here is relative. Scaling every intensity by an exact power
+// of two scales every bound, estimate and cluster sum exactly (no rounding,
+// far from overflow and denormals), so every cut must stay the same and the
+// image must scale exactly.
 TEST(Lightcuts, ThresholdIsRelativeToTheEstimate) {
     auto base = test::random_point_lights(500, {-0.9f, 0.2f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 8);
     PreparedScene p0 = prepare_scene(test::room_scene(base, 24), 1);

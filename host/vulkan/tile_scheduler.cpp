@@ -56,8 +56,9 @@ void TileScheduler::render(RenderResult& result) {
     const std::uint32_t tallest = quads ? std::max(2u, resources_.tiles().invocations / 2u) : max_pixels;
     for (std::uint32_t y0 = 0; y0 < height;) {
         // About square, or as tall as the budget where the image is narrower
-        // than that (a band of sqrt(budget) rows made a 1 x 16384 image 129
-        // tiles of 128 pixels, far under a GPU's smallest tile of 65,536).
+        // than that (a band of sqrt(budget) rows made a 1 x 16384 image
+        // tiles of sqrt(budget) pixels: 64 of 256 where a GPU's budget is
+        // 65,536).
         const double rows = std::max(std::sqrt(budget), budget / width);
         const std::uint32_t band = std::min<std::uint32_t>(
             height - y0, even(std::clamp<std::uint32_t>(std::uint32_t(rows), 1u, tallest)));

@@ -17,7 +17,7 @@
 //    renderer then moves the scene back to the origin (prepare_scene), so
 //    nothing else is lost: before it did, hit points were shaded a few
 //    ulps (0.03) off their surfaces where the untranslated room has 3e-5.
-#include <ostream>#include <ostream>
+#include <ostream>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -97,16 +97,18 @@ struct TransformCase {
 // 9.8e-8, none (0.0070 and 0.0069 shaded where it lay, 11% and 13%);
 // ScaledTo1em4 brute 1.8e-7, none; lightcuts 2.1e-5, none (when first
 // measured; 1.5e-7 for both on a later host, where no cut differed). The
-// translated cases take ScaledTo1em4's limits, lightcuts' allowing a cut
-// that rounding turns the other way.
+// translated cases keep the hall's limits from before the move, far above
+// lavapipe's figures: on a GPU a shadow ray that FMA or its sqrt turns
+// the other way moves a pixel of the hall's 500 lights by about 0.2%, and
+// no GPU run has measured them yet.
 const TransformCase kTransforms[] = {
     // Lightcuts against brute force measured 0.0127, 0.0087 (5 pixels of 576 above 5%) with the quads' cuts
     // refined largest first throughout; 0.0126, 0.0139 (8 pixels) since they are refined in passes while the
     // list has room (host/quad_cut.h; on the shipped scenes no larger error and no more pixels above 2%, the
     // gallery's 54.0% against 55.0% aside: docs/results/speed.md). Limits 1.5 times the measurement.
-    {"TranslatedBy1e5", 50.0f, 1.0f, {1e5f, 1e5f, -1e5f}, 4e-4, 0.002, {0.019, 0.021}, {{5e-7, 0.002}, {6e-5, 0.002}}},
+    {"TranslatedBy1e5", 50.0f, 1.0f, {1e5f, 1e5f, -1e5f}, 4e-4, 0.002, {0.019, 0.021}, {{5.5e-4, 0.005}, {4e-4, 0.002}}},
     // 0.0115, 0.0104 with a heap the tree cannot fill; 0.0115, 0.0208 with the default heap of 64 slots
-    {"SmallRoomTranslatedBy1e5", 1.0f, 1.0f, {1e5f, 1e5f, -1e5f}, -1.0, 0.0, {0.018, 0.03}, {{5e-7, 0.002}, {6e-5, 0.002}}},
+    {"SmallRoomTranslatedBy1e5", 1.0f, 1.0f, {1e5f, 1e5f, -1e5f}, -1.0, 0.0, {0.018, 0.03}, {{5.5e-4, 0.005}, {4e-4, 0.002}}},
     {"ScaledTo1em4", 1.0f, 1e-4f, {0.0f, 0.0f, 0.0f}, 1e-6, 0.002, {0.019, 0.013}, {{5e-7, 0.002}, {6e-5, 0.002}}},  // 0.0125, 0.0104 (0.0126, 0.0087 largest first)
 };
 
