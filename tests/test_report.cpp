@@ -1,10 +1,13 @@
 // The render report (lightcuts/report.h): the JSON keeps every key scripts
 // read (bench/run) and adds the black lights; the text says what the JSON says.
 #include <algorithm>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "lightcuts/report.h"
 #include "test_util.h"
@@ -27,7 +30,7 @@ TEST(Report, JsonHasEveryKeyScriptsReadAndTheBlackLights) {
     ASSERT_EQ(p.tree.black_lights, 3u);
     const RenderOptions o = test::options("lightcuts", 8);
     RenderResult r = render_cpu(p, o);
-    r.stats.buffer_bytes = {{"lights", 7}, {"g_buffer", 99}};  // as the Vulkan renderer reports its buffers
+    r.stats.buffer_bytes = {{"lights", 7}, {"g-buffer", 99}};  // as the Vulkan renderer reports its buffers
     const RenderReport report = make_report("room.json", o, p, r, 0.25);
     const std::string json = report_json(report);
     for (const char* key : {"scene", "method", "device", "width", "height", "spp", "triangles", "lights",
@@ -49,7 +52,7 @@ TEST(Report, JsonHasEveryKeyScriptsReadAndTheBlackLights) {
     const auto named_lights = std::count_if(report.buffer_bytes.begin(), report.buffer_bytes.end(),
                                             [](const BufferBytes& b) { return b.name == "lights"; });
     EXPECT_EQ(named_lights, 1);
-    EXPECT_THAT(json, HasSubstr("\"g_buffer\": 99"));
+    EXPECT_THAT(json, HasSubstr("\"g-buffer\": 99"));
     EXPECT_THAT(json, HasSubstr("\"load\": 0.25"));
     EXPECT_THAT(report_text(report), HasSubstr("lights 20 (and 3 black, left out of the tree)"));
     EXPECT_THAT(report_text(report), HasSubstr("cut size mean"));
@@ -137,6 +140,33 @@ TEST(Report, BruteForceHasNoLightcutsPart) {
     EXPECT_THAT(report_json(report), HasSubstr("\"black_lights\": 0,"));
     EXPECT_THAT(report_text(report), Not(HasSubstr("black")));
     EXPECT_THAT(report_text(report), Not(HasSubstr("cut size")));
+}
+
+// docs/stats.md names every key the JSON can hold: the keys of reports of
+// every shape (lightcuts with VPLs, sampled, path), scene arrays aside
+// (buffer_bytes' names are the kernels', listed by info).
+TEST(Report, DocsNameEveryJsonKey) {
+    std::ifstream in(LC_SOURCE_DIR "/docs/stats.md");
+    ASSERT_TRUE(in) << "docs/stats.md";
+    const std::string docs((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    Scene s = test::room_scene(test::random_point_lights(20, {-0.9f, 0.1f, -0.9f}, {0.9f, 1.9f, 0.9f}, 10.0f, 3), 4);
+    s.render.indirect.vpls = 16;
+    const PreparedScene p = prepare_scene(std::move(s), 1);
+    std::vector<std::string> missing;
+    for (const char* method : {"lightcuts", "sampled", "path"}) {
+        const RenderOptions o = test::options(method, 4);
+        const nlohmann::json j = nlohmann::json::parse(report_json(make_report("room.json", o, p, render_cpu(p, o), 0.0)));
+        std::vector<std::pair<std::string, const nlohmann::json*>> todo{{"", &j}};
+        while (!todo.empty()) {
+            const auto [parent, object] = todo.back();
+            todo.pop_back();
+            for (const auto& [key, value] : object->items()) {
+                if (docs.find("`" + key + "`") == std::string::npos) missing.push_back(parent + key);
+                if (value.is_object() && key != "buffer_bytes") todo.push_back({parent + key + ".", &value});
+            }
+        }
+    }
+    EXPECT_THAT(missing, ::testing::IsEmpty());
 }
 
 // info and the report list the same arrays: the ones the kernels read.
