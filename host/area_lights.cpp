@@ -2,8 +2,10 @@
 #include "area_lights.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <thread>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -110,30 +112,51 @@ glm::vec3 TriangleEmission::mean(std::size_t i) const {
 
 double TriangleEmission::brightest_in_footprint(std::size_t i) const {
     const gpu::Material& m = materials_[triangles_[i].material];
-    const gpu::TriangleUvs& uv = uvs_[i];
     const gpu::TextureInfo& info = textures_[m.emissive_texture];
-    const float u_lo = std::min({uv.u0, uv.u1, uv.u2}), u_hi = std::max({uv.u0, uv.u1, uv.u2});
-    const float v_lo = std::min({uv.v0, uv.v1, uv.v2}), v_hi = std::max({uv.v0, uv.v1, uv.v2});
-    // The texels the bilinear filter may read anywhere in the box: from
-    // the one left of (below) the first centre to the one right of the last.
-    const double x0 = std::floor(double(u_lo) * info.width - 0.5);
-    const double x1 = std::floor(double(u_hi) * info.width - 0.5) + 1;
-    const double y0 = std::floor(double(v_lo) * info.height - 0.5);
-    const double y1 = std::floor(double(v_hi) * info.height - 0.5) + 1;
-    const double columns = std::min(x1 - x0 + 1, double(info.width));
-    const double rows = std::min(y1 - y0 + 1, double(info.height));
-    if (!(columns * rows <= 65536.0)) return -1.0;  // too many to look at (or NaN uvs)
+    // The triangle's texture coordinates as the lookup takes them: an
+    // affine transform maps the triangle to a triangle, so the box of its
+    // transformed corners bounds every point's.
+    const gpu::TriangleUvs& t = uvs_[i];
+    std::array<glm::dvec2, 3> uv{glm::dvec2(t.u0, t.v0), glm::dvec2(t.u1, t.v1), glm::dvec2(t.u2, t.v2)};
+    if ((info.sampling & gpu::kTextureTransformed) != 0u)
+        for (glm::dvec2& c : uv)
+            c = glm::dvec2(double(info.uv_transform[0]) * c.x + double(info.uv_transform[1]) * c.y + info.uv_transform[2],
+                           double(info.uv_transform[3]) * c.x + double(info.uv_transform[4]) * c.y + info.uv_transform[5]);
+    // Along one axis, the texels the bilinear filter may read anywhere in
+    // [lo, hi] of n texels: from the one left of (below) the first centre
+    // to the one right of the last, wrapped as lc_wrap_texel wraps them;
+    // a repeat's n and a mirror's 2n cover every texel. (The nearest
+    // texel is among them.) None where there are too many (or NaN).
+    const auto texels = [](double lo, double hi, std::uint32_t n, std::uint32_t wrap) {
+        std::vector<std::uint32_t> out;
+        const double first = std::floor(lo * n - 0.5), last = std::floor(hi * n - 0.5) + 1;
+        const double period = wrap == gpu::kTextureWrapMirror ? 2.0 * n : double(n);
+        const double count = std::min(last - first + 1, period);
+        if (!(count <= 65536.0)) return out;
+        for (double p = first; p < first + count; ++p) {
+            if (wrap == gpu::kTextureWrapClamp) {
+                out.push_back(std::uint32_t(std::clamp(p, 0.0, double(n - 1))));
+                continue;
+            }
+            const double q = std::fmod(std::fmod(p, period) + period, period);
+            out.push_back(std::uint32_t(q < n ? q : period - 1 - q));
+        }
+        return out;
+    };
+    const auto [u_lo, u_hi] = std::minmax({uv[0].x, uv[1].x, uv[2].x});
+    const auto [v_lo, v_hi] = std::minmax({uv[0].y, uv[1].y, uv[2].y});
+    const std::vector<std::uint32_t> columns = texels(u_lo, u_hi, info.width, info.sampling & 3u);
+    const std::vector<std::uint32_t> rows =
+        texels(v_lo, v_hi, info.height, (info.sampling >> gpu::kTextureWrapVShift) & 3u);
+    if (columns.empty() || rows.empty() || double(columns.size()) * double(rows.size()) > 65536.0)
+        return -1.0;  // too many to look at (or NaN coordinates)
     cpu::TextureKernel k;
     k.textures = textures_.data();
     k.texels = texels_.data();
-    // Texel p of n, the pattern repeating outside [0, n) as lc_texture_sample's does.
-    const auto wrap = [](double p, std::uint32_t n) {
-        return std::uint32_t(std::fmod(std::fmod(p, double(n)) + n, double(n)));
-    };
     float brightest = 0.0f;
-    for (std::uint32_t y = 0; y < std::uint32_t(rows); ++y)
-        for (std::uint32_t x = 0; x < std::uint32_t(columns); ++x) {
-            const glm::vec4 c = k.lc_texel(info, wrap(x0 + x, info.width), wrap(y0 + y, info.height), true);
+    for (const std::uint32_t y : rows)
+        for (const std::uint32_t x : columns) {
+            const glm::vec4 c = k.lc_texel(info, x, y, true);
             brightest = std::max(brightest, gpu::lc_luminance(emission(m) * glm::vec3(c)));
         }
     return brightest;

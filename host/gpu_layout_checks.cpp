@@ -40,8 +40,10 @@ static_assert(offsetof(Material, normal_scale) == 76);
 static_assert(offsetof(Material, base_color_texture) == 80);
 static_assert(offsetof(Material, normal_texture) == 92);
 
-static_assert(sizeof(TextureInfo) == 16);
+static_assert(sizeof(TextureInfo) == 40);
 static_assert(offsetof(TextureInfo, height) == 8);
+static_assert(offsetof(TextureInfo, sampling) == 12);
+static_assert(offsetof(TextureInfo, uv_transform) == 16);
 static_assert(offsetof(Material, emission_r) == 32);
 static_assert(offsetof(Material, ks_r) == 12);
 static_assert(offsetof(Material, alpha) == 24);

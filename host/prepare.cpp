@@ -99,11 +99,49 @@ void centre_far_scene(Scene& scene) {
     scene.bounds_max -= c;
 }
 
+// Moves each triangle's texture coordinates by a whole number of periods
+// towards 0, where every texture its material samples repeats or mirrors
+// without a transform along that axis (a move by an even number changes
+// neither lookup). A float near 1e6 is a multiple of 0.0625, so the
+// barycentric sums of coordinates that large lose the texture's detail
+// (relative RMSE 0.36 at 64 texels with 999999 added to a quad's u and v,
+// and the texture one colour at 1e7); moved, they keep their fraction. A
+// triangle within 2 of the origin is left as it is, to the bit.
+void wrap_texture_coordinates(Scene& scene) {
+    if (scene.uvs.size() != scene.triangles.size() || scene.textures.empty()) return;
+    for (std::size_t i = 0; i < scene.triangles.size(); ++i) {
+        const gpu::Material& m = scene.materials[scene.triangles[i].material];
+        if ((m.flags & gpu::kMaterialTextured) == 0u) continue;
+        bool movable[2] = {true, true};
+        for (const std::uint32_t t :
+             {m.base_color_texture, m.metallic_roughness_texture, m.emissive_texture, m.normal_texture}) {
+            if (t == gpu::kInvalidIndex) continue;
+            const std::uint32_t sampling = scene.textures[t].sampling;
+            for (std::uint32_t axis = 0; axis < 2; ++axis) {
+                const std::uint32_t wrap = sampling >> (axis * gpu::kTextureWrapVShift) & 3u;
+                movable[axis] = movable[axis] && (sampling & gpu::kTextureTransformed) == 0u &&
+                                (wrap == gpu::kTextureWrapRepeat || wrap == gpu::kTextureWrapMirror);
+            }
+        }
+        gpu::TriangleUvs& uv = scene.uvs[i];
+        float* coordinates[2][3] = {{&uv.u0, &uv.u1, &uv.u2}, {&uv.v0, &uv.v1, &uv.v2}};
+        for (std::uint32_t axis = 0; axis < 2; ++axis) {
+            if (!movable[axis]) continue;
+            const double lowest = std::min({*coordinates[axis][0], *coordinates[axis][1], *coordinates[axis][2]});
+            if (std::abs(lowest) < 2.0) continue;
+            // Even, and a float: a float at or above 2^24 is a whole number.
+            const float periods = float(2.0 * std::floor(lowest / 2.0));
+            for (float* c : coordinates[axis]) *c -= periods;
+        }
+    }
+}
+
 }  // namespace
 
 PreparedScene prepare_scene(Scene scene, std::uint32_t seed, unsigned threads) {
     PreparedScene prepared;
     centre_far_scene(scene);
+    wrap_texture_coordinates(scene);
     prepared.has_occluders = !all_coplanar(scene.triangles);
     // A scene without texture coordinates gets zeros: every kernel reads them.
     if (scene.uvs.empty()) scene.uvs.assign(scene.triangles.size(), gpu::TriangleUvs{});

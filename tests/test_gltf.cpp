@@ -174,10 +174,10 @@ TEST(Gltf, MetallicRoughnessAndExtensionsBecomeDisneyParameters) {
     EXPECT_EQ(noted.sheen_tint, 0.0f);
     EXPECT_EQ(noted.base_color_texture, gpu::kInvalidIndex);  // TEXCOORD_1: left out
     EXPECT_EQ(noted.flags & gpu::kMaterialEmissive, 0u);
-    for (const char* note : {"texCoord: uses TEXCOORD_1", "KHR_texture_transform: not supported",
-                             "alphaMode: BLEND", "occlusionTexture", "samplers[0]: clamped and mirrored wrapping",
-                             "samplers[0]: nearest filtering is not supported"})
+    for (const char* note : {"texCoord: uses TEXCOORD_1", "alphaMode: BLEND", "occlusionTexture",
+                             "samplers[1].minFilter: is nearest but magFilter linear"})
         EXPECT_TRUE(has_note(s, note)) << note;
+    for (const char* read : {"KHR_texture_transform", "samplers[0]"}) EXPECT_FALSE(has_note(s, read)) << read;
     // The primitive without a material: the default one.
     EXPECT_EQ(s.materials[s.triangles[2].material].metallic, 1.0f);
 }
@@ -185,15 +185,38 @@ TEST(Gltf, MetallicRoughnessAndExtensionsBecomeDisneyParameters) {
 TEST(Gltf, TexturesAreAddedOncePerImageWithTheirTexelsAndUvs) {
     const Scene s = load("materials.gltf");
     const gpu::Material& m = s.materials[s.triangles[0].material];
-    // Textures 0 and 1 share image 0: one texture record for both.
-    ASSERT_EQ(s.textures.size(), 2u);
+    const gpu::Material& noted = s.materials[s.triangles[1].material];
+    // A record for each way an image is sampled, its texels stored once:
+    // image 0 as it is (base colour, emission), through sampler 0 (clamped
+    // in u, nearest) and transformed; image 1 as it is (the normal map)
+    // and through sampler 1 (mirrored, bilinear: magFilter decides).
+    ASSERT_EQ(s.textures.size(), 5u);
     EXPECT_NE(m.flags & gpu::kMaterialTextured, 0u);
     EXPECT_EQ(m.base_color_texture, 0u);
-    EXPECT_EQ(m.metallic_roughness_texture, 0u);
+    EXPECT_EQ(m.metallic_roughness_texture, 1u);
     EXPECT_EQ(m.emissive_texture, 0u);
-    EXPECT_EQ(m.normal_texture, 1u);
+    EXPECT_EQ(m.normal_texture, 2u);
     EXPECT_EQ(m.normal_scale, 0.5f);
-    EXPECT_EQ(s.materials[s.triangles[1].material].metallic_roughness_texture, 0u);
+    EXPECT_EQ(noted.metallic_roughness_texture, 3u);
+    EXPECT_EQ(noted.normal_texture, 4u);
+    EXPECT_EQ(s.textures[0].sampling, gpu::kTextureWrapRepeat | gpu::kTextureWrapRepeat << gpu::kTextureWrapVShift);
+    EXPECT_EQ(s.textures[1].sampling, gpu::kTextureWrapClamp | gpu::kTextureNearest);
+    EXPECT_EQ(s.textures[3].sampling, gpu::kTextureWrapClamp | gpu::kTextureNearest | gpu::kTextureTransformed);
+    EXPECT_EQ(s.textures[4].sampling, gpu::kTextureWrapMirror | gpu::kTextureWrapMirror << gpu::kTextureWrapVShift);
+    for (const std::size_t t : {1, 3}) EXPECT_EQ(s.textures[t].offset, s.textures[0].offset) << t;
+    EXPECT_EQ(s.textures[4].offset, s.textures[2].offset);
+    // The extension's example: offset (0, 1), rotation pi/2, scale 0.5
+    // maps the unit square onto the image's lower-left quarter,
+    // u' = v / 2 and v' = 1 - u / 2.
+    const float* t = s.textures[3].uv_transform;
+    const auto transformed = [t](float u, float v) {
+        return glm::vec2(t[0] * u + t[1] * v + t[2], t[3] * u + t[4] * v + t[5]);
+    };
+    for (const glm::vec2 uv : {glm::vec2(0, 0), glm::vec2(1, 0), glm::vec2(0, 1), glm::vec2(0.5f, 0.25f)}) {
+        const glm::vec2 expected(0.5f * uv.y, 1.0f - 0.5f * uv.x);
+        EXPECT_NEAR(transformed(uv.x, uv.y).x, expected.x, 1e-6f);
+        EXPECT_NEAR(transformed(uv.x, uv.y).y, expected.y, 1e-6f);
+    }
     // Image 0 is 2 x 2, row 0 at the top: red, green / blue, white (R in the low byte).
     EXPECT_EQ(s.textures[0].width, 2u);
     EXPECT_EQ(s.textures[0].height, 2u);
@@ -202,7 +225,7 @@ TEST(Gltf, TexturesAreAddedOncePerImageWithTheirTexelsAndUvs) {
     EXPECT_EQ(s.texels[s.textures[0].offset + 1], 0xFF00FF00u);
     EXPECT_EQ(s.texels[s.textures[0].offset + 2], 0xFFFF0000u);
     EXPECT_EQ(s.texels[s.textures[0].offset + 3], 0xFFFFFFFFu);
-    EXPECT_EQ(s.texels[s.textures[1].offset], 0xFFFF8080u);
+    EXPECT_EQ(s.texels[s.textures[2].offset], 0xFFFF8080u);
     // TEXCOORD_0 as written (glTF's convention is the renderer's: no flip).
     EXPECT_EQ(s.uvs[0].u0, 0.0f);
     EXPECT_EQ(s.uvs[0].u1, 1.0f);
@@ -410,6 +433,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_node_cycle.gltf", "nodes[3].children[0]: nodes[2] is reached twice"},
         BadCase{"bad_material_index.gltf", "meshes[0].primitives[0].material: material 3 out of range"},
         BadCase{"bad_base_color.gltf", "materials[0].pbrMetallicRoughness.baseColorFactor[0]: must be from 0 to 1"},
+        BadCase{"bad_base_alpha.gltf", "materials[0].pbrMetallicRoughness.baseColorFactor[3]: must be from 0 to 1"},
+        BadCase{"bad_wrap.gltf", "samplers[0].wrapS: must be 10497 (REPEAT), 33071 (CLAMP_TO_EDGE) or 33648 "
+                                 "(MIRRORED_REPEAT), not 12345"},
+        BadCase{"bad_mag_filter.gltf", "samplers[0].magFilter: must be 9728 (NEAREST) or 9729 (LINEAR), not 1"},
+        BadCase{"bad_min_filter.gltf", "samplers[0].minFilter: must be 9728 (NEAREST), 9729 (LINEAR) or 9984 to 9987"},
+        BadCase{"bad_transform_offset.gltf", "materials[0].pbrMetallicRoughness.baseColorTexture.extensions."
+                                             "KHR_texture_transform.offset[0]: must be a number, not a string"},
+        BadCase{"bad_transform_scale.gltf", "materials[0].pbrMetallicRoughness.baseColorTexture.extensions."
+                                            "KHR_texture_transform.scale[0]: must be a finite number"},
         BadCase{"bad_spot_cone.gltf", "extensions.KHR_lights_punctual.lights[0].spot.outerConeAngle"},
         BadCase{"bad_position_type.gltf", "accessors[0].componentType: is UNSIGNED_SHORT, expected FLOAT"},
         BadCase{"bad_json.gltf", "tinygltf: "},

@@ -108,6 +108,83 @@ TEST(TextureLookup, WrapsInBothDirections) {
                              "shifted by " + std::to_string(shift.x) + "," + std::to_string(shift.y));
 }
 
+// glTF's CLAMP_TO_EDGE and MIRRORED_REPEAT on a 4 x 1 texture whose texels
+// are 0, 1, 2, 3 (in red), against what each wrapping reads: the edge
+// texel beyond the edges; the image mirrored in every other period.
+TEST(TextureLookup, ClampedAndMirroredWrapping) {
+    TextureScene t;
+    const std::uint32_t image = t.add(4, 1, {rgba(0, 0, 0), rgba(1, 0, 0), rgba(2, 0, 0), rgba(3, 0, 0)});
+    loader::TextureSampling clamp, mirror;
+    clamp.wrap_u = gpu::kTextureWrapClamp;
+    mirror.wrap_u = gpu::kTextureWrapMirror;
+    const std::uint32_t clamped = loader::sampled_texture(t.scene, image, clamp);
+    const std::uint32_t mirrored = loader::sampled_texture(t.scene, image, mirror);
+    EXPECT_EQ(loader::sampled_texture(t.scene, image, clamp), clamped) << "made once";
+    EXPECT_EQ(loader::sampled_texture(t.scene, image, loader::TextureSampling{}), image);
+    ASSERT_EQ(t.scene.textures.size(), 3u);
+    auto& k = t.kernel();
+    const auto red = [&](std::uint32_t tex, float u) { return k.lc_texture_sample(tex, {u, 0.5f}, false).x * 255.0f; };
+    struct Case {
+        float u, repeat, clamp, mirror;
+    };
+    // Texel centres at u = 0.125, 0.375, ...: between the first and the
+    // last centre all three agree; outside, repeat blends 3 and 0, clamp
+    // holds the edge texel, mirror reflects about the edge.
+    for (const Case c : {Case{0.25f, 0.5f, 0.5f, 0.5f}, Case{0.0f, 1.5f, 0.0f, 0.0f}, Case{1.0f, 1.5f, 3.0f, 3.0f},
+                         Case{-0.125f, 3.0f, 0.0f, 0.0f}, Case{1.125f, 0.0f, 3.0f, 3.0f}, Case{-0.375f, 2.0f, 0.0f, 1.0f},
+                         Case{1.375f, 1.0f, 3.0f, 2.0f}, Case{2.125f, 0.0f, 3.0f, 0.0f}, Case{-1.875f, 0.0f, 0.0f, 0.0f},
+                         Case{-7.875f, 0.0f, 0.0f, 0.0f}, Case{5.0f, 1.5f, 3.0f, 3.0f}, Case{-0.875f, 0.0f, 0.0f, 3.0f}}) {
+        EXPECT_NEAR(red(image, c.u), c.repeat, 1e-4f) << "repeat at u = " << c.u;
+        EXPECT_NEAR(red(clamped, c.u), c.clamp, 1e-4f) << "clamp at u = " << c.u;
+        EXPECT_NEAR(red(mirrored, c.u), c.mirror, 1e-4f) << "mirror at u = " << c.u;
+    }
+    // v keeps its own wrapping (repeat): a 1-texel-tall image reads the same anywhere.
+    EXPECT_NEAR(k.lc_texture_sample(clamped, {-3.0f, 7.3f}, false).x * 255.0f, 0.0f, 1e-4f);
+}
+
+// magFilter NEAREST: the texel the point lies in, wrapped as the sampler says.
+TEST(TextureLookup, NearestFilteringReadsOneTexel) {
+    TextureScene t;
+    const std::uint32_t image = t.add(2, 2, kTwoByTwo);
+    loader::TextureSampling nearest;
+    nearest.nearest = true;
+    nearest.wrap_v = gpu::kTextureWrapClamp;
+    const std::uint32_t tex = loader::sampled_texture(t.scene, image, nearest);
+    auto& k = t.kernel();
+    for (int y = 0; y < 2; ++y)
+        for (int x = 0; x < 2; ++x)
+            for (const glm::vec2 within : {glm::vec2(0.01f, 0.01f), glm::vec2(0.49f, 0.3f), glm::vec2(0.2f, 0.49f)}) {
+                const glm::vec2 uv = (glm::vec2(float(x), float(y)) + within) * 0.5f;
+                expect_vec4_near(k.lc_texture_sample(tex, uv, false), unpack(kTwoByTwo[std::size_t(2 * y + x)]), 1e-7f,
+                                 "texel " + std::to_string(x) + "," + std::to_string(y));
+            }
+    // u repeats (u = -0.1 is in column 1), v clamps (v = 1.7 is in row 1).
+    // (1e-7: the kernel's x * (1 / 255) against unpack's x / 255; the
+    // nearest neighbour's texel differs by more than 0.15.)
+    expect_vec4_near(k.lc_texture_sample(tex, {-0.1f, 1.7f}, false), unpack(kTwoByTwo[3]), 1e-7f, "wrapped");
+}
+
+// A uv transform applies before the wrapping; one whose products overflow
+// reads the texture at 0 rather than at a NaN's texel.
+TEST(TextureLookup, TransformedCoordinates) {
+    TextureScene t;
+    const std::uint32_t image = t.add(2, 2, kTwoByTwo);
+    loader::TextureSampling swap;  // u' = v + 0.5, v' = u
+    swap.uv_transform = {0.0f, 1.0f, 0.5f, 1.0f, 0.0f, 0.0f};
+    const std::uint32_t swapped = loader::sampled_texture(t.scene, image, swap);
+    EXPECT_NE(t.scene.textures[swapped].sampling & gpu::kTextureTransformed, 0u);
+    auto& k = t.kernel();
+    for (const glm::vec2 uv : {glm::vec2(0.25f, 0.75f), glm::vec2(0.6f, 0.1f), glm::vec2(-3.3f, 9.9f)})
+        expect_vec4_near(k.lc_texture_sample(swapped, uv, false),
+                         k.lc_texture_sample(image, glm::vec2(uv.y + 0.5f, uv.x), false), 1e-6f, "swapped");
+    loader::TextureSampling huge;
+    huge.uv_transform = {3e38f, 3e38f, 0.0f, 0.0f, 1.0f, 0.0f};
+    const std::uint32_t overflowing = loader::sampled_texture(t.scene, image, huge);
+    auto& k2 = t.kernel();
+    expect_vec4_near(k2.lc_texture_sample(overflowing, {1.0f, 0.25f}, false),
+                     k2.lc_texture_sample(image, {0.0f, 0.25f}, false), 0.0f, "u' = inf reads as 0");
+}
+
 TEST(TextureLookup, SrgbDecodedPerTexelBeforeFiltering) {
     TextureScene t;
     const std::uint32_t tex = t.add(2, 1, {rgba(188, 10, 255, 128), rgba(0, 0, 0, 0)});
@@ -235,22 +312,63 @@ TEST(ObjTextures, MapKdLoadsAndVtTurnsToGrowDownwards) {
     EXPECT_EQ(m.normal_texture, gpu::kInvalidIndex);
 }
 
-// What an MTL asks for that is not done gets a note: a map's options, and
-// maps the renderer has no use for (tinyobjloader reads them all).
+// What an MTL asks for that is not done gets a note: a map's options but
+// -s, -o and -clamp, and maps the renderer has no use for (tinyobjloader
+// reads them all).
 TEST(ObjTextures, UnusedMapsAndOptionsAreNoted) {
     TempDir dir;
     write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
     dir.write("quad.obj", kTexturedObj);
-    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd -s 2 1 1 paint.png\nmap_Bump paint.png\nmap_Ks paint.png\n");
+    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd -colorspace linear paint.png\nmap_Bump paint.png\n"
+                          "map_Ks paint.png\n");
     const Scene scene = load_scene(dir.write("scene.json", quad_scene_json()));
     const std::string obj = (dir.path() / "quad.obj").lexically_normal().string();
     EXPECT_EQ(scene.load_notes,
               (std::vector<std::string>{obj + ": material 'paint'.map_Bump is not used (a normal map is read from norm)",
                                         obj + ": material 'paint'.map_Ks is not used",
-                                        obj + ": material 'paint'.map_Kd: its options are not applied (the texture "
-                                              "repeats, unscaled and unmoved)"}));
+                                        obj + ": material 'paint'.map_Kd: options other than -s, -o and -clamp are "
+                                              "not applied (sRGB, bilinear)"}));
+    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd -clamp on -s 2 3 1 -o 0.25 0.5 0 paint.png\n");
+    EXPECT_TRUE(load_scene(dir.path() / "scene.json").load_notes.empty());
     dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd paint.png\n");
     EXPECT_TRUE(load_scene(dir.path() / "scene.json").load_notes.empty());
+}
+
+// -s and -o scale and move an MTL map's texture coordinates, which OBJ
+// counts from the bottom (v up): u' = s_u u + o_u, v' = s_v v + o_v there;
+// -clamp on clamps both. The file is loaded once for both uses.
+TEST(ObjTextures, ScaleOffsetAndClampOptionsApply) {
+    TempDir dir;
+    write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
+    dir.write("quad.obj", kTexturedObj);
+    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd -clamp on -s 2 3 1 -o 0.25 0.5 0 paint.png\n"
+                          "map_Ke paint.png\n");
+    const Scene s = load_scene(dir.write("scene.json", quad_scene_json()));
+    ASSERT_EQ(s.textures.size(), 2u);
+    ASSERT_EQ(s.texels.size(), 2u);
+    const gpu::Material& m = s.materials[s.triangles[0].material];
+    const gpu::TextureInfo& kd = s.textures[m.base_color_texture];
+    EXPECT_EQ(s.textures[m.emissive_texture].sampling, 0u);
+    EXPECT_EQ(kd.sampling, gpu::kTextureWrapClamp | gpu::kTextureWrapClamp << gpu::kTextureWrapVShift |
+                               gpu::kTextureTransformed);
+    EXPECT_EQ(kd.offset, s.textures[m.emissive_texture].offset);
+    // OBJ's (u, v) is the renderer's (u, 1 - v); the transform takes the
+    // renderer's to the renderer's, (u', 1 - (s_v (1 - v) + o_v)).
+    for (const glm::vec2 obj_uv : {glm::vec2(0, 0), glm::vec2(1, 0), glm::vec2(0.3f, 0.8f)}) {
+        const glm::vec2 uv(obj_uv.x, 1.0f - obj_uv.y);
+        const float* t = kd.uv_transform;
+        EXPECT_NEAR(t[0] * uv.x + t[1] * uv.y + t[2], 2.0f * obj_uv.x + 0.25f, 1e-6f);
+        EXPECT_NEAR(t[3] * uv.x + t[4] * uv.y + t[5], 1.0f - (3.0f * obj_uv.y + 0.5f), 1e-6f);
+    }
+    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd -s 1e39 1 1 paint.png\n");
+    try {
+        load_scene(dir.path() / "scene.json");
+        FAIL() << "a scale past the float range loaded";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("material 'paint'.map_Kd: -s and -o must be finite numbers"),
+                  std::string::npos)
+            << e.what();
+    }
 }
 
 // JPEG as well as PNG: a uniform 8 x 8 JPEG decodes to (nearly) its colour.
@@ -485,6 +603,84 @@ TEST(TexturedAreaLights, SmallBrightFeaturesStillGetSamples) {
     // About 2 of each seed's 1000 samples land where the texel shines, so
     // the mean over 400 seeds has a relative spread of about 3%.
     EXPECT_NEAR(total / seeds, integral, 0.1 * integral);
+}
+
+// The floor above reads the texels the lookups read: through a uv
+// transform, and wrapped as the texture's sampler wraps.
+TEST(TexturedAreaLights, SmallBrightFeaturesAreFoundThroughTheSampler) {
+    std::vector<std::uint32_t> texels(64 * 64, rgba(0, 0, 0));
+    texels[30 * 64 + 30] = rgba(255, 255, 255);  // at uv (0.477, 0.477)
+    texels[50 * 64 + 0] = rgba(255, 255, 255);   // on the left edge, at v = 0.789
+    const auto power = [&](const loader::TextureSampling& sampling, const gpu::TriangleUvs& uvs, float* mean) {
+        TextureScene t;
+        const std::uint32_t tex = loader::sampled_texture(t.scene, t.add(64, 64, texels), sampling);
+        gpu::Material m = loader::make_material(glm::vec3(0.0f), glm::vec3(0.0f), 1.0f);
+        loader::set_emission(m, {1000.0f, 1000.0f, 1000.0f}, false);
+        loader::set_texture(m, &gpu::Material::emissive_texture, tex);
+        t.scene.materials = {m};
+        test::add_triangle(t.scene, {0, 1, 0}, {1, 1, 0}, {0, 1, 1}, 0);
+        t.scene.uvs = {uvs};
+        const TriangleEmission emission(t.scene);
+        if (mean) *mean = emission.mean(0).x;
+        return emission.power(0);
+    };
+    // The corner of the texture up to 0.2 holds no bright texel; scaled by
+    // 5 it covers the whole texture, and its points are the previous
+    // test's, which all miss the texel at (30, 30).
+    const gpu::TriangleUvs corner{0.0f, 0.0f, 0.2f, 0.0f, 0.0f, 0.2f};
+    EXPECT_EQ(power({}, corner, nullptr), 0.0);
+    loader::TextureSampling scaled;
+    scaled.uv_transform = {5.0f, 0.0f, 0.0f, 0.0f, 5.0f, 0.0f};
+    float mean = -1.0f;
+    EXPECT_GT(power(scaled, corner, &mean), 0.0);
+    EXPECT_EQ(mean, 0.0f);
+    // Left of the texture at u in [-1.6, -1.5]: repeated (and mirrored) that
+    // is u in [0.4, 0.5], black; clamped it is the left column, which is
+    // white at v = 0.789.
+    const gpu::TriangleUvs left{-1.6f, 0.78f, -1.5f, 0.78f, -1.6f, 0.8f};
+    EXPECT_EQ(power({}, left, nullptr), 0.0);
+    loader::TextureSampling mirror, clamp;
+    mirror.wrap_u = gpu::kTextureWrapMirror;
+    clamp.wrap_u = gpu::kTextureWrapClamp;
+    EXPECT_EQ(power(mirror, left, nullptr), 0.0);
+    EXPECT_GT(power(clamp, left, nullptr), 0.0);
+}
+
+// Texture coordinates near 1e6 (a float step of 0.0625 there) render as
+// those near 0: prepare_scene moves each triangle's by whole periods where
+// its textures repeat (before, relative RMSE 0.36 against the same quad at
+// 0). Where a texture clamps, nothing moves: clamped, u = 1e6 is u = 1.
+TEST(TexturedRender, FarTextureCoordinatesKeepTheirDetail) {
+    const auto render = [](float shift, bool clamp) {
+        Scene s;
+        std::vector<std::uint32_t> texels(64 * 64);
+        for (std::size_t i = 0; i < texels.size(); ++i) texels[i] = rgba(std::uint32_t(i * 37 % 256), 128, 255);
+        const std::uint32_t image = loader::add_texture(s, 64, 64, rgba_bytes(texels).data(), "test", "texture");
+        loader::TextureSampling sampling;
+        if (clamp) sampling.wrap_u = gpu::kTextureWrapClamp;
+        gpu::Material m = loader::make_material(glm::vec3(0.5f), glm::vec3(0.0f), 1.0f);
+        loader::set_texture(m, &gpu::Material::base_color_texture, loader::sampled_texture(s, image, sampling));
+        s.materials = {m};
+        test::add_quad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0);
+        s.uvs = {{0, 0, 0, 1, 1, 1}, {0, 0, 1, 1, 1, 0}};
+        for (gpu::TriangleUvs& uv : s.uvs)
+            for (float* c : {&uv.u0, &uv.u1, &uv.u2, &uv.v0, &uv.v1, &uv.v2}) *c += shift;
+        s.lights = {test::directional_light({0, -1, 0}, glm::vec3(3.0f))};
+        s.camera = test::camera({0, 4, 0}, {0, 0, 0}, float(2.0 * std::atan(0.25) * 180.0 / 3.14159265358979), 32, 32);
+        s.camera.up = {0, 0, -1};
+        update_bounds(s);
+        return render_cpu(prepare_scene(std::move(s), 1), test::options("brute", 32)).image;
+    };
+    const Image near = render(0.0f, false);
+    for (const float shift : {999998.0f, -1e7f}) {  // the corners 0 and 1 still apart
+        const Image far = render(shift, false);
+        ASSERT_EQ(far.rgb.size(), near.rgb.size());
+        for (std::size_t i = 0; i < near.rgb.size(); ++i)
+            ASSERT_EQ(far.rgb[i], near.rgb[i]) << "pixel " << i / 3 << " with the coordinates moved by " << shift;
+    }
+    // Clamped in u, the far quad reads the texture's last column (u = 1) everywhere.
+    const Image clamped = render(999998.0f, true);
+    EXPECT_NE(clamped.rgb, near.rgb);
 }
 
 // A plane seen from straight above, lit by a directional light along -y,

@@ -22,7 +22,8 @@ namespace fs = std::filesystem;
 
 // Extensions whose meaning this loader honours: a file may require them.
 constexpr std::array kSupportedExtensions{"KHR_lights_punctual", "KHR_materials_emissive_strength",
-                                          "KHR_materials_clearcoat", "KHR_materials_sheen"};
+                                          "KHR_materials_clearcoat", "KHR_materials_sheen",
+                                          "KHR_texture_transform"};
 
 bool supported(const std::string& extension) {
     return std::find(kSupportedExtensions.begin(), kSupportedExtensions.end(), extension) !=
@@ -212,7 +213,8 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
         if (!supported(ext))
             throw InputError(name, "extensionsRequired[" + std::to_string(i) + "]",
                              ext + " is required by the file but not supported (supported: KHR_lights_punctual, "
-                                   "KHR_materials_emissive_strength, KHR_materials_clearcoat, KHR_materials_sheen)");
+                                   "KHR_materials_emissive_strength, KHR_materials_clearcoat, KHR_materials_sheen, "
+                                   "KHR_texture_transform)");
     }
     for (const std::string& ext : model.extensionsUsed)
         if (!supported(ext)) notes.add("extensionsUsed", ext + " is not supported; what it adds is ignored");

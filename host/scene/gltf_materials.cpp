@@ -67,11 +67,15 @@ public:
         return float(v);
     }
 
-    // The first three of `size` numbers, each in [0, 1].
+    // The first three of `size` numbers, each of them in [0, 1] (an alpha
+    // too, though the renderer does not use it).
     glm::vec3 colour(const std::vector<double>& v, std::size_t size, const std::string& field) const {
         if (v.size() != size) throw InputError(file_, field, "must have " + std::to_string(size) + " components");
         glm::vec3 c;
-        for (int i = 0; i < 3; ++i) c[i] = in_range(v[std::size_t(i)], 1.0, field + "[" + std::to_string(i) + "]");
+        for (std::size_t i = 0; i < size; ++i) {
+            const float x = in_range(v[i], 1.0, field + "[" + std::to_string(i) + "]");
+            if (i < 3) c[int(i)] = x;
+        }
         return c;
     }
 
@@ -112,8 +116,6 @@ bool has_any(const tinygltf::Value& ext, std::initializer_list<const char*> keys
         if (ext.IsObject() && ext.Has(key)) return true;
     return false;
 }
-
-bool transformed(const tinygltf::ExtensionMap& ext) { return ext.find("KHR_texture_transform") != ext.end(); }
 
 // Disney's sheen colour is mix(white, tint, sheen_tint), the tint being the
 // base colour's hue. With both colours scaled to a largest component of 1,
@@ -165,7 +167,7 @@ void GltfMaterials::add_textures(gpu::Material& m, const tinygltf::Material& g, 
     const std::string pbr_name = name + ".pbrMetallicRoughness";
     const auto slot = [&](std::uint32_t gpu::Material::*field, const auto& info, const std::string& path) {
         if (info.index < 0) return;
-        const std::uint32_t t = texture(info.index, info.texCoord, transformed(info.extensions), path);
+        const std::uint32_t t = texture(info.index, info.texCoord, info.extensions, path);
         if (t != gpu::kInvalidIndex) set_texture(m, field, t);
     };
     slot(&gpu::Material::base_color_texture, pbr.baseColorTexture, pbr_name + ".baseColorTexture");
@@ -209,17 +211,80 @@ gpu::Material GltfMaterials::convert(int index) {
     return m;
 }
 
-std::uint32_t GltfMaterials::texture(int index, int tex_coord, bool transformed, const std::string& field) {
+namespace {
+
+// A number of KHR_texture_transform, finite and within a float's range.
+double transform_number(const tinygltf::Value& v, const std::string& file, const std::string& field) {
+    if (!v.IsNumber()) throw InputError(file, field, "must be a number");
+    const double x = v.GetNumberAsDouble();
+    if (!(std::abs(x) <= double(std::numeric_limits<float>::max())))
+        throw InputError(file, field, "must be a finite number, got " + std::to_string(x));
+    return x;
+}
+
+// Two numbers of KHR_texture_transform (offset, scale); `fallback` when absent.
+glm::dvec2 transform_pair(const tinygltf::Value& ext, const char* key, glm::dvec2 fallback, const std::string& file,
+                          const std::string& field) {
+    if (!ext.Has(key)) return fallback;
+    const tinygltf::Value& v = ext.Get(key);
+    const std::string at = field + "." + key;
+    if (!v.IsArray() || v.ArrayLen() != 2) throw InputError(file, at, "must be an array of 2 numbers");
+    return {transform_number(v.Get(0), file, at + "[0]"), transform_number(v.Get(1), file, at + "[1]")};
+}
+
+// A glTF sampler's wrapping (wrapS, wrapT) as a TextureInfo wrap mode.
+std::uint32_t wrap_mode(int wrap, const std::string& file, const std::string& field) {
+    switch (wrap) {
+    case TINYGLTF_TEXTURE_WRAP_REPEAT: return gpu::kTextureWrapRepeat;
+    case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return gpu::kTextureWrapClamp;
+    case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return gpu::kTextureWrapMirror;
+    default:
+        throw InputError(file, field, "must be 10497 (REPEAT), 33071 (CLAMP_TO_EDGE) or 33648 (MIRRORED_REPEAT), not " +
+                                          std::to_string(wrap));
+    }
+}
+
+}  // namespace
+
+// KHR_texture_transform: uv' = T R S uv, offset T, rotation R by `rotation`
+// radians, scale S. R is the matrix of the extension's example (offset [0,
+// 1], rotation pi/2, scale 0.5 takes the image's lower-left quarter) and of
+// the sample model TextureTransformTest, [[cos, sin], [-sin, cos]]; the
+// GLSL listing of the extension's README has it transposed (glTF issue
+// 1563). Its texCoord replaces the texture reference's.
+void GltfMaterials::read_transform(const tinygltf::Value& ext, const std::string& field, int& tex_coord,
+                                   TextureSampling& sampling) const {
+    const std::string& file = notes_.file();
+    if (!ext.IsObject()) throw InputError(file, field, "must be an object");
+    const glm::dvec2 offset = transform_pair(ext, "offset", glm::dvec2(0.0), file, field);
+    const glm::dvec2 scale = transform_pair(ext, "scale", glm::dvec2(1.0), file, field);
+    const double rotation = ext.Has("rotation") ? transform_number(ext.Get("rotation"), file, field + ".rotation") : 0.0;
+    if (ext.Has("texCoord")) {
+        const tinygltf::Value& v = ext.Get("texCoord");
+        if (!v.IsInt() || v.GetNumberAsInt() < 0)
+            throw InputError(file, field + ".texCoord", "must be a whole number >= 0");
+        tex_coord = v.GetNumberAsInt();
+    }
+    const double c = std::cos(rotation), s = std::sin(rotation);
+    sampling.uv_transform = {float(scale.x * c), float(scale.y * s), float(offset.x),
+                             float(-scale.x * s), float(scale.y * c), float(offset.y)};
+}
+
+std::uint32_t GltfMaterials::texture(int index, int tex_coord, const tinygltf::ExtensionMap& extensions,
+                                     const std::string& field) {
     const std::string& file = notes_.file();
     if (index < 0 || std::size_t(index) >= model_.textures.size())
         throw InputError(file, field + ".index", "texture " + std::to_string(index) + " out of range (" +
                                                      std::to_string(model_.textures.size()) + " textures)");
+    TextureSampling sampling;
+    const auto transform = extensions.find("KHR_texture_transform");
+    if (transform != extensions.end())
+        read_transform(transform->second, field + ".extensions.KHR_texture_transform", tex_coord, sampling);
     if (tex_coord != 0) {
         notes_.add(field + ".texCoord", "uses TEXCOORD_" + std::to_string(tex_coord) +
                                             "; only TEXCOORD_0 is read, so the texture is left out");
         return gpu::kInvalidIndex;
     }
-    if (transformed) notes_.add(field + ".extensions.KHR_texture_transform", "not supported; the texture is used untransformed");
     const std::string name = "textures[" + std::to_string(index) + "]";
     const tinygltf::Texture& t = model_.textures[std::size_t(index)];
     if (t.source < 0) {
@@ -233,21 +298,35 @@ std::uint32_t GltfMaterials::texture(int index, int tex_coord, bool transformed,
         if (std::size_t(t.sampler) >= model_.samplers.size())
             throw InputError(file, name + ".sampler", "sampler " + std::to_string(t.sampler) + " out of range (" +
                                                           std::to_string(model_.samplers.size()) + " samplers)");
+        const std::string sampler = "samplers[" + std::to_string(t.sampler) + "]";
         const tinygltf::Sampler& s = model_.samplers[std::size_t(t.sampler)];
-        if (s.wrapS != TINYGLTF_TEXTURE_WRAP_REPEAT || s.wrapT != TINYGLTF_TEXTURE_WRAP_REPEAT)
-            notes_.add("samplers[" + std::to_string(t.sampler) + "]",
-                       "clamped and mirrored wrapping are not supported; textures repeat");
-        // Nearest filtering (magnification, or minification with or without
-        // nearest mipmaps): every lookup is bilinear (shared/textures.h).
-        const bool nearest = s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ||
-                             s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ||
-                             s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
-                             s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR;
-        if (nearest)
-            notes_.add("samplers[" + std::to_string(t.sampler) + "]",
-                       "nearest filtering is not supported; textures are filtered bilinearly");
+        sampling.wrap_u = wrap_mode(s.wrapS, file, sampler + ".wrapS");
+        sampling.wrap_v = wrap_mode(s.wrapT, file, sampler + ".wrapT");
+        if (s.magFilter != -1 && s.magFilter != TINYGLTF_TEXTURE_FILTER_NEAREST &&
+            s.magFilter != TINYGLTF_TEXTURE_FILTER_LINEAR)
+            throw InputError(file, sampler + ".magFilter",
+                             "must be 9728 (NEAREST) or 9729 (LINEAR), not " + std::to_string(s.magFilter));
+        if (s.minFilter != -1 && s.minFilter != TINYGLTF_TEXTURE_FILTER_NEAREST &&
+            s.minFilter != TINYGLTF_TEXTURE_FILTER_LINEAR &&
+            !(s.minFilter >= TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST &&
+              s.minFilter <= TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR))
+            throw InputError(file, sampler + ".minFilter",
+                             "must be 9728 (NEAREST), 9729 (LINEAR) or 9984 to 9987 (the mipmap kinds), not " +
+                                 std::to_string(s.minFilter));
+        // Without mipmaps or ray footprints a lookup cannot tell
+        // magnification from minification: magFilter decides (minFilter
+        // where it is the only one given), and a minFilter that would pick
+        // texels otherwise is noted.
+        const bool min_nearest = s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ||
+                                 s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
+                                 s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR;
+        sampling.nearest = s.magFilter >= 0 ? s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST : min_nearest;
+        if (s.minFilter >= 0 && min_nearest != sampling.nearest)
+            notes_.add(sampler + ".minFilter", std::string("is ") + (min_nearest ? "nearest" : "linear") +
+                                                   " but magFilter " + (sampling.nearest ? "nearest" : "linear") +
+                                                   ": there are no mipmaps, and every lookup filters as magFilter says");
     }
-    return image(t.source);
+    return sampled_texture(scene_, image(t.source), sampling);
 }
 
 std::uint32_t GltfMaterials::image(int index) {

@@ -11,9 +11,11 @@
 #include "lightcuts/scene.h"
 
 #include "materials.h"
+#include "textures.h"
 
 namespace tinygltf {
 class Model;
+class Value;
 struct Material;
 }
 
@@ -53,9 +55,18 @@ private:
     gpu::Material convert(int index);
     DisneyParams params(const tinygltf::Material& g, const std::string& name);
     void add_textures(gpu::Material& m, const tinygltf::Material& g, const std::string& name);
-    // The scene texture for a material's texture reference, or
-    // kInvalidIndex where it is left out (with a note).
-    std::uint32_t texture(int texture, int tex_coord, bool transformed, const std::string& field);
+    // The scene texture for a material's texture reference (its texture,
+    // texCoord and extensions: the sampler and KHR_texture_transform
+    // decide how it is sampled), or kInvalidIndex where it is left out
+    // (with a note).
+    std::uint32_t texture(int texture, int tex_coord, const std::map<std::string, tinygltf::Value>& extensions,
+                          const std::string& field);
+    // KHR_texture_transform `ext` (at `field`) into sampling's uv_transform;
+    // its texCoord, where it has one, into tex_coord.
+    void read_transform(const tinygltf::Value& ext, const std::string& field, int& tex_coord,
+                        TextureSampling& sampling) const;
+    // The scene texture of glTF image `index` (sampled as by default),
+    // added on first use.
     std::uint32_t image(int index);
 };
 

@@ -96,6 +96,17 @@ public:
         index(*t, "texCoord", where);
         number(*t, "scale", where);
         number(*t, "strength", where);
+        object(*t, "extensions", where);
+        if (const json* ext = member(*t, "extensions")) {
+            // Read as an object (gltf_materials.cpp), so its type is checked there.
+            if (const json* transform = member(*ext, "KHR_texture_transform")) {
+                const std::string at = where + ".extensions.KHR_texture_transform";
+                numbers(*transform, "offset", 2, at);
+                numbers(*transform, "scale", 2, at);
+                number(*transform, "rotation", at);
+                index(*transform, "texCoord", at);
+            }
+        }
     }
 
     void material(const json& m, const std::string& path) const {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <exception>
 #include <istream>
+#include <limits>
 #include <map>
 #include <streambuf>
 #include <string>
@@ -250,10 +251,11 @@ private:
     // The MTL's texture maps (docs/scene-format.md): map_Kd scales the
     // albedo (base colour), map_Ke the emission (black or absent Ke counts
     // as 1 where there is a map_Ke), norm is a tangent-space normal map.
-    // Paths are relative to the OBJ's folder; each file is loaded once.
-    // What is read but not used gets a note: a map's options (-s, -o, -t,
-    // -clamp, -imfchan, -bm, -mm, -boost, -blendu, -blendv; lookups repeat
-    // and are bilinear), and the maps the renderer has no use for.
+    // Paths are relative to the OBJ's folder; each file is loaded once. A
+    // map's -s and -o scale and move its texture coordinates and -clamp on
+    // clamps them (sampled_texture); its other options (-t, -imfchan, -bm,
+    // -mm, -boost, -blendu, -blendv, -type, -texres, -colorspace) and the
+    // maps the renderer has no use for are read but not used, with a note.
     void add_textures(gpu::Material& m, const tinyobj::material_t& mtl, const std::filesystem::path& folder,
                       std::map<std::string, std::uint32_t>& loaded) {
         const std::string where = obj_name_ + ": material '" + mtl.name + "'.";
@@ -266,17 +268,28 @@ private:
             const tinyobj::texture_option_t& o = key == std::string("map_Kd")   ? mtl.diffuse_texopt
                                                  : key == std::string("norm") ? mtl.normal_texopt
                                                                               : mtl.emissive_texopt;
-            const bool plain = o.scale[0] == 1 && o.scale[1] == 1 && o.scale[2] == 1 && o.origin_offset[0] == 0 &&
-                               o.origin_offset[1] == 0 && o.origin_offset[2] == 0 && o.turbulence[0] == 0 &&
-                               o.turbulence[1] == 0 && o.turbulence[2] == 0 && !o.clamp && o.imfchan == 'm' &&
-                               o.bump_multiplier == 1 && o.brightness == 0 && o.contrast == 1 && o.sharpness == 1 &&
-                               o.blendu && o.blendv;
-            if (!plain) note(where + key + ": its options are not applied (the texture repeats, unscaled and unmoved)");
+            const std::string field = "material '" + mtl.name + "'." + key;
+            const bool plain = o.turbulence[0] == 0 && o.turbulence[1] == 0 && o.turbulence[2] == 0 &&
+                               o.imfchan == 'm' && o.bump_multiplier == 1 && o.brightness == 0 && o.contrast == 1 &&
+                               o.sharpness == 1 && o.blendu && o.blendv && o.type == tinyobj::TEXTURE_TYPE_NONE &&
+                               o.texture_resolution == -1 && o.colorspace.empty();
+            if (!plain)
+                note(where + key + ": options other than -s, -o and -clamp are not applied (" +
+                     (std::string(key) == "norm" ? "linear" : "sRGB") + ", bilinear)");
+            for (int i = 0; i < 2; ++i)
+                if (!(std::abs(o.scale[i]) <= std::numeric_limits<float>::max()) ||
+                    !(std::abs(o.origin_offset[i]) <= std::numeric_limits<float>::max()))
+                    throw InputError(obj_name_, field, "-s and -o must be finite numbers");
+            // -s and -o act on OBJ's texture coordinates, whose v grows
+            // upwards: in the renderer's (v' = 1 - v) the v offset is
+            // 1 - s_v - o_v.
+            TextureSampling sampling;
+            sampling.uv_transform = {float(o.scale[0]), 0.0f, float(o.origin_offset[0]),
+                                     0.0f, float(o.scale[1]), float(1.0 - double(o.scale[1]) - o.origin_offset[1])};
+            if (o.clamp) sampling.wrap_u = sampling.wrap_v = gpu::kTextureWrapClamp;
             const auto [at, added] = loaded.try_emplace(name, 0u);
-            if (added)
-                at->second = load_texture(target_.scene, folder / name, obj_name_,
-                                          "material '" + mtl.name + "'." + key);
-            set_texture(m, slot, at->second);
+            if (added) at->second = load_texture(target_.scene, folder / name, obj_name_, field);
+            set_texture(m, slot, sampled_texture(target_.scene, at->second, sampling));
         };
         if (!mtl.bump_texname.empty()) note(where + "map_Bump is not used (a normal map is read from norm)");
         for (const auto& [name, key] : {std::pair{&mtl.specular_texname, "map_Ks"}, {&mtl.ambient_texname, "map_Ka"},
@@ -326,10 +339,10 @@ private:
             const auto k = static_cast<std::size_t>(idx[c].texcoord_index) * 2;
             const float u = static_cast<float>(attrib_.texcoords[k]);
             const float v = static_cast<float>(attrib_.texcoords[k + 1]);
-            if (!std::isfinite(u) || !std::isfinite(v) || std::abs(u) > 1e6f || std::abs(v) > 1e6f)
+            if (!std::isfinite(u) || !std::isfinite(v))
                 throw InputError(obj_name_, face_name(f, shape),
                                  "texture coordinate " + std::to_string(idx[c].texcoord_index + 1) +
-                                     " must be finite and within 1e6");
+                                     " must be finite");
             uv[2 * c] = u;
             uv[2 * c + 1] = 1.0f - v;
         }

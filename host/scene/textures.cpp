@@ -25,12 +25,32 @@ std::uint32_t add_texture(Scene& scene, std::uint32_t width, std::uint32_t heigh
     info.offset = std::uint32_t(scene.texels.size());
     info.width = width;
     info.height = height;
+    const TextureSampling untransformed;
+    std::copy(untransformed.uv_transform.begin(), untransformed.uv_transform.end(), info.uv_transform);
     scene.texels.reserve(scene.texels.size() + count);
     for (std::uint64_t i = 0; i < count; ++i) {
         const std::uint8_t* t = rgba + 4 * i;
         scene.texels.push_back(std::uint32_t(t[0]) | std::uint32_t(t[1]) << 8 | std::uint32_t(t[2]) << 16 |
                                std::uint32_t(t[3]) << 24);
     }
+    scene.textures.push_back(info);
+    return std::uint32_t(scene.textures.size() - 1);
+}
+
+std::uint32_t sampled_texture(Scene& scene, std::uint32_t image, const TextureSampling& sampling) {
+    gpu::TextureInfo info = scene.textures.at(image);
+    info.sampling = sampling.wrap_u | sampling.wrap_v << gpu::kTextureWrapVShift |
+                   (sampling.nearest ? gpu::kTextureNearest : 0u);
+    const TextureSampling identity;
+    if (sampling.uv_transform != identity.uv_transform) info.sampling |= gpu::kTextureTransformed;
+    std::copy(sampling.uv_transform.begin(), sampling.uv_transform.end(), info.uv_transform);
+    const auto same = [&](const gpu::TextureInfo& t) {
+        return t.offset == info.offset && t.width == info.width && t.height == info.height &&
+               t.sampling == info.sampling && std::equal(t.uv_transform, t.uv_transform + 6, info.uv_transform);
+    };
+    if (same(scene.textures[image])) return image;
+    const auto found = std::find_if(scene.textures.begin(), scene.textures.end(), same);
+    if (found != scene.textures.end()) return std::uint32_t(found - scene.textures.begin());
     scene.textures.push_back(info);
     return std::uint32_t(scene.textures.size() - 1);
 }

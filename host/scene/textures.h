@@ -2,6 +2,7 @@
 // RGBA8 and appended to Scene::texels, one TextureInfo each.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -11,11 +12,28 @@
 namespace lc::loader {
 
 // Appends a width x height RGBA8 image (row 0 at the top, 4 bytes a texel)
-// and returns its index into scene.textures. Throws InputError naming
+// and returns its index into scene.textures, sampled as by default
+// (repeated, bilinear, untransformed). Throws InputError naming
 // `file` and `field` when the image is empty or the scene's texels would
 // pass kMaxTexels.
 std::uint32_t add_texture(Scene& scene, std::uint32_t width, std::uint32_t height, const std::uint8_t* rgba,
                           const std::string& file, const std::string& field);
+
+// How a material samples a texture: gpu::TextureInfo's sampling and
+// uv_transform, from a glTF sampler and KHR_texture_transform or an MTL
+// map's options.
+struct TextureSampling {
+    std::uint32_t wrap_u = gpu::kTextureWrapRepeat;
+    std::uint32_t wrap_v = gpu::kTextureWrapRepeat;
+    bool nearest = false;
+    // u' = t[0] u + t[1] v + t[2], v' = t[3] u + t[4] v + t[5].
+    std::array<float, 6> uv_transform{1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f};
+};
+
+// The texture `image` (an index add_texture or load_texture returned)
+// sampled as `sampling`: `image` itself where that is how it samples, or
+// else a record sharing its texels, made once for each sampling.
+std::uint32_t sampled_texture(Scene& scene, std::uint32_t image, const TextureSampling& sampling);
 
 // Loads a PNG or JPEG (stb_image; grey, grey-alpha and RGB get alpha 1) and
 // adds it. When it is missing or cannot be decoded, throws InputError

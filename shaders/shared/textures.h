@@ -1,4 +1,5 @@
-// Textures: bilinear lookups with wrapping, sRGB decoding, and the material
+// Textures: lookups with glTF's samplers (repeated, clamped or mirrored;
+// bilinear or nearest) and uv transforms, sRGB decoding, and the material
 // at a shaded point (its factors times its textures). Shared by the CPU
 // reference and the Vulkan kernels (see glsl_compat.h).
 //
@@ -9,7 +10,8 @@
 // No include guard: see shading.h.
 //
 // Texture coordinates follow glTF: (0, 0) is the top-left corner of the
-// image, v grows downwards, and the pattern repeats outside [0, 1).
+// image and v grows downwards; outside [0, 1] the sampler's wrapping
+// decides (the default repeats the image).
 
 // The sRGB transfer function undone (IEC 61966-2-1).
 float lc_srgb_to_linear(float c) {
@@ -27,25 +29,57 @@ vec4 lc_texel(TextureInfo t, uint x, uint y, bool srgb) {
     return c;
 }
 
-// Bilinear lookup of texture `index` at uv, wrapping in both directions.
+// Texture coordinate c (u or v) brought into one period of its wrapping,
+// where the texel coordinates it makes stay small: [0, 1] for repeat and
+// clamp, [0, 2] for mirror (the image, then its mirror image; a period's
+// end may round up to it, which wraps to the same texels as its start). A
+// coordinate that is not finite (an overflowing transform) reads as 0.
+float lc_wrap_coordinate(float c, uint wrap) {
+    if (wrap == kTextureWrapClamp) return c >= 0.0f ? min(c, 1.0f) : 0.0f;
+    float period = wrap == kTextureWrapMirror ? 2.0f : 1.0f;
+    float w = c - period * floor(c / period);
+    return w >= 0.0f && w <= period ? w : 0.0f;
+}
+
+// Texel column (or row) i of n, from -1 to one period (n, or 2n mirrored)
+// as lc_wrap_coordinate leaves it, mapped into [0, n) by the wrapping. (GLSL
+// leaves % of negative numbers undefined: every operand here is >= 0.)
+uint lc_wrap_texel(int i, uint n, uint wrap) {
+    if (wrap == kTextureWrapClamp) return uint(clamp(i, 0, int(n) - 1));
+    if (wrap == kTextureWrapMirror) {
+        uint m = uint(i + 2 * int(n)) % (2u * n);
+        return m < n ? m : 2u * n - 1u - m;
+    }
+    return uint(i + int(n)) % n;
+}
+
+// Texture `index` at uv: transformed where the texture says so, wrapped as
+// its sampler says, and the nearest texel or a bilinear blend of four.
 // Texel centres sit at (i + 0.5) / width; colour textures are decoded
 // before they are filtered, so the filter blends linear values.
 vec4 lc_texture_sample(uint index, vec2 uv, bool srgb) {
     TextureInfo t = LC_TEXTURE(index);
+    if ((t.sampling & kTextureTransformed) != 0u)
+        uv = vec2(t.uv_transform[0] * uv.x + t.uv_transform[1] * uv.y + t.uv_transform[2],
+                  t.uv_transform[3] * uv.x + t.uv_transform[4] * uv.y + t.uv_transform[5]);
+    uint wrap_u = t.sampling & 3u;
+    uint wrap_v = (t.sampling >> kTextureWrapVShift) & 3u;
     // Wrap first, so the integer texel coordinates below stay small.
-    float u = uv.x - floor(uv.x);
-    float v = uv.y - floor(uv.y);
+    float u = lc_wrap_coordinate(uv.x, wrap_u);
+    float v = lc_wrap_coordinate(uv.y, wrap_v);
+    if ((t.sampling & kTextureNearest) != 0u)
+        return lc_texel(t, lc_wrap_texel(int(floor(u * float(t.width))), t.width, wrap_u),
+                        lc_wrap_texel(int(floor(v * float(t.height))), t.height, wrap_v), srgb);
     float x = u * float(t.width) - 0.5f;
     float y = v * float(t.height) - 0.5f;
     float fx = floor(x);
     float fy = floor(y);
     float ax = x - fx;
     float ay = y - fy;
-    // fx is in [-1, width - 1] (u may round up to 1.0): wrap both columns.
-    uint x0 = uint(int(fx) + int(t.width)) % t.width;
-    uint y0 = uint(int(fy) + int(t.height)) % t.height;
-    uint x1 = (x0 + 1u) % t.width;
-    uint y1 = (y0 + 1u) % t.height;
+    uint x0 = lc_wrap_texel(int(fx), t.width, wrap_u);
+    uint y0 = lc_wrap_texel(int(fy), t.height, wrap_v);
+    uint x1 = lc_wrap_texel(int(fx) + 1, t.width, wrap_u);
+    uint y1 = lc_wrap_texel(int(fy) + 1, t.height, wrap_v);
     vec4 top = mix(lc_texel(t, x0, y0, srgb), lc_texel(t, x1, y0, srgb), ax);
     vec4 bottom = mix(lc_texel(t, x0, y1, srgb), lc_texel(t, x1, y1, srgb), ax);
     return mix(top, bottom, ay);

@@ -156,14 +156,30 @@ struct Material {
     uint normal_texture;
 };
 
-// One texture (16 bytes): width x height texels, row 0 at the top (v = 0),
-// RGBA8 packed one per uint (R in the low byte) from texel `offset` of the
-// texel buffer. Sampled bilinearly with wrapping (shared/textures.h).
+// One texture as a material samples it (40 bytes): an image of width x
+// height texels, row 0 at the top (v = 0), RGBA8 packed one per uint (R in
+// the low byte) from texel `offset` of the texel buffer, and how it is
+// sampled (`sampling`, below; shared/textures.h). Textures that sample one
+// image in different ways share its texels.
+//
+// sampling: bits 0-1 the wrapping along u, bits 2-3 along v (kTextureWrap*),
+// kTextureNearest for the nearest texel instead of a bilinear blend, and
+// kTextureTransformed where the texture coordinates are first transformed
+// (glTF's KHR_texture_transform, MTL's -o and -s):
+//   u' = uv_transform[0] u + uv_transform[1] v + uv_transform[2]
+//   v' = uv_transform[3] u + uv_transform[4] v + uv_transform[5]
 struct TextureInfo {
     uint offset;
     uint width, height;
-    uint pad0;
+    uint sampling;
+    float uv_transform[6];
 };
+LC_CONST uint kTextureWrapRepeat = 0u;     // the image repeats (glTF's REPEAT, the default)
+LC_CONST uint kTextureWrapClamp = 1u;      // the edge texels continue (CLAMP_TO_EDGE)
+LC_CONST uint kTextureWrapMirror = 2u;     // every other repeat mirrored (MIRRORED_REPEAT)
+LC_CONST uint kTextureWrapVShift = 2u;     // the v wrapping's bits: (sampling >> kTextureWrapVShift) & 3
+LC_CONST uint kTextureNearest = 16u;
+LC_CONST uint kTextureTransformed = 32u;
 
 // One light (48 bytes).
 //   point:        position, radiant intensity (W/sr)

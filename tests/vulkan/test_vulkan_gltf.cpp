@@ -1,6 +1,9 @@
 // glTF scenes on the Vulkan path: the shipped room as glTF renders like the
 // room as JSON + OBJ on the device too, and the textured glTF scene
 // (textures, Disney materials, point and spot lights) matches the CPU.
+#include <algorithm>
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "gltf_room.h"
@@ -43,6 +46,26 @@ TEST_F(Vulkan, TexturedGltfSceneMatchesTheCpu) {
     s.render.area_light_samples = 1024;  // the glowing box; brute force sums every sample
     const PreparedScene p = prepare_scene(std::move(s), 1);
     ASSERT_EQ(p.scene.textures.size(), 4u);
+    const RenderOptions o = options("brute", 32, 24);
+    expect_brute_matches(p, o, gpu(p, o), kTexturedRelative);
+}
+
+// The same with the textures sampled every other way: clamped, mirrored,
+// nearest and through a rotating, scaling uv transform (glTF samplers and
+// KHR_texture_transform; shaders/shared/textures.h).
+TEST_F(Vulkan, TexturedGltfSceneWithOtherSamplersMatchesTheCpu) {
+    Scene s = load_scene(LC_SOURCE_DIR "/scenes/gltf/textured.gltf");
+    s.render.area_light_samples = 1024;
+    ASSERT_EQ(s.textures.size(), 4u);
+    const float c = std::cos(0.3f), sn = std::sin(0.3f);
+    s.textures[0].sampling = gpu::kTextureWrapMirror | gpu::kTextureWrapClamp << gpu::kTextureWrapVShift |
+                             gpu::kTextureTransformed;
+    const float transform[6] = {1.5f * c, 0.7f * sn, 0.2f, -1.5f * sn, 0.7f * c, -0.1f};
+    std::copy(transform, transform + 6, s.textures[0].uv_transform);
+    s.textures[1].sampling = gpu::kTextureNearest | gpu::kTextureWrapClamp |
+                             gpu::kTextureWrapMirror << gpu::kTextureWrapVShift;
+    s.textures[2].sampling = gpu::kTextureNearest;
+    const PreparedScene p = prepare_scene(std::move(s), 1);
     const RenderOptions o = options("brute", 32, 24);
     expect_brute_matches(p, o, gpu(p, o), kTexturedRelative);
 }

@@ -195,7 +195,7 @@ def materials_doc():
     colours = [[(255, 0, 0, 255), (0, 255, 0, 255)], [(0, 0, 255, 255), (255, 255, 255, 255)]]
     images = [{"uri": png_uri(2, 2, lambda x, y: colours[y][x])},
               {"uri": png_uri(1, 1, lambda x, y: (128, 128, 255, 255))}]
-    textures = [{"source": 0}, {"source": 0, "sampler": 0}, {"source": 1}]
+    textures = [{"source": 0}, {"source": 0, "sampler": 0}, {"source": 1}, {"source": 1, "sampler": 1}]
     materials = [
         # 0: factors, clearcoat, sheen, emission with strength, two-sided, textures.
         {"name": "everything",
@@ -207,11 +207,15 @@ def materials_doc():
          "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 8.0},
                         "KHR_materials_clearcoat": {"clearcoatFactor": 0.6, "clearcoatRoughnessFactor": 0.2},
                         "KHR_materials_sheen": {"sheenColorFactor": [0.5, 0.25, 0.125]}}},
-        # 1: what is noted and left out: TEXCOORD_1, a texture transform, BLEND, occlusion.
+        # 1: what is noted and left out: TEXCOORD_1, BLEND, occlusion, a
+        # minFilter the magFilter overrides; the texture transform of the
+        # extension's example (the image's lower-left quarter, turned).
         {"name": "noted",
          "pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1},
                                   "metallicRoughnessTexture": {
-                                      "index": 1, "extensions": {"KHR_texture_transform": {"scale": [2, 2]}}}},
+                                      "index": 1, "extensions": {"KHR_texture_transform": {
+                                          "offset": [0, 1], "rotation": 1.57079632679, "scale": [0.5, 0.5]}}}},
+         "normalTexture": {"index": 3},
          "alphaMode": "BLEND", "occlusionTexture": {"index": 0},
          "extensions": {"KHR_materials_sheen": {"sheenColorFactor": [0.5, 0.5, 0.5]}}},
     ]
@@ -219,7 +223,9 @@ def materials_doc():
                               {"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 1},
                               {"attributes": {"POSITION": 0}}]}]
     return gltf(b, acc, meshes, [{"mesh": 0}], images=images, textures=textures,
-                samplers=[{"wrapS": 33071, "wrapT": 10497, "magFilter": 9728}], materials=materials,
+                samplers=[{"wrapS": 33071, "wrapT": 10497, "magFilter": 9728, "minFilter": 9728},
+                          {"wrapS": 33648, "wrapT": 33648, "magFilter": 9729, "minFilter": 9984}],
+                materials=materials,
                 extensionsUsed=["KHR_materials_emissive_strength", "KHR_materials_clearcoat",
                                 "KHR_materials_sheen", "KHR_texture_transform"])
 
@@ -331,6 +337,26 @@ def bad_cases():
     variant("bad_material_index", lambda d: d["meshes"][0]["primitives"][0].update(material=3))
     variant("bad_base_color", lambda d: (d.update(materials=[{"pbrMetallicRoughness": {
         "baseColorFactor": [1.5, 0, 0, 1]}}]), d["meshes"][0]["primitives"][0].update(material=0)))
+    variant("bad_base_alpha", lambda d: (d.update(materials=[{"pbrMetallicRoughness": {
+        "baseColorFactor": [1, 1, 1, 7]}}]), d["meshes"][0]["primitives"][0].update(material=0)))
+
+    def textured(d, texture_info, sampler=None):
+        """The triangle with a base-colour texture of one white texel."""
+        d["images"] = [{"uri": png_uri(1, 1, lambda x, y: (255, 255, 255, 255))}]
+        d["textures"] = [{"source": 0}]
+        if sampler is not None:
+            d["samplers"] = [sampler]
+            d["textures"][0]["sampler"] = 0
+        d["materials"] = [{"pbrMetallicRoughness": {"baseColorTexture": dict(index=0, **texture_info)}}]
+        d["meshes"][0]["primitives"][0]["material"] = 0
+
+    variant("bad_wrap", lambda d: textured(d, {}, {"wrapS": 12345}))
+    variant("bad_mag_filter", lambda d: textured(d, {}, {"magFilter": 1}))
+    variant("bad_min_filter", lambda d: textured(d, {}, {"minFilter": 9990}))
+    variant("bad_transform_offset", lambda d: textured(d, {"extensions": {"KHR_texture_transform": {
+        "offset": ["0", 0]}}}))
+    variant("bad_transform_scale", lambda d: textured(d, {"extensions": {"KHR_texture_transform": {
+        "scale": [1e39, 1]}}}))
     variant("bad_spot_cone", lambda d: d["extensions"]["KHR_lights_punctual"]["lights"][0].update(
         type="spot", spot={"innerConeAngle": 0.5, "outerConeAngle": 2.0}))
     variant("bad_position_type", lambda d: d["accessors"][0].update(componentType=USHORT))
