@@ -304,6 +304,77 @@ TEST(PathBsdf, SampledEstimateMatchesQuadrature) {
         }
 }
 
+// At the roughness floor (alpha 1e-3) the half vectors sample_bsdf draws
+// follow GGX's distribution, P(theta_h < x) = x^2 / (alpha^2 + x^2) for
+// small x: 5.9% within alpha / 4 of the normal, 50% within alpha. (With
+// sin(theta_h) made as sqrt(1 - cos^2), cos rounding in steps of 1e-7
+// left a few angles only: 15% within alpha / 4, most of them exactly on
+// the normal.)
+TEST(PathBsdf, SharpLobesDrawTheirHalfVectorsSmoothly) {
+    const float alpha = 1e-3f;
+    const gpu::Material m = test::glossy(glm::vec3(0.0f), glm::vec3(0.9f), alpha);
+    const glm::vec3 n(0.0f, 0.0f, 1.0f), wo(std::sin(0.35f), 0.0f, std::cos(0.35f));
+    const path::LobeWeights lobes = path::lobe_weights(m, n, wo);
+    Kernel k{};
+    constexpr std::uint32_t kSamples = 100000;
+    std::uint32_t quarter = 0, within = 0, drawn = 0;
+    for (std::uint32_t s = 0; s < kSamples; ++s) {
+        const std::uint32_t h = gpu::lc_hash(s * 3u + 1u);
+        const path::BsdfSample b = path::sample_bsdf(k, m, lobes, n, wo, 0.5f, gpu::lc_unit_float(h),
+                                                     gpu::lc_unit_float(gpu::lc_hash(h)));
+        if (!(b.pdf > 0.0f)) continue;
+        ++drawn;
+        const float sin2 = k.lc_half_angle(n, glm::normalize(b.wi + wo)).y;
+        quarter += sin2 < 0.0625f * alpha * alpha;
+        within += sin2 < alpha * alpha;
+    }
+    ASSERT_GT(drawn, kSamples * 99 / 100);
+    std::printf("[ measured ] half vectors within alpha/4 of n: %.4f (expected 0.0588), within alpha: %.4f (0.5)\n",
+                double(quarter) / drawn, double(within) / drawn);
+    EXPECT_NEAR(double(quarter) / drawn, 0.0625 / 1.0625, 0.006);
+    EXPECT_NEAR(double(within) / drawn, 0.5, 0.01);
+}
+
+// A grazing view of a sharp Disney surface: the mirror direction is nearly
+// -wo, where normalize(wi + wo) can face away from wo in float. The BRDF
+// and the sampling density agree that no microfacet reflects there, so no
+// sample weighs more than the lobes' peak allows (before, weights up to
+// 1e12 and a mean of 1e8 for a white dielectric whose albedo is about 1.4).
+TEST(PathBsdf, GrazingViewsOfSharpLobesKeepTheirWeights) {
+    loader::DisneyParams plastic;
+    plastic.base_color = glm::vec3(1.0f);
+    plastic.roughness = 0.0f;
+    plastic.clearcoat = 1.0f;
+    plastic.clearcoat_gloss = 1.0f;
+    const gpu::Material materials[] = {loader::make_disney_material(plastic),
+                                       test::glossy(glm::vec3(0.5f), glm::vec3(0.04f), 1e-3f)};
+    Kernel k{};
+    const glm::vec3 n = glm::normalize(glm::vec3(0.3f, -0.5f, 0.8f));
+    glm::vec3 t, b;
+    k.lc_basis(n, t, b);
+    for (const gpu::Material& m : materials)
+        for (const float cos_o : {1e-4f, 1e-5f, 1e-6f}) {
+            const float sin_o = std::sqrt(1.0f - cos_o * cos_o);
+            const glm::vec3 wo = glm::normalize(0.6f * sin_o * t + 0.8f * sin_o * b + cos_o * n);
+            const path::LobeWeights lobes = path::lobe_weights(m, n, wo);
+            double sum = 0.0, largest = 0.0;
+            constexpr std::uint32_t kSamples = 200000;
+            for (std::uint32_t s = 0; s < kSamples; ++s) {
+                const std::uint32_t h = gpu::lc_hash(s ^ 0x5eedu);
+                const path::BsdfSample bs = path::sample_bsdf(k, m, lobes, n, wo, gpu::lc_unit_float(h),
+                                                              gpu::lc_unit_float(gpu::lc_hash(h)),
+                                                              gpu::lc_unit_float(gpu::lc_hash(h + 1u)));
+                const double w = luminance(bs.weight);
+                sum += w;
+                largest = std::max(largest, w);
+            }
+            std::printf("[ measured ] alpha %g, cos_o %g: mean weight %.4f, largest %.1f\n", double(m.alpha),
+                        double(cos_o), sum / kSamples, largest);
+            EXPECT_LT(sum / kSamples, 2.0) << "cos_o " << cos_o;
+            EXPECT_LT(largest, 1e4) << "cos_o " << cos_o;
+        }
+}
+
 // ---- Whole renders ----
 
 // The furnace: inside a closed box of Lambert albedo rho that emits Le on

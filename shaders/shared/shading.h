@@ -305,6 +305,17 @@ float lc_microfacet_cos(float d, float cos_i, float cos_o, float alpha_g) {
     return d * lc_smith_g1(cos_i, alpha_g) * lc_smith_g1(cos_o, alpha_g) / (4.0f * cos_o);
 }
 
+// The microfacet lobes reflect wo into wi only where h = normalize(wi +
+// wo) faces wo. Mathematically it always does (wo.(wi + wo) = 1 + wo.wi);
+// in float, where wi is nearly -wo (a grazing view's mirror direction) h
+// is the normalised sum of two nearly opposite vectors and can come out
+// facing away. The path tracer's sampling density leaves the lobes out
+// there, so these BRDFs must too: with them in, such samples weighed up to
+// 1e12 (a white Disney floor at roughness 0 seen at cos_o 1e-5 came out a
+// thousand times too bright; an audit). Walter et al. 2007's positivity
+// factor on the microfacet terms.
+bool lc_facets_reflect(vec3 wo, vec3 h) { return dot(wo, h) > 0.0f; }
+
 vec3 lc_disney_brdf_cos(LC_IN(Material) m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
     float cos_o = dot(n, wo);
     if (!(cos_o > 0.0f)) return vec3(0.0f);
@@ -313,10 +324,12 @@ vec3 lc_disney_brdf_cos(LC_IN(Material) m, vec3 n, vec3 wi, vec3 wo, float cos_i
     float cos_d = clamp(dot(wi, h), 0.0f, 1.0f);
     float w = lc_schlick_weight(cos_d);
     vec3 value = lc_disney_diffuse(m, 0.5f + 2.0f * m.roughness * cos_d * cos_d, cos_i, cos_o);
-    value += mix(lc_disney_spec0(m), vec3(1.0f), w) *
-             lc_microfacet_cos(lc_ggx_d(half_angle.x, half_angle.y, m.alpha), cos_i, cos_o, m.alpha);
+    bool facets = lc_facets_reflect(wo, h);
+    if (facets)
+        value += mix(lc_disney_spec0(m), vec3(1.0f), w) *
+                 lc_microfacet_cos(lc_ggx_d(half_angle.x, half_angle.y, m.alpha), cos_i, cos_o, m.alpha);
     if (kEnableSheen && (m.flags & kMaterialHasSheen) != 0u) value += lc_disney_sheen_color(m) * (w * cos_i);
-    if (kEnableClearcoat && (m.flags & kMaterialHasClearcoat) != 0u) {
+    if (facets && kEnableClearcoat && (m.flags & kMaterialHasClearcoat) != 0u) {
         float coat = lc_microfacet_cos(lc_gtr1_d(half_angle.x, half_angle.y, lc_clearcoat_alpha(m)), cos_i, cos_o,
                                        kClearcoatSmithAlpha);
         value += vec3(0.25f * m.clearcoat * mix(0.04f, 1.0f, w) * coat);
@@ -330,8 +343,9 @@ vec3 lc_brdf_cos(LC_IN(Material) m, vec3 n, vec3 wi, vec3 wo, float cos_i) {
     vec3 value = lc_kd(m) * (cos_i / kPi);
     if (kEnableGgx && (m.flags & kMaterialHasSpecular) != 0u) {
         float cos_o = dot(n, wo);
-        if (cos_o > 0.0f) {
-            vec2 half_angle = lc_half_angle(n, normalize(wi + wo));
+        vec3 h = normalize(wi + wo);
+        if (cos_o > 0.0f && lc_facets_reflect(wo, h)) {
+            vec2 half_angle = lc_half_angle(n, h);
             float spec = lc_ggx_d(half_angle.x, half_angle.y, m.alpha) * lc_smith_g1(cos_i, m.alpha) *
                          lc_smith_g1(cos_o, m.alpha) / (4.0f * cos_o);
             value += lc_ks(m) * spec;
