@@ -5,7 +5,9 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdlib>
 #include <cstring>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -33,6 +35,12 @@ using namespace lc::gpu;
 // branches follow the box's side of the point and were mispredicted.
 // Found before glm's by unqualified lookup in the kernel structs below (and
 // preferred to its template for vectors).
+// Whether the environment variable `name` is "1" (the benchmarks' switches).
+inline bool environment_flag(const char* name) {
+    const char* value = std::getenv(name);
+    return value != nullptr && std::string_view(value) == "1";
+}
+
 inline float abs(float x) { return std::fabs(x); }
 inline vec2 abs(vec2 v) { return vec2(std::fabs(v.x), std::fabs(v.y)); }
 inline vec3 abs(vec3 v) { return vec3(std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)); }
@@ -213,15 +221,17 @@ struct BasicShadeKernel {
     static constexpr bool kEnableClearcoat = true;
     // Benchmarks only: replace the Disney BRDF's non-diffuse lobe bounds by
     // the seed report's constant 1 (lc_disney_bound), to measure the cut
-    // size the lobe bounds save. Not conservative; the renderer reads it
-    // once per render from LC_CPU_SEED_LOBE_BOUND (cpu_renderer.cpp).
-    static inline bool seed_lobe_bound = false;
+    // size the lobe bounds save (docs/results/disney.md). Not conservative;
+    // LC_CPU_SEED_LOBE_BOUND=1, read once when the program starts, so that
+    // renders on several threads never write it (a data race, ThreadSanitizer
+    // found, while it was set by every render).
+    static inline const bool seed_lobe_bound = environment_flag("LC_CPU_SEED_LOBE_BOUND");
     // Benchmarks only: bound a refinement's children by the tightest bound
     // of Walter's form instead (tightest_error below), to measure how much
-    // smaller the cuts could get with better bounds. It visits every light
-    // of the cluster, so it is far too slow to render with; the renderer
-    // reads it once per render from LC_CPU_TIGHTEST_BOUND.
-    static inline bool tightest_bound = false;
+    // smaller the cuts could get with better bounds (docs/results/speed.md).
+    // It visits every light of the cluster, so it is far too slow to render
+    // with; LC_CPU_TIGHTEST_BOUND=1, read as the one above.
+    static inline const bool tightest_bound = environment_flag("LC_CPU_TIGHTEST_BOUND");
 
 #define LC_BVH_NODE(i) bvh_nodes[i]
 #define LC_TRIANGLE(i) triangles[i]

@@ -185,19 +185,10 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
     const Method method = method_of(options.method);
     const bool lightcuts = method_selects_cuts(options.method);
     const gpu::FrameParams frame = make_frame_params(prepared, options);
-    // Benchmarks only (docs/results/disney.md): the seed report's constant
-    // bound for the Disney BRDF's non-diffuse lobes.
-    const char* seed_bound = std::getenv("LC_CPU_SEED_LOBE_BOUND");
-    cpu::ShadeKernel::seed_lobe_bound = seed_bound != nullptr && std::string(seed_bound) == "1";
-    // Benchmarks only (docs/results/speed.md): the tightest bound of
-    // Walter's form for every refinement's children.
-    const char* tightest = std::getenv("LC_CPU_TIGHTEST_BOUND");
-    cpu::ShadeKernel::tightest_bound = tightest != nullptr && std::string(tightest) == "1";
     // Benchmarks only (bench/speed.py): the camera rays alone, each pixel's
     // first hit and what it sees there (emission, the environment), no light
     // shaded; the per-ray cost the issue asks for leaves their time out.
-    const char* camera_only_env = std::getenv("LC_CPU_CAMERA_RAYS_ONLY");
-    const bool camera_only = camera_only_env != nullptr && std::string(camera_only_env) == "1";
+    const bool camera_only = cpu::environment_flag("LC_CPU_CAMERA_RAYS_ONLY");
     auto start = std::chrono::steady_clock::now();
 
     RenderResult result;
