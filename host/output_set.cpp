@@ -45,17 +45,21 @@ void create_empty(const fs::path& file, const std::string& label) {
     ::close(fd);
 }
 
-// Moves a file already at `file` aside, then `temporary` onto `file`.
-// Returns the problem, or "" on success.
-std::string place(const fs::path& temporary, const fs::path& file, Placement& step) {
+// Moves a file already at `file` aside, then `temporary` onto `file`, each
+// step in the journal before it is taken. Returns the problem, or "" on
+// success.
+std::string place(const fs::path& temporary, const fs::path& file, Placement& step, ReplacementJournal& journal) {
     std::error_code ec;
     const fs::file_status status = fs::symlink_status(file, ec);
     // A folder is never moved aside: the rename below must fail on it.
     if (fs::exists(status) && !fs::is_directory(status)) {
         const fs::path backup = temporary_path_for(file);
+        journal.begin(file, backup);
         fs::rename(file, backup, ec);
         if (ec) return "cannot move the existing file aside: " + ec.message();
         step.backup = backup;
+    } else {
+        journal.begin(file, {});
     }
     fs::rename(temporary, file, ec);
     if (ec) return "cannot rename the temporary file into place: " + ec.message();
@@ -150,12 +154,17 @@ void OutputSet::commit() {
     std::vector<fs::path> files;
     for (const Output& out : outputs_) files.push_back(out.name.file);
     std::vector<Placement> steps(outputs_.size());
+    // A signal while the files are being placed puts back what was there
+    // (and leaves no backup), as a failure below does; one after they all
+    // are keeps them.
+    ReplacementJournal journal;
     for (std::size_t i = 0; i < outputs_.size(); ++i) {
-        const std::string problem = place(outputs_[i].temporary, files[i], steps[i]);
+        const std::string problem = place(outputs_[i].temporary, files[i], steps[i], journal);
         if (problem.empty()) continue;
         roll_back(files, steps, i + 1);
         throw std::runtime_error(files[i].string() + ": " + problem);
     }
+    journal.finish();
     committed_ = true;
     for (const Output& out : outputs_) untrack_temporary(out.tracked);
     for (const Placement& step : steps) {

@@ -3,6 +3,7 @@
 // files the outputs would have replaced are as they were.
 #include <algorithm>
 #include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "lightcuts/image.h"
 #include "lightcuts/output_set.h"
 #include "test_util.h"
 
@@ -127,6 +129,76 @@ TEST_F(OutputSetTest, SignalLeavesNoTemporaries) {
     EXPECT_EXIT(render_then_signal(false, SIGPIPE), ::testing::KilledBySignal(SIGPIPE), "");
     EXPECT_EQ(entries().size(), 3u) << "without the handler the two temporaries stay";
     GTEST_FLAG_SET(death_test_style, style);
+}
+
+// A signal during a commit (ReplacementJournal, as OutputSet::commit uses
+// it): the commit of a.txt, which replaces an old file, and b.txt, which is
+// new, stopped by SIGTERM after each of its steps in turn. Before finish()
+// every file is as it was; after it, both are new; never is a backup or a
+// temporary left. (Before the journal, a signal between moving a.txt aside
+// and renaming its temporary onto it left no a.txt, and the old one under
+// a hidden name.)
+TEST_F(OutputSetTest, SignalDuringACommitPutsBackOrKeepsEveryFile) {
+    const std::string style = GTEST_FLAG_GET(death_test_style);
+    GTEST_FLAG_SET(death_test_style, "fast");
+    write(at("a.txt"), "old");
+    constexpr int kSteps = 6;
+    auto commit_until = [&](int stop) {
+        remove_temporaries_on_signal();
+        int step = 0;
+        const auto next = [&] {
+            if (++step == stop) std::raise(SIGTERM);
+        };
+        const fs::path temporary_a = temporary_path_for(at("a.txt")), temporary_b = temporary_path_for(at("b.txt"));
+        const int tracked_a = track_temporary(temporary_a), tracked_b = track_temporary(temporary_b);
+        write(temporary_a, "new A");
+        write(temporary_b, "new B");
+        const fs::path backup = temporary_path_for(at("a.txt"));
+        ReplacementJournal journal;
+        if (!journal.active()) std::abort();
+        journal.begin(at("a.txt"), backup);
+        next();  // 1
+        fs::rename(at("a.txt"), backup);
+        next();  // 2
+        fs::rename(temporary_a, at("a.txt"));
+        next();  // 3
+        journal.begin(at("b.txt"), {});
+        fs::rename(temporary_b, at("b.txt"));
+        next();  // 4
+        journal.finish();
+        next();  // 5
+        untrack_temporary(tracked_a);
+        untrack_temporary(tracked_b);
+        fs::remove(backup);
+        next();  // 6
+        std::exit(3);
+    };
+    for (int stop = 1; stop <= kSteps; ++stop) {
+        SCOPED_TRACE("signal after step " + std::to_string(stop));
+        EXPECT_EXIT(commit_until(stop), ::testing::KilledBySignal(SIGTERM), "");
+        if (stop <= 4) {
+            EXPECT_EQ(entries(), (std::set<std::string>{"a.txt"}));
+            EXPECT_EQ(read(at("a.txt")), "old");
+        } else {
+            EXPECT_EQ(entries(), (std::set<std::string>{"a.txt", "b.txt"}));
+            EXPECT_EQ(read(at("a.txt")), "new A");
+            EXPECT_EQ(read(at("b.txt")), "new B");
+            fs::remove(at("b.txt"));
+            write(at("a.txt"), "old");
+        }
+    }
+    GTEST_FLAG_SET(death_test_style, style);
+}
+
+// One journal at a time: a second, while the first lives, records nothing.
+TEST(ReplacementJournal, OneAtATime) {
+    ReplacementJournal first;
+    EXPECT_TRUE(first.active());
+    {
+        ReplacementJournal second;
+        EXPECT_FALSE(second.active());
+    }
+    EXPECT_TRUE(first.active());
 }
 
 // The table of tracked temporaries is bounded; a full table refuses (-1),

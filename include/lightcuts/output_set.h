@@ -49,7 +49,9 @@ public:
     // Renames every temporary onto its file. When one cannot be (its path is
     // now a folder, say), the outputs already renamed are removed, the files
     // they replaced are put back, every temporary is removed and
-    // std::runtime_error names the file. Call at most once.
+    // std::runtime_error names the file; so too, without the error, when a
+    // signal ends the program before every file is in place
+    // (ReplacementJournal). Call at most once.
     void commit();
 
 private:

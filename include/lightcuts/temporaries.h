@@ -26,4 +26,31 @@ int track_temporary(const std::filesystem::path& file) noexcept;
 // or renamed, so a signal between the two finds nothing left behind.
 void untrack_temporary(int handle) noexcept;
 
+// The steps of a commit that replaces several files one rename at a time
+// (OutputSet::commit), for remove_temporaries_on_signal: a signal before
+// finish() puts every file begun back as it was (the file it replaced,
+// moved aside to its backup, renamed back onto it; a file that was not
+// there removed), and one after finish() keeps the new files and removes
+// the backups. Each step holds whatever a signal interrupts: before, during
+// or after its renames. One journal at a time per process: a second one,
+// while the first lives, records nothing (active() is false). At most 64
+// steps are recorded; more are not undone by a signal.
+class ReplacementJournal {
+public:
+    ReplacementJournal() noexcept;
+    ~ReplacementJournal();
+    ReplacementJournal(const ReplacementJournal&) = delete;
+    ReplacementJournal& operator=(const ReplacementJournal&) = delete;
+
+    bool active() const noexcept { return active_; }
+    // Before anything is renamed for `file`: `backup` is where the file it
+    // replaces will be moved, or empty where there is none to keep.
+    void begin(const std::filesystem::path& file, const std::filesystem::path& backup) noexcept;
+    // Every file is in place: a signal from now on keeps them.
+    void finish() noexcept;
+
+private:
+    bool active_ = false;
+};
+
 }  // namespace lc
