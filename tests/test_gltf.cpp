@@ -285,7 +285,8 @@ TEST(Gltf, UnsupportedPartsAreSkippedWithOneNoteEach) {
     const Scene s = load("unsupported.gltf");
     EXPECT_EQ(s.triangles.size(), 1u);
     for (const char* note : {"animations: 1 animation(s) ignored", "targets: morph targets are not supported",
-                             "COLOR_0: vertex colours are not read", "EXT_unknown_feature is not supported"})
+                             "COLOR_0: vertex colours are not read", "EXT_unknown_feature is not supported",
+                             "primitives[0].attributes.TEXCOORD_0: missing, but the material has textures"})
         EXPECT_TRUE(has_note(s, note)) << note;
 }
 
@@ -436,6 +437,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_base_alpha.gltf", "materials[0].pbrMetallicRoughness.baseColorFactor[3]: must be from 0 to 1"},
         BadCase{"bad_wrap.gltf", "samplers[0].wrapS: must be 10497 (REPEAT), 33071 (CLAMP_TO_EDGE) or 33648 "
                                  "(MIRRORED_REPEAT), not 12345"},
+        BadCase{"bad_image_missing.gltf", "images[1].uri: 'missing.png' not found next to the glTF"},
+        BadCase{"bad_image_corrupt.gltf",
+                "tinygltf: images[0] ('corrupt.png') cannot be decoded as PNG or JPEG (bad zlib header)"},
         BadCase{"bad_mag_filter.gltf", "samplers[0].magFilter: must be 9728 (NEAREST) or 9729 (LINEAR), not 1"},
         BadCase{"bad_min_filter.gltf", "samplers[0].minFilter: must be 9728 (NEAREST), 9729 (LINEAR) or 9984 to 9987"},
         BadCase{"bad_transform_offset.gltf", "materials[0].pbrMetallicRoughness.baseColorTexture.extensions."

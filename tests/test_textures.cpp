@@ -334,6 +334,42 @@ TEST(ObjTextures, UnusedMapsAndOptionsAreNoted) {
     EXPECT_TRUE(load_scene(dir.path() / "scene.json").load_notes.empty());
 }
 
+// Faces without vt whose material has textures read them at (0, 0): a
+// note says so, once per material.
+TEST(ObjTextures, TexturedFacesWithoutTextureCoordinatesAreNoted) {
+    TempDir dir;
+    write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
+    dir.write("quad.obj", "mtllib quad.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nusemtl paint\n"
+                          "f 1 4 3\nf 1 3 2\n");
+    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd paint.png\n");
+    const Scene s = load_scene(dir.write("scene.json", quad_scene_json()));
+    const auto noted = std::count_if(s.load_notes.begin(), s.load_notes.end(), [](const std::string& note) {
+        return note.find("has no texture coordinates (vt) at some corner, but its material has textures") !=
+               std::string::npos;
+    });
+    EXPECT_EQ(noted, 1) << "one note for the material's two faces";
+    dir.write("quad.obj", kTexturedObj);
+    EXPECT_TRUE(load_scene(dir.path() / "scene.json").load_notes.empty());
+}
+
+// An MTL map_Kd without a Kd is the base colour itself, whatever came
+// before it in the file (tinyobjloader gives it 0.6 where no Kd came
+// before, and its default, black, where one did).
+TEST(ObjTextures, MapKdWithoutKdIsTheTextureItself) {
+    TempDir dir;
+    write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
+    dir.write("quad.obj", kTexturedObj);
+    for (const char* mtl : {"newmtl paint\nmap_Kd paint.png\n",
+                            "newmtl other\nKd 0.5 0.5 0.5\nnewmtl paint\nmap_Kd paint.png\n",
+                            "newmtl paint\nmap_Kd paint.png\nKd 0.25 0.25 0.25\n"}) {
+        dir.write("quad.mtl", mtl);
+        const Scene s = load_scene(dir.write("scene.json", quad_scene_json()));
+        const gpu::Material& m = s.materials[s.triangles[0].material];
+        const float expected = std::string(mtl).find("Kd 0.25") != std::string::npos ? 0.25f : 1.0f;
+        EXPECT_EQ(glm::vec3(m.kd_r, m.kd_g, m.kd_b), glm::vec3(expected)) << mtl;
+    }
+}
+
 // -s and -o scale and move an MTL map's texture coordinates, which OBJ
 // counts from the bottom (v up): u' = s_u u + o_u, v' = s_v v + o_v there;
 // -clamp on clamps both. The file is loaded once for both uses.

@@ -92,11 +92,22 @@ fs::path uri_file(const std::string& base, const std::string& uri) {
 // seek to its end: a folder's "size" makes it ask for about 2^63 bytes
 // (std::bad_alloc), and a device or a pipe may never end. So every URI that
 // tinygltf would open must name a regular file, checked in the file's JSON
-// before tinygltf reads it. A missing file is left to tinygltf's
-// "File not found"; JSON that does not parse, to tinygltf's message.
-void check_uri_files(std::string_view json, const std::string& base, const std::string& name) {
+// before tinygltf reads it. A missing buffer is left to tinygltf's "File
+// not found"; a missing image is refused here, used or not (tinygltf would
+// only warn, and a texture of it fail without naming the file). JSON that
+// does not parse is left to tinygltf's message. Returns each image's uri
+// ("" for a data URI or a buffer view), for load_image_checked's messages.
+std::vector<std::string> check_uri_files(std::string_view json, const std::string& base, const std::string& name) {
+    std::vector<std::string> image_uris;
     const nlohmann::json doc = nlohmann::json::parse(json.begin(), json.end(), nullptr, false);
-    if (doc.is_discarded() || !doc.is_object()) return;
+    if (doc.is_discarded() || !doc.is_object()) return image_uris;
+    if (const auto images = doc.find("images"); images != doc.end() && images->is_array())
+        for (const nlohmann::json& image : *images) {
+            const auto uri = image.is_object() ? image.find("uri") : image.end();
+            const bool named = image.is_object() && uri != image.end() && uri->is_string() &&
+                               !tinygltf::IsDataURI(uri->get_ref<const std::string&>());
+            image_uris.push_back(named ? uri->get<std::string>() : std::string());
+        }
     for (const char* list : {"buffers", "images"}) {
         const auto entries = doc.find(list);
         if (entries == doc.end() || !entries->is_array()) continue;
@@ -113,23 +124,40 @@ void check_uri_files(std::string_view json, const std::string& base, const std::
                 throw InputError(name, std::string(list) + "[" + std::to_string(i) + "].uri",
                                  "'" + text + "' decodes to a file name with a NUL character");
             const std::string problem = input_file_problem(uri_file(base, text));
-            if (problem.empty() || problem == kFileNotFound) continue;
-            throw InputError(name, std::string(list) + "[" + std::to_string(i) + "].uri", "'" + text + "' " + problem);
+            if (problem.empty() || (problem == kFileNotFound && list == std::string("buffers"))) continue;
+            throw InputError(name, std::string(list) + "[" + std::to_string(i) + "].uri",
+                             "'" + text + "' " + (problem == kFileNotFound ? "not found next to the glTF" : problem));
         }
     }
+    return image_uris;
 }
 
 // tinygltf's own image loader (stb_image) after a look at the image's
 // header: one larger than the scene's textures may hold is refused before
 // its pixels are allocated (encoded_image_problem).
+// An image that stb_image cannot decode is named with stb's reason (tinygltf
+// says "Unknown image format" for all of them); `user_data` is
+// check_uri_files' list of the images' uris.
 bool load_image_checked(tinygltf::Image* image, const int index, std::string* err, std::string* warn,
                         int req_width, int req_height, const unsigned char* bytes, int size, void* user_data) {
-    const std::string problem = encoded_image_problem(bytes, std::size_t(std::max(size, 0)));
+    const auto& uris = *static_cast<const std::vector<std::string>*>(user_data);
+    const std::string uri = index >= 0 && std::size_t(index) < uris.size() && !uris[std::size_t(index)].empty()
+                                ? " ('" + uris[std::size_t(index)] + "')"
+                                : std::string();
+    const std::size_t size_bytes = std::size_t(std::max(size, 0));
+    const std::string problem = encoded_image_problem(bytes, size_bytes);
     if (!problem.empty()) {
-        if (err != nullptr) *err += "images[" + std::to_string(index) + "] " + problem + "\n";
+        if (err != nullptr) *err += "images[" + std::to_string(index) + "]" + uri + " " + problem + "\n";
         return false;
     }
-    return tinygltf::LoadImageData(image, index, err, warn, req_width, req_height, bytes, size, user_data);
+    const std::size_t before = err != nullptr ? err->size() : 0;
+    if (tinygltf::LoadImageData(image, index, err, warn, req_width, req_height, bytes, size, nullptr)) return true;
+    if (err != nullptr) {
+        err->resize(before);
+        *err += "images[" + std::to_string(index) + "]" + uri + " cannot be decoded as PNG or JPEG (" +
+                image_decode_problem(bytes, size_bytes) + ")\n";
+    }
+    return false;
 }
 
 // tinygltf's file access, through ours (its FsCallbacks). A URI is looked
@@ -180,13 +208,13 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
     }
     if (too_deep(json)) throw InputError(name, "", "JSON nested more than " + std::to_string(kMaxJsonDepth) + " levels deep");
     const std::string base = file.parent_path().empty() ? std::string(".") : file.parent_path().string();
-    check_uri_files(json, base, name);
+    std::vector<std::string> image_uris = check_uri_files(json, base, name);
     // Before tinygltf, whose messages for a value of the wrong JSON type
     // name neither the value nor where it is.
     check_gltf_types(json, name);
 
     tinygltf::TinyGLTF gltf;
-    gltf.SetImageLoader(load_image_checked, nullptr);
+    gltf.SetImageLoader(load_image_checked, &image_uris);
     GltfFolder folder{base.back() == '/' ? base : base + "/"};
     gltf.SetFsCallbacks({gltf_file_exists, gltf_expand_path, gltf_read_file, gltf_write_file, &folder});
     tinygltf::Model model;

@@ -256,6 +256,10 @@ private:
             target_.scene.triangles.back().material = *material;
             ++kept_;
         }
+        // glTF asks for the texture coordinates a material's textures use.
+        if (material && uv.empty() && (target_.scene.materials[*material].flags & gpu::kMaterialTextured) != 0u)
+            notes_.add(field + ".attributes.TEXCOORD_0",
+                       "missing, but the material has textures: they are read at (0, 0) everywhere");
     }
 
     // False when the triangle is degenerate and dropped (as OBJ faces are).

@@ -8,6 +8,7 @@
 #include <istream>
 #include <limits>
 #include <map>
+#include <set>
 #include <streambuf>
 #include <string>
 #include <string_view>
@@ -120,9 +121,30 @@ private:
         const std::string text = read_input_file(file);
         const std::string_view mtl = without_bom(text);
         if (uses_mtl_) check_mtl_numbers(mtl, display(file));
+        // Each named material's block: whether it has a Kd, and a map_Kd.
+        std::vector<std::pair<bool, bool>> blocks;
+        bool named = false;
+        for_each_line(mtl, [&](const Line& line) {
+            if (line.words[0] == "newmtl") {
+                named = line.words.size() > 1;
+                if (named) blocks.emplace_back(false, false);
+            } else if (named && line.words[0] == "Kd") {
+                blocks.back().first = true;
+            } else if (named && line.words[0] == "map_Kd") {
+                blocks.back().second = true;
+            }
+        });
+        const std::size_t first = materials->size();
         TextBuffer buffer(mtl);
         std::istream in(&buffer);
         tinyobj::LoadMtl(material_map, materials, &in, warn, err);
+        // A map_Kd without a Kd is the base colour itself (Kd 1), as a
+        // map_Ke without a Ke emits the texture itself; tinyobjloader gives
+        // such a material Kd 0.6 (where no Kd came before it in the file).
+        if (materials->size() - first == blocks.size())
+            for (std::size_t k = 0; k < blocks.size(); ++k)
+                if (!blocks[k].first && blocks[k].second)
+                    for (tinyobj::real_t& c : (*materials)[first + k].diffuse) c = 1;
         return true;
     }
 
@@ -419,8 +441,19 @@ private:
         target_.scene.normals.push_back(gpu::TriangleNormals{n[0].x, n[0].y, n[0].z, n[1].x, n[1].y, n[1].z,
                                                              n[2].x, n[2].y, n[2].z, 0u, 0u, 0u});
         target_.scene.uvs.push_back(texcoords(idx, f, shape));
+        const bool textured = (target_.scene.materials[material].flags & gpu::kMaterialTextured) != 0u;
+        const bool uv_everywhere = std::all_of(idx.begin(), idx.end(), [](const tinyobj::index_t& i) {
+            return i.texcoord_index >= 0;
+        });
+        if (textured && !uv_everywhere && untextured_noted_.insert(material).second)
+            target_.scene.load_notes.push_back(
+                obj_name_ + ": " + face_name(f, shape) +
+                ": has no texture coordinates (vt) at some corner, but its material has textures: they are read "
+                "at (0, 0) there (noted for the first such face of each material)");
         return true;
     }
+
+    std::set<std::uint32_t> untextured_noted_;  // materials whose faces without vt were noted
 };
 
 }  // namespace

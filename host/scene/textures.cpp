@@ -110,6 +110,16 @@ std::string encoded_image_problem(const unsigned char* bytes, std::size_t size) 
            std::to_string(kMaxTexels) + " that textures may hold in all";
 }
 
+std::string image_decode_problem(const unsigned char* bytes, std::size_t size) {
+    if (size > std::size_t(std::numeric_limits<int>::max())) return "too large to decode";
+    int w = 0, h = 0, channels = 0;
+    std::unique_ptr<stbi_uc, void (*)(void*)> pixels(stbi_load_from_memory(bytes, int(size), &w, &h, &channels, 4),
+                                                     stbi_image_free);
+    if (pixels) return "";
+    const char* why = stbi_failure_reason();
+    return why != nullptr ? why : "unknown";
+}
+
 std::uint32_t load_texture(Scene& scene, const std::filesystem::path& image, const std::string& referrer,
                            const std::string& field) {
     const std::string name = "texture '" + display(image) + "'";

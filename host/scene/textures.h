@@ -42,6 +42,10 @@ std::uint32_t sampled_texture(Scene& scene, std::uint32_t image, const TextureSa
 std::uint32_t load_texture(Scene& scene, const std::filesystem::path& image, const std::string& referrer,
                            const std::string& field);
 
+// Why stb_image cannot decode an encoded image (its failure reason, "bad
+// zlib header" say), or "" where it can.
+std::string image_decode_problem(const unsigned char* bytes, std::size_t size);
+
 // All textures of a scene together hold at most this many texels (512 MiB).
 inline constexpr std::uint64_t kMaxTexels = std::uint64_t(1) << 27;
 

@@ -14,6 +14,7 @@ import math
 import os
 import struct
 import sys
+import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "..", "scripts"))
@@ -278,6 +279,11 @@ def unsupported_doc():
     doc["meshes"][0]["primitives"][0]["targets"] = [{"POSITION": 0}]
     doc["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"] = 0
     doc["extensionsUsed"].append("EXT_unknown_feature")
+    # A textured material on a primitive without TEXCOORD_0.
+    doc["images"] = [{"uri": png_uri(1, 1, lambda x, y: (255, 255, 255, 255))}]
+    doc["textures"] = [{"source": 0}]
+    doc["materials"] = [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}]
+    doc["meshes"][0]["primitives"][0]["material"] = 0
     return doc
 
 
@@ -351,6 +357,12 @@ def bad_cases():
         d["meshes"][0]["primitives"][0]["material"] = 0
 
     variant("bad_wrap", lambda d: textured(d, {}, {"wrapS": 12345}))
+    # A missing image, though only an occlusion texture (which is not read) uses it.
+    variant("bad_image_missing", lambda d: (textured(d, {}), d["images"].append({"uri": "missing.png"}),
+                                            d["textures"].append({"source": 1}),
+                                            d["materials"][0].update(occlusionTexture={"index": 1})))
+    # A PNG whose chunks are whole but whose pixels are not zlib data (corrupt.png).
+    variant("bad_image_corrupt", lambda d: (textured(d, {}), d["images"].__setitem__(0, {"uri": "corrupt.png"})))
     variant("bad_mag_filter", lambda d: textured(d, {}, {"magFilter": 1}))
     variant("bad_min_filter", lambda d: textured(d, {}, {"minFilter": 9990}))
     variant("bad_transform_offset", lambda d: textured(d, {"extensions": {"KHR_texture_transform": {
@@ -400,6 +412,12 @@ def main():
     write("emissive_only.gltf", no_camera_gltf_with_emission())
     for name, doc in bad_cases().items():
         write(name + ".gltf", doc)
+    with open(os.path.join(HERE, "corrupt.png"), "wb") as f:
+        def chunk(kind, data):
+            return (struct.pack(">I", len(data)) + kind + data +
+                    struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 2, 2, 8, 6, 0, 0, 0)) +
+                chunk(b"IDAT", b"not zlib data") + chunk(b"IEND", b""))
     with open(os.path.join(HERE, "bad_json.gltf"), "w", encoding="ascii") as f:
         f.write('{"asset": {"version": "2.0"}, "nodes": [\n')
     # A JSON scene with an OBJ and two glTF files (one placed by a transform), next to its own lights.
