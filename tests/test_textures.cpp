@@ -535,7 +535,7 @@ TEST(TextureLimits, OversizedOrTruncatedImagesAreRefusedFromTheirHeaders) {
         FAIL() << "no error for the glTF";
     } catch (const InputError& e) {
         EXPECT_EQ(std::string(e.what()), gltf.lexically_normal().string() +
-                                             ": tinygltf: images[0] is 16384 x 16384 texels, more than the "
+                                             ": tinygltf: images[0] ('big.png') is 16384 x 16384 texels, more than the "
                                              "134217728 that textures may hold in all");
     }
 }
