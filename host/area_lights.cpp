@@ -129,13 +129,17 @@ double TriangleEmission::brightest_in_footprint(std::size_t i) const {
     // texel is among them.) None where there are too many (or NaN).
     const auto texels = [](double lo, double hi, std::uint32_t n, std::uint32_t wrap) {
         std::vector<std::uint32_t> out;
-        const double first = std::floor(lo * n - 0.5), last = std::floor(hi * n - 0.5) + 1;
+        double first = std::floor(lo * n - 0.5), last = std::floor(hi * n - 0.5) + 1;
+        if (wrap == gpu::kTextureWrapClamp) {  // every texel past an edge is the edge's
+            first = std::clamp(first, 0.0, double(n - 1));
+            last = std::clamp(last, 0.0, double(n - 1));
+        }
         const double period = wrap == gpu::kTextureWrapMirror ? 2.0 * n : double(n);
         const double count = std::min(last - first + 1, period);
         if (!(count <= 65536.0)) return out;
         for (double p = first; p < first + count; ++p) {
             if (wrap == gpu::kTextureWrapClamp) {
-                out.push_back(std::uint32_t(std::clamp(p, 0.0, double(n - 1))));
+                out.push_back(std::uint32_t(p));
                 continue;
             }
             const double q = std::fmod(std::fmod(p, period) + period, period);

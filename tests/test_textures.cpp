@@ -352,6 +352,28 @@ TEST(ObjTextures, TexturedFacesWithoutTextureCoordinatesAreNoted) {
     EXPECT_TRUE(load_scene(dir.path() / "scene.json").load_notes.empty());
 }
 
+// tinyobjloader reads -s and -o as three numbers; with two, the file name
+// goes into the third and the map names no file: refused, not a material
+// without its texture.
+TEST(ObjTextures, MapWhoseOptionsTookItsFileNameIsRefused) {
+    TempDir dir;
+    write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
+    dir.write("quad.obj", kTexturedObj);
+    for (const char* map : {"map_Kd -s 2 2 paint.png", "map_Ke -o 0.5 0.5 paint.png", "norm -s 1 1 paint.png"}) {
+        dir.write("quad.mtl", std::string("newmtl paint\nKd 1 1 1\n") + map + "\n");
+        const std::string key = std::string(map).substr(0, std::string(map).find(' '));
+        try {
+            load_scene(dir.write("scene.json", quad_scene_json()));
+            ADD_FAILURE() << map << " loaded";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("quad.mtl: material 'paint'." + key +
+                                                 ": names no texture file (its -s and -o options take three numbers"),
+                      std::string::npos)
+                << e.what();
+        }
+    }
+}
+
 // An MTL map_Kd without a Kd is the base colour itself, whatever came
 // before it in the file (tinyobjloader gives it 0.6 where no Kd came
 // before, and its default, black, where one did).
@@ -680,6 +702,24 @@ TEST(TexturedAreaLights, SmallBrightFeaturesAreFoundThroughTheSampler) {
     clamp.wrap_u = gpu::kTextureWrapClamp;
     EXPECT_EQ(power(mirror, left, nullptr), 0.0);
     EXPECT_GT(power(clamp, left, nullptr), 0.0);
+    // A clamped uv box wider than the texture reads up to its far edge: a
+    // 1024 x 1 texture black but for its last texel, under a triangle
+    // from u = -1 to 1 whose points all miss it (the range was counted
+    // one period from its start, every texel of which clamped to the
+    // first).
+    TextureScene t;
+    std::vector<std::uint32_t> row(1024, rgba(0, 0, 0));
+    row.back() = rgba(255, 255, 255);
+    const std::uint32_t tex = loader::sampled_texture(t.scene, t.add(1024, 1, row), clamp);
+    gpu::Material m = loader::make_material(glm::vec3(0.0f), glm::vec3(0.0f), 1.0f);
+    loader::set_emission(m, {1.0f, 1.0f, 1.0f}, false);
+    loader::set_texture(m, &gpu::Material::emissive_texture, tex);
+    t.scene.materials = {m};
+    test::add_triangle(t.scene, {0, 1, 0}, {1, 1, 0}, {0, 1, 1}, 0);
+    t.scene.uvs = {{-1.0f, 0.5f, -1.0f, 0.5f, 1.0f, 0.5f}};
+    const TriangleEmission wide(t.scene);
+    ASSERT_EQ(wide.mean(0).x, 0.0f);
+    EXPECT_GT(wide.power(0), 0.0);
 }
 
 // Texture coordinates near 1e6 (a float step of 0.0625 there) render as

@@ -12,6 +12,7 @@
 #include <streambuf>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -121,30 +122,49 @@ private:
         const std::string text = read_input_file(file);
         const std::string_view mtl = without_bom(text);
         if (uses_mtl_) check_mtl_numbers(mtl, display(file));
-        // Each named material's block: whether it has a Kd, and a map_Kd.
-        std::vector<std::pair<bool, bool>> blocks;
+        // Each named material's block: whether it has a Kd, and which of
+        // the maps the renderer reads it has.
+        struct Block {
+            bool kd = false, map_kd = false, map_ke = false, norm = false;
+        };
+        std::vector<Block> blocks;
         bool named = false;
         for_each_line(mtl, [&](const Line& line) {
-            if (line.words[0] == "newmtl") {
+            const std::string_view key = line.words[0];
+            if (key == "newmtl") {
                 named = line.words.size() > 1;
-                if (named) blocks.emplace_back(false, false);
-            } else if (named && line.words[0] == "Kd") {
-                blocks.back().first = true;
-            } else if (named && line.words[0] == "map_Kd") {
-                blocks.back().second = true;
+                if (named) blocks.emplace_back();
+            } else if (named) {
+                Block& b = blocks.back();
+                b.kd = b.kd || key == "Kd";
+                b.map_kd = b.map_kd || key == "map_Kd";
+                b.map_ke = b.map_ke || key == "map_Ke";
+                b.norm = b.norm || key == "norm";
             }
         });
         const std::size_t first = materials->size();
         TextBuffer buffer(mtl);
         std::istream in(&buffer);
         tinyobj::LoadMtl(material_map, materials, &in, warn, err);
-        // A map_Kd without a Kd is the base colour itself (Kd 1), as a
-        // map_Ke without a Ke emits the texture itself; tinyobjloader gives
-        // such a material Kd 0.6 (where no Kd came before it in the file).
-        if (materials->size() - first == blocks.size())
-            for (std::size_t k = 0; k < blocks.size(); ++k)
-                if (!blocks[k].first && blocks[k].second)
-                    for (tinyobj::real_t& c : (*materials)[first + k].diffuse) c = 1;
+        if (materials->size() - first != blocks.size()) return true;
+        for (std::size_t k = 0; k < blocks.size(); ++k) {
+            tinyobj::material_t& m = (*materials)[first + k];
+            // tinyobjloader reads -s and -o as three numbers: given two,
+            // it takes the file name for the third and the map names none.
+            for (const auto& [given, name, key] :
+                 {std::tuple{blocks[k].map_kd, &m.diffuse_texname, "map_Kd"},
+                  std::tuple{blocks[k].map_ke, &m.emissive_texname, "map_Ke"},
+                  std::tuple{blocks[k].norm, &m.normal_texname, "norm"}})
+                if (given && name->empty())
+                    throw InputError(display(file), "material '" + m.name + "'." + key,
+                                     "names no texture file (its -s and -o options take three numbers, u v w)");
+            // A map_Kd without a Kd is the base colour itself (Kd 1), as a
+            // map_Ke without a Ke emits the texture itself; tinyobjloader
+            // gives such a material Kd 0.6 (where no Kd came before it in
+            // the file).
+            if (!blocks[k].kd && blocks[k].map_kd)
+                for (tinyobj::real_t& c : m.diffuse) c = 1;
+        }
         return true;
     }
 
