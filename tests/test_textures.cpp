@@ -727,7 +727,7 @@ TEST(TexturedAreaLights, SmallBrightFeaturesAreFoundThroughTheSampler) {
 // its textures repeat (before, relative RMSE 0.36 against the same quad at
 // 0). Where a texture clamps, nothing moves: clamped, u = 1e6 is u = 1.
 TEST(TexturedRender, FarTextureCoordinatesKeepTheirDetail) {
-    const auto render = [](float shift, bool clamp) {
+    const auto render = [](float shift, bool clamp, bool u_at_one = false) {
         Scene s;
         std::vector<std::uint32_t> texels(64 * 64);
         for (std::size_t i = 0; i < texels.size(); ++i) texels[i] = rgba(std::uint32_t(i * 37 % 256), 128, 255);
@@ -739,8 +739,10 @@ TEST(TexturedRender, FarTextureCoordinatesKeepTheirDetail) {
         s.materials = {m};
         test::add_quad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0);
         s.uvs = {{0, 0, 0, 1, 1, 1}, {0, 0, 1, 1, 1, 0}};
-        for (gpu::TriangleUvs& uv : s.uvs)
+        for (gpu::TriangleUvs& uv : s.uvs) {
             for (float* c : {&uv.u0, &uv.u1, &uv.u2, &uv.v0, &uv.v1, &uv.v2}) *c += shift;
+            if (u_at_one) uv.u0 = uv.u1 = uv.u2 = 1.0f;
+        }
         s.lights = {test::directional_light({0, -1, 0}, glm::vec3(3.0f))};
         s.camera = test::camera({0, 4, 0}, {0, 0, 0}, float(2.0 * std::atan(0.25) * 180.0 / 3.14159265358979), 32, 32);
         s.camera.up = {0, 0, -1};
@@ -754,9 +756,11 @@ TEST(TexturedRender, FarTextureCoordinatesKeepTheirDetail) {
         for (std::size_t i = 0; i < near.rgb.size(); ++i)
             ASSERT_EQ(far.rgb[i], near.rgb[i]) << "pixel " << i / 3 << " with the coordinates moved by " << shift;
     }
-    // Clamped in u, the far quad reads the texture's last column (u = 1) everywhere.
+    // Clamped in u, the far quad reads the texture's last column (u = 1)
+    // everywhere, and v, which repeats, as near the origin.
     const Image clamped = render(999998.0f, true);
     EXPECT_NE(clamped.rgb, near.rgb);
+    EXPECT_EQ(clamped.rgb, render(0.0f, true, true).rgb);
 }
 
 // A plane seen from straight above, lit by a directional light along -y,
