@@ -332,6 +332,16 @@ TEST(Gltf, CameraOptionIsRefusedForAJsonScene) {
     EXPECT_NE(e.find("--camera picks a camera of a glTF scene"), std::string::npos) << e;
 }
 
+// A file past GLB's 32-bit lengths is refused from its size, before it is
+// read (a sparse file here: no disk is used).
+TEST(Gltf, FilePastFourGibibytesIsRefusedBeforeItIsRead) {
+    test::TempDir dir;
+    const fs::path file = dir.write("huge.glb", "glTF");
+    fs::resize_file(file, (std::uintmax_t(1) << 32) + 4096);
+    EXPECT_EQ(error_of(file.string()), file.string() + ": the file is 4294971392 bytes; a glTF file holds at most "
+                                                       "4294967295 (GLB's lengths are 32-bit)");
+}
+
 // A buffer read from a device or a pipe could go on for ever: such URIs are
 // refused before tinygltf opens them (it reads a pipe until its writer
 // closes it, which here is never).

@@ -225,22 +225,47 @@ std::vector<double> GltfAccessors::components(int index, const std::string& fiel
     return values;
 }
 
-std::vector<glm::vec3> GltfAccessors::vec3s(int index, const std::string& field) const {
+namespace {
+
+// The entry of `index` in a list of recently decoded accessors, or null.
+template <class T>
+std::shared_ptr<const std::vector<T>> recent(
+    const std::vector<std::pair<int, std::shared_ptr<const std::vector<T>>>>& list, int index) {
+    for (const auto& [i, values] : list)
+        if (i == index) return values;
+    return nullptr;
+}
+
+// Adds a decoded accessor to the list, dropping the oldest past `most`.
+template <class T>
+std::shared_ptr<const std::vector<T>> remember(std::vector<std::pair<int, std::shared_ptr<const std::vector<T>>>>& list,
+                                               std::size_t most, int index, std::vector<T>&& values) {
+    auto kept = std::make_shared<const std::vector<T>>(std::move(values));
+    if (list.size() == most) list.erase(list.begin());
+    list.emplace_back(index, kept);
+    return kept;
+}
+
+}  // namespace
+
+std::shared_ptr<const std::vector<glm::vec3>> GltfAccessors::vec3s(int index, const std::string& field) const {
+    if (auto kept = recent(recent_vec3s_, index)) return kept;
     const std::vector<double> v = components(index, field, TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT});
     std::vector<glm::vec3> out(v.size() / 3);
     for (std::size_t i = 0; i < out.size(); ++i)
         out[i] = glm::vec3(float(v[3 * i]), float(v[3 * i + 1]), float(v[3 * i + 2]));
-    return out;
+    return remember(recent_vec3s_, kRecent, index, std::move(out));
 }
 
-std::vector<glm::vec2> GltfAccessors::vec2s(int index, const std::string& field) const {
+std::shared_ptr<const std::vector<glm::vec2>> GltfAccessors::vec2s(int index, const std::string& field) const {
+    if (auto kept = recent(recent_vec2s_, index)) return kept;
     const std::vector<double> v =
         components(index, field, TINYGLTF_TYPE_VEC2,
                    {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
     std::vector<glm::vec2> out(v.size() / 2);
     for (std::size_t i = 0; i < out.size(); ++i) out[i] = glm::vec2(float(v[2 * i]), float(v[2 * i + 1]));
-    return out;
+    return remember(recent_vec2s_, 1, index, std::move(out));
 }
 
 std::vector<std::uint32_t> GltfAccessors::indices(int index, const std::string& field,

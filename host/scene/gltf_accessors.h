@@ -5,7 +5,9 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -24,10 +26,15 @@ public:
     // The accessor `index` as VEC3 floats (FLOAT components only), every
     // value finite. `field` is the glTF path that named the accessor
     // ("meshes[0].primitives[1].attributes.POSITION") for error messages.
-    std::vector<glm::vec3> vec3s(int index, const std::string& field) const;
+    // The last few decoded are kept for the primitives that name them next:
+    // exporters split one vertex array into many primitives (10,000 over
+    // one POSITION accessor of 10^6 triangles took 25 s to load, decoding
+    // it again for each; an audit of large meshes).
+    std::shared_ptr<const std::vector<glm::vec3>> vec3s(int index, const std::string& field) const;
 
-    // VEC2 texture coordinates: FLOAT, or normalized UNSIGNED_BYTE/SHORT.
-    std::vector<glm::vec2> vec2s(int index, const std::string& field) const;
+    // VEC2 texture coordinates: FLOAT, or normalized UNSIGNED_BYTE/SHORT;
+    // kept as vec3s are.
+    std::shared_ptr<const std::vector<glm::vec2>> vec2s(int index, const std::string& field) const;
 
     // SCALAR vertex indices (UNSIGNED_BYTE/SHORT/INT), each below
     // vertex_count.
@@ -36,6 +43,11 @@ public:
 private:
     const tinygltf::Model& model_;
     std::string file_;
+    // The accessors last decoded, newest last: a primitive's positions and
+    // normals, and its texture coordinates.
+    static constexpr std::size_t kRecent = 2;
+    mutable std::vector<std::pair<int, std::shared_ptr<const std::vector<glm::vec3>>>> recent_vec3s_;
+    mutable std::vector<std::pair<int, std::shared_ptr<const std::vector<glm::vec2>>>> recent_vec2s_;
 
     // The accessor's components as doubles (count * components values),
     // sparse substitutions applied; integers normalized when the accessor

@@ -197,8 +197,16 @@ bool gltf_write_file(std::string* err, const std::string&, const std::vector<uns
 
 tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
     const std::string& name = notes.file();
+    // Before it is read: a GLB's lengths are 32-bit, and tinygltf takes an
+    // unsigned int (a 4 GiB file took 12 s and 4 GiB of memory to refuse).
+    std::error_code ec;
+    const std::uintmax_t size = fs::file_size(file, ec);
+    constexpr std::uintmax_t kMost = std::numeric_limits<unsigned int>::max();
+    if (!ec && size > kMost)
+        throw InputError(name, "", "the file is " + std::to_string(size) + " bytes; a glTF file holds at most " +
+                                       std::to_string(kMost) + " (GLB's lengths are 32-bit)");
     const std::string bytes = read_input_file(file);  // names the file when missing
-    if (bytes.size() > std::numeric_limits<unsigned int>::max()) throw InputError(name, "", "file too large");
+    if (bytes.size() > kMost) throw InputError(name, "", "file too large");
     const bool binary = bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0;
     std::string_view json(bytes);
     if (binary && bytes.size() >= 20) {

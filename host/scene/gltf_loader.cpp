@@ -6,6 +6,7 @@
 #include <cctype>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <utility>
 
 #include <glm/gtc/matrix_inverse.hpp>
@@ -238,17 +239,22 @@ private:
             if (key.starts_with("COLOR_")) notes_.add(field + ".attributes." + key, "vertex colours are not read");
         const auto position = prim.attributes.find("POSITION");
         if (position == prim.attributes.end()) fail(field + ".attributes.POSITION", "missing");
-        const std::vector<glm::vec3> p = accessors_.vec3s(position->second, field + ".attributes.POSITION");
-        std::vector<glm::vec3> n;
+        const auto positions = accessors_.vec3s(position->second, field + ".attributes.POSITION");
+        const std::vector<glm::vec3>& p = *positions;
+        static const std::vector<glm::vec3> no_normals;
+        static const std::vector<glm::vec2> no_uvs;
+        std::shared_ptr<const std::vector<glm::vec3>> normals;
         if (const auto it = prim.attributes.find("NORMAL"); it != prim.attributes.end()) {
-            n = accessors_.vec3s(it->second, field + ".attributes.NORMAL");
-            if (n.size() != p.size()) fail(field + ".attributes.NORMAL", "count differs from POSITION's");
+            normals = accessors_.vec3s(it->second, field + ".attributes.NORMAL");
+            if (normals->size() != p.size()) fail(field + ".attributes.NORMAL", "count differs from POSITION's");
         }
-        std::vector<glm::vec2> uv;
+        const std::vector<glm::vec3>& n = normals ? *normals : no_normals;
+        std::shared_ptr<const std::vector<glm::vec2>> uvs;
         if (const auto it = prim.attributes.find("TEXCOORD_0"); it != prim.attributes.end()) {
-            uv = accessors_.vec2s(it->second, field + ".attributes.TEXCOORD_0");
-            if (uv.size() != p.size()) fail(field + ".attributes.TEXCOORD_0", "count differs from POSITION's");
+            uvs = accessors_.vec2s(it->second, field + ".attributes.TEXCOORD_0");
+            if (uvs->size() != p.size()) fail(field + ".attributes.TEXCOORD_0", "count differs from POSITION's");
         }
+        const std::vector<glm::vec2>& uv = uvs ? *uvs : no_uvs;
         std::optional<std::uint32_t> material;
         for (const auto& c : triangles(prim, field, p.size())) {
             if (!add_triangle(p, n, uv, c, t, field)) continue;
