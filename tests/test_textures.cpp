@@ -290,12 +290,26 @@ std::string quad_scene_json() {
                "lights": [{"type": "point", "position": [0, 2, 0], "intensity": [1, 1, 1]}]})";
 }
 
-TEST(ObjTextures, MapKdLoadsAndVtTurnsToGrowDownwards) {
+// A folder holding paint.png (2 x 1: red, blue), quad.obj (kTexturedObj
+// unless given) and scene.json (quad_scene_json()); load() writes quad.mtl
+// and loads the scene.
+struct TexturedQuad {
     TempDir dir;
-    write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
-    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd paint.png\n");
-    dir.write("quad.obj", kTexturedObj);
-    const Scene s = load_scene(dir.write("scene.json", quad_scene_json()));
+    explicit TexturedQuad(const char* obj = kTexturedObj) {
+        write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
+        dir.write("quad.obj", obj);
+        dir.write("scene.json", quad_scene_json());
+    }
+    Scene load(const std::string& mtl) {
+        dir.write("quad.mtl", mtl);
+        return load_scene(dir.path() / "scene.json");
+    }
+    std::string obj() const { return (dir.path() / "quad.obj").lexically_normal().string(); }
+};
+
+TEST(ObjTextures, MapKdLoadsAndVtTurnsToGrowDownwards) {
+    TexturedQuad quad;
+    const Scene s = quad.load("newmtl paint\nKd 1 1 1\nmap_Kd paint.png\n");
     ASSERT_EQ(s.textures.size(), 1u);
     EXPECT_EQ(s.textures[0].width, 2u);
     EXPECT_EQ(s.textures[0].height, 1u);
@@ -316,54 +330,42 @@ TEST(ObjTextures, MapKdLoadsAndVtTurnsToGrowDownwards) {
 // -s, -o and -clamp, and maps the renderer has no use for (tinyobjloader
 // reads them all).
 TEST(ObjTextures, UnusedMapsAndOptionsAreNoted) {
-    TempDir dir;
-    write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
-    dir.write("quad.obj", kTexturedObj);
-    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd -colorspace linear paint.png\nmap_Bump paint.png\n"
-                          "map_Ks paint.png\n");
-    const Scene scene = load_scene(dir.write("scene.json", quad_scene_json()));
-    const std::string obj = (dir.path() / "quad.obj").lexically_normal().string();
+    TexturedQuad quad;
+    const Scene scene = quad.load("newmtl paint\nKd 1 1 1\nmap_Kd -colorspace linear paint.png\nmap_Bump paint.png\n"
+                                  "map_Ks paint.png\n");
+    const std::string obj = quad.obj();
     EXPECT_EQ(scene.load_notes,
               (std::vector<std::string>{obj + ": material 'paint'.map_Bump is not used (a normal map is read from norm)",
                                         obj + ": material 'paint'.map_Ks is not used",
                                         obj + ": material 'paint'.map_Kd: options other than -s, -o and -clamp are "
                                               "not applied (sRGB, bilinear)"}));
-    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd -clamp on -s 2 3 1 -o 0.25 0.5 0 paint.png\n");
-    EXPECT_TRUE(load_scene(dir.path() / "scene.json").load_notes.empty());
-    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd paint.png\n");
-    EXPECT_TRUE(load_scene(dir.path() / "scene.json").load_notes.empty());
+    EXPECT_TRUE(quad.load("newmtl paint\nKd 1 1 1\nmap_Kd -clamp on -s 2 3 1 -o 0.25 0.5 0 paint.png\n")
+                    .load_notes.empty());
+    EXPECT_TRUE(quad.load("newmtl paint\nKd 1 1 1\nmap_Kd paint.png\n").load_notes.empty());
 }
 
 // Faces without vt whose material has textures read them at (0, 0): a
 // note says so, once per material.
 TEST(ObjTextures, TexturedFacesWithoutTextureCoordinatesAreNoted) {
-    TempDir dir;
-    write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
-    dir.write("quad.obj", "mtllib quad.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nusemtl paint\n"
-                          "f 1 4 3\nf 1 3 2\n");
-    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd paint.png\n");
-    const Scene s = load_scene(dir.write("scene.json", quad_scene_json()));
+    TexturedQuad quad("mtllib quad.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nusemtl paint\nf 1 4 3\nf 1 3 2\n");
+    const Scene s = quad.load("newmtl paint\nKd 1 1 1\nmap_Kd paint.png\n");
     const auto noted = std::count_if(s.load_notes.begin(), s.load_notes.end(), [](const std::string& note) {
         return note.find("has no texture coordinates (vt) at some corner, but its material has textures") !=
                std::string::npos;
     });
     EXPECT_EQ(noted, 1) << "one note for the material's two faces";
-    dir.write("quad.obj", kTexturedObj);
-    EXPECT_TRUE(load_scene(dir.path() / "scene.json").load_notes.empty());
+    EXPECT_TRUE(TexturedQuad().load("newmtl paint\nKd 1 1 1\nmap_Kd paint.png\n").load_notes.empty());
 }
 
 // tinyobjloader reads -s and -o as three numbers; with two, the file name
 // goes into the third and the map names no file: refused, not a material
 // without its texture.
 TEST(ObjTextures, MapWhoseOptionsTookItsFileNameIsRefused) {
-    TempDir dir;
-    write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
-    dir.write("quad.obj", kTexturedObj);
+    TexturedQuad quad;
     for (const char* map : {"map_Kd -s 2 2 paint.png", "map_Ke -o 0.5 0.5 paint.png", "norm -s 1 1 paint.png"}) {
-        dir.write("quad.mtl", std::string("newmtl paint\nKd 1 1 1\n") + map + "\n");
         const std::string key = std::string(map).substr(0, std::string(map).find(' '));
         try {
-            load_scene(dir.write("scene.json", quad_scene_json()));
+            quad.load(std::string("newmtl paint\nKd 1 1 1\n") + map + "\n");
             ADD_FAILURE() << map << " loaded";
         } catch (const InputError& e) {
             EXPECT_NE(std::string(e.what()).find("quad.mtl: material 'paint'." + key +
@@ -378,14 +380,11 @@ TEST(ObjTextures, MapWhoseOptionsTookItsFileNameIsRefused) {
 // before it in the file (tinyobjloader gives it 0.6 where no Kd came
 // before, and its default, black, where one did).
 TEST(ObjTextures, MapKdWithoutKdIsTheTextureItself) {
-    TempDir dir;
-    write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
-    dir.write("quad.obj", kTexturedObj);
+    TexturedQuad quad;
     for (const char* mtl : {"newmtl paint\nmap_Kd paint.png\n",
                             "newmtl other\nKd 0.5 0.5 0.5\nnewmtl paint\nmap_Kd paint.png\n",
                             "newmtl paint\nmap_Kd paint.png\nKd 0.25 0.25 0.25\n"}) {
-        dir.write("quad.mtl", mtl);
-        const Scene s = load_scene(dir.write("scene.json", quad_scene_json()));
+        const Scene s = quad.load(mtl);
         const gpu::Material& m = s.materials[s.triangles[0].material];
         const float expected = std::string(mtl).find("Kd 0.25") != std::string::npos ? 0.25f : 1.0f;
         EXPECT_EQ(glm::vec3(m.kd_r, m.kd_g, m.kd_b), glm::vec3(expected)) << mtl;
@@ -396,12 +395,9 @@ TEST(ObjTextures, MapKdWithoutKdIsTheTextureItself) {
 // counts from the bottom (v up): u' = s_u u + o_u, v' = s_v v + o_v there;
 // -clamp on clamps both. The file is loaded once for both uses.
 TEST(ObjTextures, ScaleOffsetAndClampOptionsApply) {
-    TempDir dir;
-    write_png(dir.path() / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
-    dir.write("quad.obj", kTexturedObj);
-    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd -clamp on -s 2 3 1 -o 0.25 0.5 0 paint.png\n"
-                          "map_Ke paint.png\n");
-    const Scene s = load_scene(dir.write("scene.json", quad_scene_json()));
+    TexturedQuad quad;
+    const Scene s = quad.load("newmtl paint\nKd 1 1 1\nmap_Kd -clamp on -s 2 3 1 -o 0.25 0.5 0 paint.png\n"
+                              "map_Ke paint.png\n");
     ASSERT_EQ(s.textures.size(), 2u);
     ASSERT_EQ(s.texels.size(), 2u);
     const gpu::Material& m = s.materials[s.triangles[0].material];
@@ -418,9 +414,8 @@ TEST(ObjTextures, ScaleOffsetAndClampOptionsApply) {
         EXPECT_NEAR(t[0] * uv.x + t[1] * uv.y + t[2], 2.0f * obj_uv.x + 0.25f, 1e-6f);
         EXPECT_NEAR(t[3] * uv.x + t[4] * uv.y + t[5], 1.0f - (3.0f * obj_uv.y + 0.5f), 1e-6f);
     }
-    dir.write("quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd -s 1e39 1 1 paint.png\n");
     try {
-        load_scene(dir.path() / "scene.json");
+        quad.load("newmtl paint\nKd 1 1 1\nmap_Kd -s 1e39 1 1 paint.png\n");
         FAIL() << "a scale past the float range loaded";
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("material 'paint'.map_Kd: -s and -o must be finite numbers"),
