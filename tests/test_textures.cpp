@@ -664,9 +664,12 @@ TEST(TexturedAreaLights, SmallBrightFeaturesAreFoundThroughTheSampler) {
     std::vector<std::uint32_t> texels(64 * 64, rgba(0, 0, 0));
     texels[30 * 64 + 30] = rgba(255, 255, 255);  // at uv (0.477, 0.477)
     texels[50 * 64 + 0] = rgba(255, 255, 255);   // on the left edge, at v = 0.789
-    const auto power = [&](const loader::TextureSampling& sampling, const gpu::TriangleUvs& uvs, float* mean) {
+    // The power (and the mean, where asked) of one triangle emitting a
+    // w x h texture sampled as `sampling` at `uvs`.
+    const auto emitted = [](std::uint32_t w, std::uint32_t h, const std::vector<std::uint32_t>& image,
+                            const loader::TextureSampling& sampling, const gpu::TriangleUvs& uvs, float* mean) {
         TextureScene t;
-        const std::uint32_t tex = loader::sampled_texture(t.scene, t.add(64, 64, texels), sampling);
+        const std::uint32_t tex = loader::sampled_texture(t.scene, t.add(w, h, image), sampling);
         gpu::Material m = loader::make_material(glm::vec3(0.0f), glm::vec3(0.0f), 1.0f);
         loader::set_emission(m, {1000.0f, 1000.0f, 1000.0f}, false);
         loader::set_texture(m, &gpu::Material::emissive_texture, tex);
@@ -676,6 +679,9 @@ TEST(TexturedAreaLights, SmallBrightFeaturesAreFoundThroughTheSampler) {
         const TriangleEmission emission(t.scene);
         if (mean) *mean = emission.mean(0).x;
         return emission.power(0);
+    };
+    const auto power = [&](const loader::TextureSampling& sampling, const gpu::TriangleUvs& uvs, float* mean) {
+        return emitted(64, 64, texels, sampling, uvs, mean);
     };
     // The corner of the texture up to 0.2 holds no bright texel; scaled by
     // 5 it covers the whole texture, and its points are the previous
@@ -702,19 +708,11 @@ TEST(TexturedAreaLights, SmallBrightFeaturesAreFoundThroughTheSampler) {
     // from u = -1 to 1 whose points all miss it (the range was counted
     // one period from its start, every texel of which clamped to the
     // first).
-    TextureScene t;
     std::vector<std::uint32_t> row(1024, rgba(0, 0, 0));
     row.back() = rgba(255, 255, 255);
-    const std::uint32_t tex = loader::sampled_texture(t.scene, t.add(1024, 1, row), clamp);
-    gpu::Material m = loader::make_material(glm::vec3(0.0f), glm::vec3(0.0f), 1.0f);
-    loader::set_emission(m, {1.0f, 1.0f, 1.0f}, false);
-    loader::set_texture(m, &gpu::Material::emissive_texture, tex);
-    t.scene.materials = {m};
-    test::add_triangle(t.scene, {0, 1, 0}, {1, 1, 0}, {0, 1, 1}, 0);
-    t.scene.uvs = {{-1.0f, 0.5f, -1.0f, 0.5f, 1.0f, 0.5f}};
-    const TriangleEmission wide(t.scene);
-    ASSERT_EQ(wide.mean(0).x, 0.0f);
-    EXPECT_GT(wide.power(0), 0.0);
+    float wide_mean = -1.0f;
+    EXPECT_GT(emitted(1024, 1, row, clamp, {-1.0f, 0.5f, -1.0f, 0.5f, 1.0f, 0.5f}, &wide_mean), 0.0);
+    EXPECT_EQ(wide_mean, 0.0f);
 }
 
 // Texture coordinates near 1e6 (a float step of 0.0625 there) render as
