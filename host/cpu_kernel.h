@@ -337,7 +337,7 @@ struct BasicShadeKernel {
 #if defined(__SSE2__)
     // lc_child_errors' lanes, of lanes_point (its material the one it was
     // given), compared byte for byte: SurfacePoint has no padding.
-    static_assert(offsetof(SurfacePoint, mat) == 5 * sizeof(vec3) + sizeof(uint) + sizeof(vec2));
+    static_assert(offsetof(SurfacePoint, mat) == 5 * sizeof(vec3) + sizeof(uint) + sizeof(vec2) + sizeof(vec4));
     quad8::QuadLanes point_lanes;
     SurfacePoint lanes_point;
     bool lanes_made = false, lanes_covered = false;

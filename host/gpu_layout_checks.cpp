@@ -40,10 +40,11 @@ static_assert(offsetof(Material, normal_scale) == 76);
 static_assert(offsetof(Material, base_color_texture) == 80);
 static_assert(offsetof(Material, normal_texture) == 92);
 
-static_assert(sizeof(TextureInfo) == 40);
+static_assert(sizeof(TextureInfo) == 44);
 static_assert(offsetof(TextureInfo, height) == 8);
 static_assert(offsetof(TextureInfo, sampling) == 12);
 static_assert(offsetof(TextureInfo, uv_transform) == 16);
+static_assert(offsetof(TextureInfo, mip_offset) == 40);
 static_assert(offsetof(Material, emission_r) == 32);
 static_assert(offsetof(Material, ks_r) == 12);
 static_assert(offsetof(Material, alpha) == 24);
@@ -64,11 +65,12 @@ static_assert(offsetof(LightNode, rep_light) == 36);
 static_assert(offsetof(LightNode, left) == 40);
 static_assert(offsetof(LightNode, flags) == 44);
 
-static_assert(sizeof(GBufferTexel) == 48);
+static_assert(sizeof(GBufferTexel) == 64);
 static_assert(offsetof(GBufferTexel, nx) == 12);
 static_assert(offsetof(GBufferTexel, wo_x) == 24);
 static_assert(offsetof(GBufferTexel, material) == 36);
 static_assert(offsetof(GBufferTexel, v) == 44);
+static_assert(offsetof(GBufferTexel, footprint_minor_v) == 60);
 
 static_assert(sizeof(CutEntry) == 8);
 static_assert(offsetof(CutEntry, error) == 4);

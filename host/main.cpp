@@ -402,7 +402,8 @@ int main(int argc, char** argv) {
         ->transform(setting(lc::kSettingVpls));
     info->add_option("--vpl-bounces", info_args.vpl_bounces, "VPLs per light path at most, as render's")
         ->transform(setting(lc::kSettingMaxBounces));
-    info->add_option("--seed", info_args.seed, "Seed of the area-light samples and VPLs, as render's");
+    info->add_option("--seed", info_args.seed, "Seed of the area-light samples and VPLs, as render's")
+        ->transform(setting(lc::kSettingSeed));
 
     // A first word that is neither a subcommand nor an option: CLI11 would
     // say only that a subcommand is required.
@@ -422,9 +423,11 @@ int main(int argc, char** argv) {
         // as every other error does.
         if (e.get_exit_code() == 0) return app.exit(e);
         // CLI11 reports a missing command or argument before an option it
-        // does not know: the unknown option, which is more likely the
-        // mistake, is named first.
-        if (dynamic_cast<const CLI::RequiredError*>(&e) != nullptr) {
+        // does not know, and an unknown option after a complete command as
+        // its words left over, in reverse ("3 --bogus"): the unknown
+        // option, which is more likely the mistake, is named first.
+        if (dynamic_cast<const CLI::RequiredError*>(&e) != nullptr ||
+            dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr) {
             const CLI::App* command = nullptr;
             for (int i = 1; i < argc; ++i) {
                 const std::string word = argv[i];

@@ -242,7 +242,7 @@ glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, 
             }
             break;
         }
-        const glm::vec3 emitted = k.lc_surface_emission(tri, b1, b2, b.wi);
+        const glm::vec3 emitted = k.lc_surface_emission(tri, b1, b2, b.wi, glm::vec4(0.0f));
         if (!black(emitted))
             add(radiance, throughput * emitted * power_heuristic(b.pdf, triangle_light_pdf(tri, b.wi, t)));
 
@@ -254,7 +254,7 @@ glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, 
             if (!(rnd.unit(kDimRoulette) < q)) break;
             throughput /= q;
         }
-        sp = k.lc_surface_point(tri, b1, b2, b.wi);
+        sp = k.lc_surface_point(tri, b1, b2, b.wi, 0.0f);
     }
     return radiance;
 }
@@ -303,7 +303,7 @@ glm::vec3 PathTracer::triangle_sample(Kernel& k, const SurfacePoint& sp, const L
     const glm::vec3 wi = to_light / d;
     const float cos_i = glm::dot(sp.n, wi);
     if (!(cos_i > 0.0f)) return glm::vec3(0.0f);
-    const glm::vec3 emitted = k.lc_surface_emission(tri, su * (1.0f - v), su * v, wi);
+    const glm::vec3 emitted = k.lc_surface_emission(tri, su * (1.0f - v), su * v, wi, glm::vec4(0.0f));
     if (black(emitted)) return glm::vec3(0.0f);  // sp sees its back
     const float light_pdf = triangle_light_pdf(tri, wi, d);
     if (!(light_pdf > 0.0f && std::isfinite(light_pdf))) return glm::vec3(0.0f);  // seen edge-on
@@ -394,14 +394,8 @@ struct alignas(64) Worker {
 
 }  // namespace
 
-// spp x light_samples; the sample order and counters are 32-bit.
-constexpr std::uint64_t kMaxPathsPerPixel = 1u << 24;
-
 RenderResult render_path(const PreparedScene& prepared, const RenderOptions& options) {
     validate_render_options(options);
-    if (std::uint64_t(options.spp) * options.light_samples > kMaxPathsPerPixel)
-        throw std::invalid_argument("path: spp x light_samples (paths per pixel) must be at most " +
-                                    std::to_string(kMaxPathsPerPixel));
     const auto start = Clock::now();
     const auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
     const path::PathTracer tracer(prepared, options);

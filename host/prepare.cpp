@@ -13,6 +13,7 @@
 #include "vpls.h"
 #include "scene/float_limits.h"
 #include "scene/huge_pages.h"
+#include "scene/textures.h"
 #include "lightcuts/error.h"
 #include "lightcuts/render.h"
 
@@ -25,10 +26,17 @@ namespace {
 // min_d is relative to the scene's size so it scales with the scene's units.
 constexpr float kMinDistanceRelative = 1e-4f;
 
-// True when every triangle lies in one plane: then no segment from a point
-// on that plane to a light can cross it again, and shadow rays are useless.
-bool all_coplanar(const std::vector<gpu::Triangle>& tris) {
+// True when no triangle can block a light that could reach a shaded
+// point: every triangle lies in one plane, and every shading normal is
+// that plane's (no normal or normal map bends it). Then a light behind the
+// plane, which only the plane could block, meets the back of the point's
+// hemisphere, and shadow rays are useless. A bent shading normal lets such
+// a light through the cosine, and only its shadow ray blocks it.
+bool nothing_can_shadow(const Scene& scene) {
+    const std::vector<gpu::Triangle>& tris = scene.triangles;
     if (tris.empty()) return true;
+    for (const gpu::Material& m : scene.materials)
+        if ((m.flags & gpu::kMaterialTextured) != 0u && m.normal_texture != gpu::kInvalidIndex) return false;
     const auto& t0 = tris[0];
     glm::dvec3 a(t0.v0_x, t0.v0_y, t0.v0_z), b(t0.v1_x, t0.v1_y, t0.v1_z), c(t0.v2_x, t0.v2_y, t0.v2_z);
     glm::dvec3 n = glm::normalize(glm::cross(b - a, c - a));
@@ -43,18 +51,23 @@ bool all_coplanar(const std::vector<gpu::Triangle>& tris) {
             if (std::abs(glm::dot(p - a, n)) > tolerance) return false;
         }
     }
+    for (const gpu::TriangleNormals& t : scene.normals)
+        for (glm::dvec3 v : {glm::dvec3(t.n0_x, t.n0_y, t.n0_z), glm::dvec3(t.n1_x, t.n1_y, t.n1_z),
+                             glm::dvec3(t.n2_x, t.n2_y, t.n2_z)})
+            if (glm::length(glm::cross(v, n)) > 1e-6 * glm::length(v)) return false;
     return true;
 }
 
 // Adds `lights` to the running totals; an InputError naming the scene file
-// and `field` where a per-type total leaves the float range. Positions
+// and `field` where a per-type total leaves the float range, ending with
+// `why`. Positions
 // are not checked: these lights lie on the geometry or have none.
 void check_generated_totals(const Scene& scene, loader::LightLimits& limits, std::span<const gpu::Light> lights,
-                            const char* field, const char* what) {
+                            const char* field, const char* why) {
     for (const gpu::Light& l : lights) {
         const loader::LightLimits::Problem problem = limits.add(l);
         if (problem.fault == loader::LightLimits::Fault::total)
-            throw InputError(scene.file.string(), field, problem.text + ", with " + what);
+            throw InputError(scene.file.string(), field, problem.text + why);
     }
 }
 
@@ -142,7 +155,8 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed, unsigned threads) {
     PreparedScene prepared;
     centre_far_scene(scene);
     wrap_texture_coordinates(scene);
-    prepared.has_occluders = !all_coplanar(scene.triangles);
+    loader::add_mipmaps(scene);
+    prepared.has_occluders = !nothing_can_shadow(scene);
     // A scene without texture coordinates gets zeros: every kernel reads them.
     if (scene.uvs.empty()) scene.uvs.assign(scene.triangles.size(), gpu::TriangleUvs{});
     prepared.bvh = build_bvh(scene.triangles, scene.normals, &scene.uvs);
@@ -160,16 +174,16 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed, unsigned threads) {
     // copy of the lights took 0.7 s).
     loader::LightLimits limits;
     bool limits_have_scene = false;
-    auto check_generated = [&](std::span<const gpu::Light> generated, const char* field, const char* what) {
+    auto check_generated = [&](std::span<const gpu::Light> generated, const char* field, const char* why) {
         if (generated.empty()) return;
         if (!limits_have_scene) {
             for (const gpu::Light& l : scene.lights) limits.add(l);
             limits_have_scene = true;
         }
-        check_generated_totals(scene, limits, generated, field, what);
+        check_generated_totals(scene, limits, generated, field, why);
     };
-    check_generated(area, "emissive surfaces", "the lights sampled on the emissive surfaces (emission times area)");
-    check_generated(sky, "environment", "the environment's directional lights (radiance times solid angle)");
+    check_generated(area, "emissive surfaces", ", with the lights sampled on the emissive surfaces (emission times area)");
+    check_generated(sky, "environment", ", with the environment's directional lights (radiance times solid angle)");
     prepared.area_lights = area.size();
     prepared.environment_lights = sky.size();
     // Every light of the tree: the scene's own, copied only where others
@@ -193,7 +207,8 @@ PreparedScene prepare_scene(Scene scene, std::uint32_t seed, unsigned threads) {
         const std::span<const gpu::Light> emitters = joined.empty() ? std::span<const gpu::Light>(scene.lights)
                                                                     : std::span<const gpu::Light>(joined);
         VplSet vpls = trace_vpls(scene, prepared.bvh, emitters, scene.render.indirect, seed, threads);
-        check_generated(vpls.lights, "indirect light", "the virtual point lights");
+        check_generated(vpls.lights, "indirect light",
+                        ": together they carry the power of the lights they leave, whatever their number");
         prepared.vpls = vpls.lights.size();
         prepared.vpl_paths = vpls.paths;
         if (joined.empty() && !vpls.lights.empty()) joined.assign(scene.lights.begin(), scene.lights.end());
@@ -241,6 +256,10 @@ gpu::FrameParams make_frame_params(const PreparedScene& prepared, const RenderOp
     float aspect = float(f.width) / float(f.height);
     right *= tan_half * aspect;
     up *= tan_half;
+    // The angle between neighbouring samples' rays at the image's centre:
+    // a pixel's, over the side of its grid of samples (lc_pixel_sample), so
+    // that the samples' footprints tile the pixel's (textures.h).
+    f.pixel_spread = float(2.0 * double(tan_half) / double(f.height) / std::sqrt(double(std::max(options.spp, 1u))));
     f.cam_pos_x = cam.position.x; f.cam_pos_y = cam.position.y; f.cam_pos_z = cam.position.z;
     f.cam_right_x = right.x; f.cam_right_y = right.y; f.cam_right_z = right.z;
     f.cam_up_x = up.x; f.cam_up_y = up.y; f.cam_up_z = up.z;

@@ -104,6 +104,14 @@ void validate_render_options(const RenderOptions& o) {
         problem = setting_problem(key, value);
         if (!problem.empty()) throw std::invalid_argument(std::string(key) + " " + problem);
     }
+    // Checked with the scene's render block and the command line merged,
+    // before the scene is prepared: either may have set either.
+    if (o.method == "path" && std::uint64_t(o.spp) * o.light_samples > kMaxPathsPerPixel)
+        throw std::invalid_argument(
+            "method path: spp x light_samples (paths per pixel) is " +
+            std::to_string(std::uint64_t(o.spp) * o.light_samples) + ", more than " +
+            std::to_string(kMaxPathsPerPixel) + " (--spp and --light-samples, or the scene's render.spp and "
+            "render.light_samples)");
 }
 
 }  // namespace lc

@@ -167,7 +167,7 @@ std::size_t trace_path(cpu::ShadeKernel& kernel, const Emitters& emitters, std::
         float t, b1, b2;
         const std::uint32_t tri = kernel.lc_trace_first_hit(org, dir, cpu::ShadeKernel::kRayInfinity, t, b1, b2);
         if (tri == gpu::kInvalidIndex) return bounce - 1;
-        const auto sp = kernel.lc_surface_point(tri, b1, b2, dir);
+        const auto sp = kernel.lc_surface_point(tri, b1, b2, dir, 0.0f);
         const gpu::Material& m = sp.mat;
         // Only the diffuse part re-emits: a Disney material's is its base
         // colour times (1 - metallic) (docs/lightcuts.md, "Indirect light").

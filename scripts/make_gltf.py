@@ -407,7 +407,7 @@ def write_textured(folder):
 
     g = Gltf("scripts/make_gltf.py")
     g.doc["images"] = [{"uri": name} for name in ("checker.png", "metal_rough.png", "glow.png", "bumps.png")]
-    g.doc["samplers"] = [{"magFilter": 9729, "minFilter": 9729, "wrapS": 10497, "wrapT": 10497}]
+    g.doc["samplers"] = [{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}]
     g.doc["textures"] = [{"sampler": 0, "source": i} for i in range(4)]
     checker = g.material({"name": "checker_floor", "pbrMetallicRoughness": {
         "baseColorTexture": {"index": 0}, "metallicFactor": 0.0, "roughnessFactor": 0.8}})

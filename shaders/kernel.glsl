@@ -157,7 +157,8 @@ uint lc_tile_y(uint i) { return push.tile_y + lc_tile_row(i, push.tile_width, pu
 
 SurfacePoint lc_texel_surface(GBufferTexel g) {
     return lc_make_surface(vec3(g.px, g.py, g.pz), vec3(g.nx, g.ny, g.nz), vec3(g.wo_x, g.wo_y, g.wo_z), g.material,
-                           vec2(g.u, g.v));
+                           vec2(g.u, g.v),
+                           vec4(g.footprint_major_u, g.footprint_major_v, g.footprint_minor_u, g.footprint_minor_v));
 }
 
 // llvmpipe (lavapipe) ends every loop of a shader invocation for good once

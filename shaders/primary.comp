@@ -26,6 +26,8 @@ void main() {
         g.material = kInvalidIndex;
         g.u = 0.0f;
         g.v = 0.0f;
+        g.footprint_major_u = 0.0f; g.footprint_major_v = 0.0f;
+        g.footprint_minor_u = 0.0f; g.footprint_minor_v = 0.0f;
     } else {
         g.px = sp.p.x; g.py = sp.p.y; g.pz = sp.p.z;
         g.nx = sp.n.x; g.ny = sp.n.y; g.nz = sp.n.z;
@@ -33,6 +35,8 @@ void main() {
         g.material = sp.material;
         g.u = sp.uv.x;
         g.v = sp.uv.y;
+        g.footprint_major_u = sp.footprint.x; g.footprint_major_v = sp.footprint.y;
+        g.footprint_minor_u = sp.footprint.z; g.footprint_minor_v = sp.footprint.w;
     }
     gbuffer[i] = g;
     if (lc_loops_were_cut_short()) pixel_stats[i].flags |= kPixelLoopLimit;

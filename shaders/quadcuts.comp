@@ -375,7 +375,8 @@ void main() {
     // A lane without a surface reads nothing of its point; it gets a valid
     // one all the same (material 0), so that no read can go astray.
     q_sp = q_active ? lc_texel_surface(g)
-                    : lc_make_surface(vec3(0.0f), vec3(0.0f, 0.0f, 1.0f), vec3(0.0f, 0.0f, 1.0f), 0u, vec2(0.0f));
+                    : lc_make_surface(vec3(0.0f), vec3(0.0f, 0.0f, 1.0f), vec3(0.0f, 0.0f, 1.0f), 0u, vec2(0.0f),
+                                      vec4(0.0f));
     if (!lc_quad_any(q_active)) return;  // no surface in the quad
 
     q_stats.cut_size = 0u;

@@ -194,7 +194,11 @@ for bad in "--error=-0.001" "--error=1.001" "--error=nan"; do
 for bad in "--max-cut=0" "--max-cut=4294967296"; do
   expect_error "--max-cut: $integer 1 to 4294967295" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
 for bad in "--seed=-1" "--seed=4294967296"; do
-  expect_error "--seed: $integer 0 to 4294967295" render "$mini" -o "$tmp/edge2.exr" "$bad"; done
+  expect_error "--seed: $integer 0 to 4294967295" render "$mini" -o "$tmp/edge2.exr" "$bad"
+  expect_error "--seed: $integer 0 to 4294967295" info "$mini" "$bad"; done
+# Each within its range, their product past the path tracer's paths per pixel.
+expect_error "method path: spp x light_samples (paths per pixel) is 16785409, more than 16777216" \
+  render "$mini" -o "$tmp/edge2.exr" --method path --spp 4097 --light-samples 4097
 for side in width height; do for bad in 0 16385; do
   expect_error "--$side: $integer 1 to 16384" render "$mini" -o "$tmp/edge2.exr" "--$side=$bad"; done; done
 for bad in "--light-samples=0" "--light-samples=65537"; do
@@ -252,6 +256,9 @@ expect_error "error: unknown command 'frobnicate' (the commands are render, comp
 # An unknown option is named before a missing command or argument.
 expect_error "error: unknown option --bogus (a command comes first: render, compare or info)" --bogus
 expect_error "error: unknown option --bogus" render --spp 2 --bogus
+# ... and after a complete command (CLI11 listed its words left over).
+expect_error "error: unknown option --bogus" render "$mini" -o "$tmp/edge2.exr" --bogus 3
+expect_error "error: unknown option --bogus" info "$mini" --bogus
 expect_error "--camera: the camera name is empty" info "$mini" --camera ""
 expect_error "--gpu: the device name is empty" render "$mini" -o "$tmp/edge2.exr" --gpu ""
 expect_error "--threads: must be an integer from 0 to 1024" render "$mini" -o "$tmp/edge2.exr" --threads 2000

@@ -314,7 +314,7 @@ TEST(DisneyBounds, EveryLobeBoundIsConservative) {
             const glm::vec3 mirror = 2.0f * glm::dot(n, to) * n - to;
             if (glm::dot(mirror, n) > 0.0f) wo = glm::normalize(mirror + 0.02f * random_unit(rng));
         }
-        const Kernel::SurfacePoint sp = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f));
+        const Kernel::SurfacePoint sp = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f), glm::vec4(0.0f));
         const glm::vec3 bound = k.lc_cluster_bound(
             sp, m, test::node_with_box(lo, hi, directional ? gpu::kLightDirectional : gpu::kLightPoint), min_distance2);
         ASSERT_TRUE(std::isfinite(bound.x) && std::isfinite(bound.y) && std::isfinite(bound.z)) << trial;
@@ -363,7 +363,7 @@ TEST(DisneyBounds, MirrorDirectionAtTheAlphaFloor) {
         const float cos_o = glm::dot(n, wo);
         if (cos_o < 0.05f) continue;
         const glm::vec3 wi = glm::normalize(2.0f * cos_o * n - wo);
-        const Kernel::SurfacePoint sp = k.lc_make_surface(glm::vec3(0.0f), n, wo, 0, glm::vec2(0.0f));
+        const Kernel::SurfacePoint sp = k.lc_make_surface(glm::vec3(0.0f), n, wo, 0, glm::vec2(0.0f), glm::vec4(0.0f));
         const glm::vec3 bound = k.lc_cluster_bound(sp, m, test::node_with_box(wi, wi, gpu::kLightDirectional), 1e-8f);
         glm::vec3 to;
         float t_max;
@@ -394,7 +394,7 @@ TEST(DisneyBounds, SaturatedTintKeepsTheFresnelBound) {
     const gpu::Material& m = materials[0];
     EXPECT_LE(k.lc_disney_spec0(m).z, 1.0f);
     const glm::vec3 n(0.0f, 0.0f, 1.0f), wo = glm::normalize(glm::vec3(1.0f, 0.0f, 1.0f));
-    const Kernel::SurfacePoint sp = k.lc_make_surface(glm::vec3(0.0f), n, wo, 0, glm::vec2(0.0f));
+    const Kernel::SurfacePoint sp = k.lc_make_surface(glm::vec3(0.0f), n, wo, 0, glm::vec2(0.0f), glm::vec4(0.0f));
     const glm::vec3 mirror(-1.0f, 0.0f, 1.0f);
     glm::vec3 wi;
     float t_max;

@@ -73,7 +73,7 @@ TEST(LightcutsBounds, EveryBoundIsConservative) {
         sp.p = x;
         sp.n = n;
         sp.wo = wo;
-        sp = k.lc_make_surface(sp.p, sp.n, sp.wo, 0, glm::vec2(0.0f));
+        sp = k.lc_make_surface(sp.p, sp.n, sp.wo, 0, glm::vec2(0.0f), glm::vec4(0.0f));
         glm::vec3 bound = k.lc_cluster_bound(
             sp, m, test::node_with_box(lo, hi, directional ? gpu::kLightDirectional : gpu::kLightPoint),
             min_distance2);
@@ -164,7 +164,7 @@ TEST(LightcutsBounds, PairOfChildErrorsIsTheScalarOneBitForBit) {
             wo = random_unit(rng);
             if (glm::dot(wo, n) < 0.0f) wo = -wo;
         }
-        const Kernel::SurfacePoint sp = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f));
+        const Kernel::SurfacePoint sp = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f), glm::vec4(0.0f));
         const float min_distance2 = u(rng) < 0.5f ? 1e-8f : 0.05f;
         glm::vec2 pair(-1.0f);
         const bool took = cpu::pair_errors(k, sp, m, nodes[0], nodes[1], min_distance2, pair);
@@ -535,7 +535,7 @@ TEST(BruteForce, ManyDimLightsBesideBrightOnesAllCount) {
     const gpu::FrameParams f = make_frame_params(p, o);
     Kernel k = cpu::make_shade_kernel(p);
     const Kernel::SurfacePoint sp =
-        k.lc_make_surface({-0.5f, 0.0f, 0.7f}, {0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0, glm::vec2(0.0f));
+        k.lc_make_surface({-0.5f, 0.0f, 0.7f}, {0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0, glm::vec2(0.0f), glm::vec4(0.0f));
     glm::dvec3 exact(0.0);
     for (std::uint32_t i = 0; i < f.light_count; ++i) {
         glm::vec3 wi;

@@ -33,7 +33,7 @@ struct Plane {
         sp.p = p;
         sp.n = glm::vec3(0, 1, 0);
         sp.wo = glm::vec3(0, 1, 0);
-        sp = k.lc_make_surface(sp.p, sp.n, sp.wo, 0, glm::vec2(0.0f));
+        sp = k.lc_make_surface(sp.p, sp.n, sp.wo, 0, glm::vec2(0.0f), glm::vec4(0.0f));
         glm::vec3 wi;
         float t_max;
         return k.lc_light_unit(sp, light, 1e-12f, wi, t_max) * glm::vec3(light.r, light.g, light.b);
@@ -130,7 +130,7 @@ TEST(EmissionBound, EveryBoundIsConservative) {
         sp.n = random_unit(rng);
         sp.wo = random_unit(rng);
         if (glm::dot(sp.wo, sp.n) < 0.0f) sp.wo = -sp.wo;
-        sp = k.lc_make_surface(sp.p, sp.n, sp.wo, 0, glm::vec2(0.0f));
+        sp = k.lc_make_surface(sp.p, sp.n, sp.wo, 0, glm::vec2(0.0f), glm::vec4(0.0f));
         const glm::vec3 bound = k.lc_cluster_bound(sp, materials[0], root, 1e-8f);
         ASSERT_TRUE(std::isfinite(bound.x) && std::isfinite(bound.y) && std::isfinite(bound.z));
         const bool cone_zero = k.lc_emission_bound(root, sp.p) == 0.0f;
@@ -316,7 +316,7 @@ Environment constant_map(std::uint32_t width, std::uint32_t height, float radian
 
 glm::dvec3 plane_radiance(const std::vector<gpu::Light>& lights, glm::vec3 p, glm::vec3 n = {0, 1, 0}) {
     Plane plane;
-    const Kernel::SurfacePoint sp = plane.k.lc_make_surface(p, n, n, 0, glm::vec2(0.0f));
+    const Kernel::SurfacePoint sp = plane.k.lc_make_surface(p, n, n, 0, glm::vec2(0.0f), glm::vec4(0.0f));
     glm::dvec3 sum(0.0);
     for (const gpu::Light& l : lights) {
         glm::vec3 wi;

@@ -25,7 +25,7 @@ Kernel::SurfacePoint random_point(Kernel& k, std::mt19937& rng, glm::vec3 x, boo
     const glm::vec3 n = test::random_unit(rng);
     glm::vec3 wo = test::random_unit(rng);
     if (glm::dot(wo, n) < 0.0f) wo = -wo;
-    Kernel::SurfacePoint s = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f));
+    Kernel::SurfacePoint s = k.lc_make_surface(x, n, wo, 0, glm::vec2(0.0f), glm::vec4(0.0f));
     const glm::vec3 kd(u(rng), u(rng), u(rng)), ks(u(rng), u(rng), u(rng));
     s.mat = u(rng) < 0.5f ? test::lambert(kd) : test::glossy(kd, ks, std::pow(10.0f, -3.0f * u(rng)));
     if (disney) {

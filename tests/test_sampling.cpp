@@ -95,7 +95,7 @@ TEST_P(TreeDescent, ProbabilitiesSumToOneAndAreTheProductOfTheBranches) {
         gpu::Material m = trial % 2 ? test::glossy({u(rng), u(rng), u(rng)}, glm::vec3(0.5f), 0.05f + u(rng))
                                     : test::lambert({u(rng), u(rng), u(rng)});
         p.scene.materials[0] = m;
-        sp = k.lc_make_surface(sp.p, sp.n, sp.wo, 0, glm::vec2(0.0f));
+        sp = k.lc_make_surface(sp.p, sp.n, sp.wo, 0, glm::vec2(0.0f), glm::vec4(0.0f));
 
         const std::vector<double> prob = enumerate_probabilities(k, sp, f, tree);
         double sum = 0.0;
@@ -153,7 +153,7 @@ TEST(TreeDescent, DrawFrequenciesFollowTheProbabilities) {
     RenderOptions o = test::options("sampled", 8);
     const gpu::FrameParams f = make_frame_params(p, o);
     Kernel k = cpu::make_shade_kernel(p, nullptr);
-    const Kernel::SurfacePoint sp = k.lc_make_surface({0.1f, 0.02f, 0.2f}, {0.0f, 1.0f, 0.0f}, glm::normalize(glm::vec3(0.3f, 1.0f, 0.2f)), 0, glm::vec2(0.0f));
+    const Kernel::SurfacePoint sp = k.lc_make_surface({0.1f, 0.02f, 0.2f}, {0.0f, 1.0f, 0.0f}, glm::normalize(glm::vec3(0.3f, 1.0f, 0.2f)), 0, glm::vec2(0.0f), glm::vec4(0.0f));
     const std::vector<double> prob = enumerate_probabilities(k, sp, f, p.tree);
     constexpr std::uint32_t kDraws = 1u << 18;
     std::vector<double> count(prob.size(), 0.0);
@@ -177,7 +177,7 @@ TEST(TreeDescent, UniformPickGivesEveryLightTheSameProbability) {
     o.light_pick = "uniform";
     const gpu::FrameParams f = make_frame_params(p, o);
     Kernel k = cpu::make_shade_kernel(p, nullptr);
-    const Kernel::SurfacePoint sp = k.lc_make_surface({0.0f, 0.5f, 0.0f}, {0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0, glm::vec2(0.0f));
+    const Kernel::SurfacePoint sp = k.lc_make_surface({0.0f, 0.5f, 0.0f}, {0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0, glm::vec2(0.0f), glm::vec4(0.0f));
     std::vector<int> seen(p.tree.lights.size(), 0);
     for (std::uint32_t s = 0; s < 4000; ++s) {
         float pdf;
@@ -208,7 +208,7 @@ TEST(TreeDescent, LightsFarDimmerThanTheirSiblingsKeepAProbability) {
         f.light_pick = pick;
         Kernel k = cpu::make_shade_kernel(p, nullptr);
         const Kernel::SurfacePoint sp =
-            k.lc_make_surface({0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0, glm::vec2(0.0f));
+            k.lc_make_surface({0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0, glm::vec2(0.0f), glm::vec4(0.0f));
         const std::vector<double> prob = enumerate_probabilities(k, sp, f, p.tree);
         ASSERT_EQ(prob.size(), 3u);
         double sum = 0.0;
@@ -237,7 +237,7 @@ TEST(TreeDescent, RootsOfHugeWeightsKeepTheirShares) {
     PreparedScene p = prepare_scene(test::room_scene(lights, 8), 1);
     gpu::FrameParams f = make_frame_params(p, test::options("sampled", 8));
     Kernel k = cpu::make_shade_kernel(p, nullptr);
-    const Kernel::SurfacePoint sp = k.lc_make_surface({0, 0, 0}, {0, 1, 0}, {0, 1, 0}, 0, glm::vec2(0.0f));
+    const Kernel::SurfacePoint sp = k.lc_make_surface({0, 0, 0}, {0, 1, 0}, {0, 1, 0}, 0, glm::vec2(0.0f), glm::vec4(0.0f));
     double sum = 0.0;
     for (const std::uint32_t type : {gpu::kLightPoint, gpu::kLightSpot, gpu::kLightOriented}) {
         const float probability = k.lc_root_probability(sp, f, type, gpu::kLightPickPower);

@@ -30,7 +30,7 @@ TEST(ShadingGgx, NormalIncidenceRadianceIsAnalytic) {
         sp.p = glm::vec3(0.0f);
         sp.n = glm::vec3(0, 0, 1);
         sp.wo = glm::vec3(0, 0, 1);
-        sp = k.lc_make_surface(sp.p, sp.n, sp.wo, 0, glm::vec2(0.0f));
+        sp = k.lc_make_surface(sp.p, sp.n, sp.wo, 0, glm::vec2(0.0f), glm::vec4(0.0f));
         const glm::vec3 irradiance(2.0f, 3.0f, 5.0f);
         glm::vec3 wi;
         float t_max;

@@ -1,6 +1,7 @@
 // Textures (shaders/shared/textures.h, host/scene/textures.h): lookups
 // against hand-made textures with known texels (texel centres, bilinear
-// weights, wrapping, sRGB decoding), the material at a point, normal maps,
+// weights, wrapping, sRGB decoding), mipmap chains and the levels a ray
+// cone's footprint reads, the material at a point, normal maps,
 // MTL texture maps and their errors, textured area lights, and a textured
 // plane rendered against its closed form.
 #include <algorithm>
@@ -200,6 +201,128 @@ TEST(TextureLookup, SrgbDecodedPerTexelBeforeFiltering) {
     EXPECT_NEAR(k.lc_texture_sample(tex, {0.25f, 0.5f}, false).x, 188.0 / 255.0, 1e-6);
 }
 
+// Mipmap chains (loader::add_mipmaps): each level's texels the box-filtered
+// mean of the level above's, colour averaged as linear values.
+double linear_to_srgb(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055; }
+
+std::uint32_t byte_of(double v) { return std::uint32_t(std::lround(std::clamp(v, 0.0, 1.0) * 255.0)); }
+
+TEST(Mipmaps, LevelsAreBoxFilteredMeansOfTheLevelAbove) {
+    TextureScene t;
+    // A 4 x 4 checker of sRGB 255 and 0 (alpha 0 and 255) as base colour;
+    // a 5 x 1 row as a metallic-roughness map (linear); a third image no
+    // material reads; a fourth whose sampler asks for no mipmaps.
+    std::vector<std::uint32_t> checker(16);
+    for (std::uint32_t i = 0; i < 16; ++i)
+        checker[i] = (i % 4 + i / 4) % 2 == 0 ? rgba(255, 255, 255, 0) : rgba(0, 0, 0, 255);
+    const std::uint32_t colour = t.add(4, 4, checker);
+    const std::uint32_t row = t.add(5, 1, {rgba(0, 0, 0), rgba(50, 0, 0), rgba(100, 0, 0), rgba(150, 0, 0), rgba(255, 0, 0)});
+    const std::uint32_t unused = t.add(2, 2, kTwoByTwo);
+    loader::TextureSampling without;
+    without.mipmaps = false;
+    const std::uint32_t plain = loader::sampled_texture(t.scene, t.add(2, 2, kTwoByTwo), without);
+    gpu::Material m = loader::make_material(glm::vec3(1.0f), glm::vec3(0.0f), 1.0f);
+    loader::set_texture(m, &gpu::Material::base_color_texture, colour);
+    loader::set_texture(m, &gpu::Material::metallic_roughness_texture, row);
+    loader::set_texture(m, &gpu::Material::normal_texture, plain);
+    t.scene.materials = {m};
+    const std::size_t base = t.scene.texels.size();
+    loader::add_mipmaps(t.scene);
+    // 2 x 2 + 1 x 1 for the checker, 2 x 1 + 1 x 1 for the row.
+    ASSERT_EQ(t.scene.texels.size(), base + 5 + 3);
+    for (const std::uint32_t none : {unused, plain})
+        EXPECT_EQ(t.scene.textures[none].sampling & gpu::kTextureMipmapped, 0u) << none;
+    const gpu::TextureInfo& c = t.scene.textures[colour];
+    ASSERT_NE(c.sampling & gpu::kTextureMipmapped, 0u);
+    // Every 2 x 2 block holds two of each: linear 0.5, stored as sRGB;
+    // alpha as it is. Level 2 is the mean of level 1.
+    const std::uint32_t half = byte_of(linear_to_srgb(0.5));
+    for (std::uint32_t i = 0; i < 5; ++i)
+        EXPECT_EQ(t.scene.texels[c.mip_offset + i], rgba(half, half, half, 128)) << "texel " << i;
+    // The row, 5 texels into 2: weights 0.4, 0.4, 0.2 and 0.2, 0.4, 0.4.
+    const gpu::TextureInfo& r = t.scene.textures[row];
+    ASSERT_NE(r.sampling & gpu::kTextureMipmapped, 0u);
+    const double left = (0.4 * 0 + 0.4 * 50 + 0.2 * 100) / 255.0, right = (0.2 * 100 + 0.4 * 150 + 0.4 * 255) / 255.0;
+    EXPECT_EQ(t.scene.texels[r.mip_offset], rgba(byte_of(left), 0, 0));
+    EXPECT_EQ(t.scene.texels[r.mip_offset + 1], rgba(byte_of(right), 0, 0));
+    EXPECT_EQ(t.scene.texels[r.mip_offset + 2], rgba(byte_of((byte_of(left) + byte_of(right)) / 510.0), 0, 0));
+}
+
+// The level a lookup reads follows its footprint: under a texel, level 0
+// as the sampler says; a texel of level l wide, level l; between two
+// levels, a blend; wider than the image, its mean. A transform that
+// stretches the coordinates stretches the footprint. A footprint longer
+// than it is wide averages lookups along its long axis.
+TEST(Mipmaps, FootprintPicksTheLevel) {
+    TextureScene t;
+    std::vector<std::uint32_t> texels(16);
+    for (std::uint32_t i = 0; i < 16; ++i) texels[i] = rgba(16 * i, 255 - 16 * i, (i * 97) % 256, 255);
+    const std::uint32_t tex = t.add(4, 4, texels);
+    loader::TextureSampling doubled;
+    doubled.uv_transform = {2.0f, 0.0f, 0.0f, 0.0f, 2.0f, 0.0f};
+    const std::uint32_t stretched = loader::sampled_texture(t.scene, tex, doubled);
+    gpu::Material m = loader::make_material(glm::vec3(1.0f), glm::vec3(0.0f), 1.0f);
+    loader::set_texture(m, &gpu::Material::metallic_roughness_texture, tex);
+    loader::set_texture(m, &gpu::Material::normal_texture, stretched);
+    t.scene.materials = {m};
+    loader::add_mipmaps(t.scene);
+    cpu::TextureKernel& k = t.kernel();
+    const gpu::TextureInfo& info = t.scene.textures[tex];
+    ASSERT_EQ(t.scene.textures[stretched].mip_offset, info.mip_offset);
+    const auto level_texel = [&](std::uint32_t offset) { return unpack(t.scene.texels[offset]); };
+    // A round footprint `width` across, in texture coordinates.
+    const auto round = [](float width) { return glm::vec4(width, 0.0f, 0.0f, width); };
+    const glm::vec2 uv(0.25f, 0.25f);  // level 1's first texel centre
+    const glm::vec4 full = k.lc_texture_sample(tex, uv, false);
+    expect_vec4_near(k.lc_texture_sample(tex, uv, false, round(0.25f)), full, 0.0f, "a texel wide: level 0");
+    expect_vec4_near(k.lc_texture_sample(tex, uv, false, round(std::nanf(""))), full, 0.0f, "NaN: level 0");
+    expect_vec4_near(k.lc_texture_sample(tex, uv, false, round(0.5f)), level_texel(info.mip_offset), 1e-6f, "level 1");
+    const glm::vec4 mean = level_texel(info.mip_offset + 4);
+    expect_vec4_near(k.lc_texture_sample(tex, uv, false, round(1.0f)), mean, 1e-6f, "the image wide: level 2");
+    expect_vec4_near(k.lc_texture_sample(tex, uv, false, round(1e30f)), mean, 1e-6f, "wider: level 2");
+    expect_vec4_near(k.lc_texture_sample(tex, uv, false, round(std::exp2(-0.25f))),
+                     0.25f * level_texel(info.mip_offset) + 0.75f * mean, 1e-6f, "three quarters to level 2");
+    // Doubled coordinates: (0.125, 0.125) is (0.25, 0.25), and a footprint
+    // of a quarter there is one of a half, level 1.
+    expect_vec4_near(k.lc_texture_sample(stretched, uv * 0.5f, false, round(0.25f)), level_texel(info.mip_offset),
+                     1e-6f, "stretched: level 1");
+    // Two texels long, half a texel wide: two bilinear lookups at level 0,
+    // a texel apart along the long axis (here v: the axes are taken in
+    // either order).
+    const glm::vec2 p(0.4f, 0.45f);
+    expect_vec4_near(k.lc_texture_sample(tex, p, false, glm::vec4(0.0f, 0.125f, 0.5f, 0.0f)),
+                     0.5f * (k.lc_texture_sample(tex, p - glm::vec2(0.125f, 0.0f), false) +
+                             k.lc_texture_sample(tex, p + glm::vec2(0.125f, 0.0f), false)),
+                     1e-6f, "anisotropic");
+}
+
+// A ray cone's footprint in texture coordinates: across the ray the cone's
+// width, along it the width over the cosine, mapped by the triangle's
+// texture coordinates.
+TEST(Mipmaps, ConeFootprintOnATriangle) {
+    TextureScene t;
+    cpu::TextureKernel& k = t.kernel();
+    // u = x / 2 and v = z / 4 on the plane y = 0.
+    const gpu::TriangleUvs uvs{0, 0, 1, 0, 0, 1};
+    const glm::vec3 v0(0, 0, 0), v1(2, 0, 0), v2(0, 0, 4);
+    const auto expect_near = [](glm::vec4 got, glm::vec4 want, const char* what) {
+        for (int c = 0; c < 4; ++c) EXPECT_NEAR(got[c], want[c], 1e-6f) << what << " " << c;
+    };
+    // Head on, a circle (its axes' directions are the triangle's choice).
+    const glm::vec4 down = k.lc_uv_footprint(0.5f, {0, -1, 0}, v0, v1, v2, uvs);
+    EXPECT_NEAR(std::hypot(2.0f * down.x, 4.0f * down.y), 0.5f, 1e-6f);
+    EXPECT_NEAR(std::hypot(2.0f * down.z, 4.0f * down.w), 0.5f, 1e-6f);
+    // At 60 degrees in the x-y plane: twice as long along x; across, z.
+    const float s60 = std::sqrt(3.0f) / 2.0f;
+    const glm::vec4 slanted = k.lc_uv_footprint(0.5f, {s60, -0.5f, 0}, v0, v1, v2, uvs);
+    expect_near(glm::abs(slanted), glm::vec4(0.5f, 0.0f, 0.0f, 0.125f), "60 degrees");
+    // Edge-on the stretch stops at 1000 times.
+    const glm::vec4 grazing = k.lc_uv_footprint(0.5f, {1, 0, 0}, v0, v1, v2, uvs);
+    EXPECT_NEAR(std::abs(grazing.x), 250.0f, 1e-3f);
+    // Degenerate texture coordinates: no footprint at all (level 0).
+    EXPECT_EQ(k.lc_uv_footprint(0.5f, {0, -1, 0}, v0, v1, v2, gpu::TriangleUvs{}), glm::vec4(0.0f));
+}
+
 TEST(TextureLookup, MaterialAtAppliesEveryTexture) {
     TextureScene t;
     const std::uint32_t colour = t.add(1, 1, {rgba(188, 255, 0)});
@@ -215,7 +338,7 @@ TEST(TextureLookup, MaterialAtAppliesEveryTexture) {
     loader::set_texture(m, &gpu::Material::metallic_roughness_texture, mr);
     loader::set_texture(m, &gpu::Material::emissive_texture, glow);
     t.scene.materials = {m};
-    const gpu::Material at = t.kernel().lc_material_at(0, {0.3f, 0.7f});
+    const gpu::Material at = t.kernel().lc_material_at(0, {0.3f, 0.7f}, glm::vec4(0.0f));
     const double c188 = srgb_to_linear(188.0 / 255.0);
     EXPECT_NEAR(at.kd_r, 0.5 * c188, 1e-6);
     EXPECT_NEAR(at.kd_g, 0.8, 1e-6);
@@ -228,7 +351,7 @@ TEST(TextureLookup, MaterialAtAppliesEveryTexture) {
     EXPECT_EQ(at.emission_b, 0.0f);
     // A black roughness texel cannot take alpha below the floor.
     t.scene.texels[t.scene.textures[mr].offset] = rgba(0, 0, 0);
-    EXPECT_EQ(t.kernel().lc_material_at(0, {0.3f, 0.7f}).alpha, 1e-3f);
+    EXPECT_EQ(t.kernel().lc_material_at(0, {0.3f, 0.7f}, glm::vec4(0.0f)).alpha, 1e-3f);
 }
 
 // A triangle in the z = 0 plane facing +z, u along +x and v along -y (v
@@ -246,7 +369,7 @@ struct NormalMapCase {
         loader::set_texture(m, &gpu::Material::normal_texture, tex);
         m.normal_scale = scale;
         t.scene.materials = {m};
-        return t.kernel().lc_normal_mapped(m, {0.3f, 0.4f}, {0, 0, 1}, v0, v1, v2, uvs);
+        return t.kernel().lc_normal_mapped(m, {0.3f, 0.4f}, glm::vec4(0.0f), {0, 0, 1}, v0, v1, v2, uvs);
     }
 };
 
@@ -516,6 +639,10 @@ TEST(TextureLimits, OversizedOrTruncatedImagesAreRefusedFromTheirHeaders) {
     // header chunk.
     EXPECT_EQ(problem(png_header(100000, 100000)),
               "is 100000 x 100000 texels, more than the 134217728 that textures may hold in all");
+    // Few texels, but a side longer than stb_image decodes (which it
+    // reports only as "too large").
+    EXPECT_EQ(problem(png_header(33554432, 1)),
+              "is 33554432 x 1 texels, more than the 16777216 a side that the image decoder reads");
     // Cut between chunks (stb_image's reason named the last chunk type it
     // read, bytes of the file): the IHDR chunk and nothing after it.
     EXPECT_EQ(problem(small.substr(0, 8 + 25)),
@@ -720,7 +847,7 @@ TEST(TexturedAreaLights, SmallBrightFeaturesAreFoundThroughTheSampler) {
 // its textures repeat (before, relative RMSE 0.36 against the same quad at
 // 0). Where a texture clamps, nothing moves: clamped, u = 1e6 is u = 1.
 TEST(TexturedRender, FarTextureCoordinatesKeepTheirDetail) {
-    const auto render = [](float shift, bool clamp, bool u_at_one = false) {
+    const auto render = [](float shift, bool clamp, bool u_past_one = false) {
         Scene s;
         std::vector<std::uint32_t> texels(64 * 64);
         for (std::size_t i = 0; i < texels.size(); ++i) texels[i] = rgba(std::uint32_t(i * 37 % 256), 128, 255);
@@ -734,7 +861,9 @@ TEST(TexturedRender, FarTextureCoordinatesKeepTheirDetail) {
         s.uvs = {{0, 0, 0, 1, 1, 1}, {0, 0, 1, 1, 1, 0}};
         for (gpu::TriangleUvs& uv : s.uvs) {
             for (float* c : {&uv.u0, &uv.u1, &uv.u2, &uv.v0, &uv.v1, &uv.v2}) *c += shift;
-            if (u_at_one) uv.u0 = uv.u1 = uv.u2 = 1.0f;
+            // Past 1 by up to a period, the same area in texture space
+            // (and so the same mipmap levels).
+            if (u_past_one) uv.u0 += 1.0f, uv.u1 += 1.0f, uv.u2 += 1.0f;
         }
         s.lights = {test::directional_light({0, -1, 0}, glm::vec3(3.0f))};
         s.camera = test::camera({0, 4, 0}, {0, 0, 0}, float(2.0 * std::atan(0.25) * 180.0 / 3.14159265358979), 32, 32);
@@ -750,7 +879,8 @@ TEST(TexturedRender, FarTextureCoordinatesKeepTheirDetail) {
             ASSERT_EQ(far.rgb[i], near.rgb[i]) << "pixel " << i / 3 << " with the coordinates moved by " << shift;
     }
     // Clamped in u, the far quad reads the texture's last column (u = 1)
-    // everywhere, and v, which repeats, as near the origin.
+    // everywhere, and v, which repeats, as near the origin: as the near
+    // quad does with u from 1 to 2.
     const Image clamped = render(999998.0f, true);
     EXPECT_NE(clamped.rgb, near.rgb);
     EXPECT_EQ(clamped.rgb, render(0.0f, true, true).rgb);
@@ -798,6 +928,86 @@ TEST(TexturedRender, PlaneShowsItsTextureOnBothHalves) {
         }
     EXPECT_GT(white, 10);
     EXPECT_GT(black, 10);
+}
+
+// A plane seen from above with a one-texel checker of black and white,
+// 15.6 texels to a pixel: with mipmaps every pixel is the checker's mean
+// (linear 0.5, stored as sRGB 188: 0.5029); read at full resolution, one
+// bilinear lookup a pixel, the pixels alias between black and white.
+TEST(TexturedRender, DistantCheckerIsItsMeanWithMipmaps) {
+    const auto render = [](bool mipmaps) {
+        Scene s;
+        constexpr std::uint32_t kSize = 250;
+        std::vector<std::uint32_t> texels(kSize * kSize);
+        for (std::uint32_t i = 0; i < texels.size(); ++i)
+            texels[i] = (i % kSize + i / kSize) % 2 == 0 ? rgba(255, 255, 255) : rgba(0, 0, 0);
+        const std::uint32_t image = loader::add_texture(s, kSize, kSize, rgba_bytes(texels).data(), "test", "texture");
+        loader::TextureSampling sampling;
+        sampling.mipmaps = mipmaps;
+        gpu::Material m = loader::make_material(glm::vec3(0.5f), glm::vec3(0.0f), 1.0f);
+        loader::set_texture(m, &gpu::Material::base_color_texture, loader::sampled_texture(s, image, sampling));
+        s.materials = {m};
+        test::add_quad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0);
+        s.uvs = {{0, 0, 0, 1, 1, 1}, {0, 0, 1, 1, 1, 0}};
+        s.lights = {test::directional_light({0, -1, 0}, glm::vec3(3.0f))};
+        s.camera = test::camera({0, 4, 0}, {0, 0, 0}, float(2.0 * std::atan(0.25) * 180.0 / 3.14159265358979), 16, 16);
+        s.camera.up = {0, 0, -1};
+        update_bounds(s);
+        return render_cpu(prepare_scene(std::move(s), 1), test::options("brute", 16)).image;
+    };
+    const float mean = 0.5f * 3.0f / 3.14159265f * float(srgb_to_linear(188.0 / 255.0));
+    const auto spread = [&](const Image& image) {
+        float lo = INFINITY, hi = -INFINITY;
+        for (std::uint32_t y = 0; y < 16; ++y)
+            for (std::uint32_t x = 0; x < 16; ++x) {
+                lo = std::min(lo, image.at(x, y).x);
+                hi = std::max(hi, image.at(x, y).x);
+            }
+        return std::pair(lo, hi);
+    };
+    const auto [lo, hi] = spread(render(true));
+    EXPECT_NEAR(lo, mean, 1e-5f * mean);
+    EXPECT_NEAR(hi, mean, 1e-5f * mean);
+    const auto [alias_lo, alias_hi] = spread(render(false));
+    EXPECT_GT(alias_hi - alias_lo, mean) << "without mipmaps, the pixels alias";
+}
+
+// A single plane lets the Vulkan kernels leave shadow rays out
+// (PreparedScene::has_occluders false), unless a normal map bends its
+// shading normals: then a light behind it can pass the cosine, and only
+// the plane's shadow ray blocks it (tests/vulkan: tilted normals).
+TEST(NormalMap, PlaneWithANormalMapCanShadow) {
+    for (const bool mapped : {false, true}) {
+        Scene s;
+        gpu::Material m = loader::make_material(glm::vec3(0.5f), glm::vec3(0.0f), 1.0f);
+        if (mapped)
+            loader::set_texture(m, &gpu::Material::normal_texture,
+                                loader::add_texture(s, 2, 2, rgba_bytes(kTwoByTwo).data(), "test", "texture"));
+        s.materials = {m};
+        test::add_quad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0);
+        s.uvs = {{0, 0, 0, 1, 1, 1}, {0, 0, 1, 1, 1, 0}};
+        s.lights = {test::directional_light({0, -1, 0}, glm::vec3(3.0f))};
+        s.camera = test::camera({0, 4, 0}, {0, 0, 0}, 40.0f, 8, 8);
+        s.camera.up = {0, 0, -1};
+        update_bounds(s);
+        EXPECT_EQ(prepare_scene(std::move(s), 1).has_occluders, mapped);
+    }
+}
+
+// The cone's angle is a pixel's, over the side of its grid of samples.
+TEST(Mipmaps, PixelSpreadFollowsTheFieldOfViewAndTheSamples) {
+    Scene s;
+    s.materials = {loader::make_material(glm::vec3(0.5f), glm::vec3(0.0f), 1.0f)};
+    test::add_quad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0);
+    s.lights = {test::directional_light({0, -1, 0}, glm::vec3(3.0f))};
+    s.camera = test::camera({0, 4, 0}, {0, 0, 0}, 90.0f, 64, 32);
+    s.camera.up = {0, 0, -1};
+    update_bounds(s);
+    const PreparedScene p = prepare_scene(std::move(s), 1);
+    RenderOptions o = test::options("brute", 0);
+    EXPECT_FLOAT_EQ(make_frame_params(p, o).pixel_spread, 2.0f / 32.0f);
+    o.spp = 16;
+    EXPECT_FLOAT_EQ(make_frame_params(p, o).pixel_spread, 2.0f / 32.0f / 4.0f);
 }
 
 }  // namespace

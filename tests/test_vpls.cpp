@@ -205,7 +205,7 @@ TEST(Vpls, ClampBoundsOneVplsContribution) {
     sp.p = glm::vec3(0.02f, 0.0f, 0.0f);
     sp.n = glm::vec3(0, 1, 0);
     sp.wo = sp.n;
-    sp = k.lc_make_surface(sp.p, sp.n, sp.wo, 0, glm::vec2(0.0f));
+    sp = k.lc_make_surface(sp.p, sp.n, sp.wo, 0, glm::vec2(0.0f), glm::vec4(0.0f));
     glm::vec3 wi;
     float t_max;
     k.vpl_min_distance2 = 0.0f;

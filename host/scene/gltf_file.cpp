@@ -82,6 +82,13 @@ std::string decoded_uri(const std::string& uri) {
     return out;
 }
 
+// A glTF's images as the JSON names them, before tinygltf decodes them.
+struct GltfImages {
+    std::vector<std::string> uris;  // the file each names; "" for a data URI or a buffer view
+    std::vector<bool> used;         // whether a material reads a texture of the image
+    std::uint64_t texels = 0;       // of the used images decoded so far, from their headers
+};
+
 // The file tinygltf 2.7 opens for a buffer's or an image's URI: the decoded
 // URI after the base folder and a '/', even when the URI is absolute.
 fs::path uri_file(const std::string& base, const std::string& uri) {
@@ -96,17 +103,44 @@ fs::path uri_file(const std::string& base, const std::string& uri) {
 // not found"; a missing image is refused here, used or not (tinygltf would
 // only warn, and a texture of it fail without naming the file). JSON that
 // does not parse is left to tinygltf's message. Returns each image's uri
-// ("" for a data URI or a buffer view), for load_image_checked's messages.
-std::vector<std::string> check_uri_files(std::string_view json, const std::string& base, const std::string& name) {
-    std::vector<std::string> image_uris;
+// ("" for a data URI or a buffer view) and whether a material reads it, for
+// load_image_checked.
+GltfImages check_uri_files(std::string_view json, const std::string& base, const std::string& name) {
+    GltfImages out;
+    std::vector<std::string>& image_uris = out.uris;
     const nlohmann::json doc = nlohmann::json::parse(json.begin(), json.end(), nullptr, false);
-    if (doc.is_discarded() || !doc.is_object()) return image_uris;
+    if (doc.is_discarded() || !doc.is_object()) return out;
     if (const auto images = doc.find("images"); images != doc.end() && images->is_array())
         for (const nlohmann::json& image : *images) {
             const auto uri = image.is_object() ? image.find("uri") : image.end();
             const bool named = image.is_object() && uri != image.end() && uri->is_string() &&
                                !tinygltf::IsDataURI(uri->get_ref<const std::string&>());
             image_uris.push_back(named ? uri->get<std::string>() : std::string());
+        }
+    // The images of the textures that the materials' read slots name
+    // (gltf_materials.cpp; an occlusion texture, say, is not read).
+    out.used.assign(image_uris.size(), false);
+    const auto member = [](const nlohmann::json& object, const char* key) -> const nlohmann::json* {
+        if (!object.is_object()) return nullptr;
+        const auto found = object.find(key);
+        return found != object.end() ? &*found : nullptr;
+    };
+    const nlohmann::json* textures = member(doc, "textures");
+    const nlohmann::json* materials = member(doc, "materials");
+    if (textures != nullptr && textures->is_array() && materials != nullptr && materials->is_array())
+        for (const nlohmann::json& material : *materials) {
+            const nlohmann::json* pbr = member(material, "pbrMetallicRoughness");
+            for (const nlohmann::json* info :
+                 {pbr ? member(*pbr, "baseColorTexture") : nullptr, pbr ? member(*pbr, "metallicRoughnessTexture") : nullptr,
+                  member(material, "normalTexture"), member(material, "emissiveTexture")}) {
+                const nlohmann::json* texture = info ? member(*info, "index") : nullptr;
+                if (texture == nullptr || !texture->is_number_unsigned() ||
+                    texture->get<std::uint64_t>() >= textures->size())
+                    continue;
+                const nlohmann::json* source = member((*textures)[texture->get<std::size_t>()], "source");
+                if (source != nullptr && source->is_number_unsigned() && source->get<std::uint64_t>() < out.used.size())
+                    out.used[source->get<std::size_t>()] = true;
+            }
         }
     for (const char* list : {"buffers", "images"}) {
         const auto entries = doc.find(list);
@@ -129,25 +163,36 @@ std::vector<std::string> check_uri_files(std::string_view json, const std::strin
                              "'" + text + "' " + (problem == kFileNotFound ? "not found next to the glTF" : problem));
         }
     }
-    return image_uris;
+    return out;
 }
 
 // tinygltf's own image loader (stb_image) after a look at the image's
-// header: one larger than the scene's textures may hold is refused before
-// its pixels are allocated (encoded_image_problem).
-// An image that stb_image cannot decode is named with stb's reason (tinygltf
-// says "Unknown image format" for all of them); `user_data` is
-// check_uri_files' list of the images' uris.
+// header: one larger than the scene's textures may hold, or one that would
+// take the images the materials read past that together, is refused before
+// its pixels are allocated (encoded_image_problem). An image no material
+// reads is not decoded. An image that stb_image cannot decode is named with
+// stb's reason (tinygltf says "Unknown image format" for all of them);
+// `user_data` is check_uri_files' GltfImages.
 bool load_image_checked(tinygltf::Image* image, const int index, std::string* err, std::string* warn,
                         int req_width, int req_height, const unsigned char* bytes, int size, void* user_data) {
-    const auto& uris = *static_cast<const std::vector<std::string>*>(user_data);
-    const std::string uri = index >= 0 && std::size_t(index) < uris.size() && !uris[std::size_t(index)].empty()
-                                ? " ('" + uris[std::size_t(index)] + "')"
-                                : std::string();
+    GltfImages& images = *static_cast<GltfImages*>(user_data);
+    const std::vector<std::string>& uris = images.uris;
+    const bool known = index >= 0 && std::size_t(index) < uris.size();
+    const std::string uri = known && !uris[std::size_t(index)].empty() ? " ('" + uris[std::size_t(index)] + "')"
+                                                                       : std::string();
     const std::size_t size_bytes = std::size_t(std::max(size, 0));
-    const std::string problem = encoded_image_problem(bytes, size_bytes);
+    std::uint64_t texels = 0;
+    const std::string problem = encoded_image_problem(bytes, size_bytes, &texels);
     if (!problem.empty()) {
         if (err != nullptr) *err += "images[" + std::to_string(index) + "]" + uri + " " + problem + "\n";
+        return false;
+    }
+    if (known && !images.used[std::size_t(index)]) return true;
+    images.texels += texels;
+    if (images.texels > kMaxTexels) {
+        if (err != nullptr)
+            *err += "images[" + std::to_string(index) + "]" + uri + ": the images the materials read would hold more than " +
+                    std::to_string(kMaxTexels) + " texels in all\n";
         return false;
     }
     const std::size_t before = err != nullptr ? err->size() : 0;
@@ -216,13 +261,13 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
     }
     if (too_deep(json)) throw InputError(name, "", "JSON nested more than " + std::to_string(kMaxJsonDepth) + " levels deep");
     const std::string base = file.parent_path().empty() ? std::string(".") : file.parent_path().string();
-    std::vector<std::string> image_uris = check_uri_files(json, base, name);
+    GltfImages images = check_uri_files(json, base, name);
     // Before tinygltf, whose messages for a value of the wrong JSON type
     // name neither the value nor where it is.
     check_gltf_types(json, name);
 
     tinygltf::TinyGLTF gltf;
-    gltf.SetImageLoader(load_image_checked, &image_uris);
+    gltf.SetImageLoader(load_image_checked, &images);
     GltfFolder folder{base.back() == '/' ? base : base + "/"};
     gltf.SetFsCallbacks({gltf_file_exists, gltf_expand_path, gltf_read_file, gltf_write_file, &folder});
     tinygltf::Model model;

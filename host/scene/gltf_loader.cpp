@@ -315,12 +315,12 @@ private:
 
     // A direction of the node's frame in world space, normalised; `what`
     // names it for the error when the transform collapses it.
-    glm::vec3 direction(const glm::dmat4& world, glm::dvec3 local, const std::string& field, const char* what) const {
+    glm::dvec3 direction(const glm::dmat4& world, glm::dvec3 local, const std::string& field, const char* what) const {
         const glm::dvec3 d = glm::dmat3(world) * local;
         const double length = glm::length(d);
         if (!(length > 0.0) || !std::isfinite(length))
             fail(field, std::string("the node's transform leaves no usable ") + what + " direction");
-        return glm::vec3(d / length);
+        return d / length;
     }
 
     // kGltfImageHeight rows and aspect times as many columns (as many rows
@@ -357,17 +357,26 @@ private:
             notes_.add(name, "camera type \"" + cam.type + "\" is skipped (only perspective cameras are read)");
             return;
         }
-        const double yfov = cam.perspective.yfov * 180.0 / 3.14159265358979323846;
-        if (!(yfov > 0.0 && yfov < 180.0)) fail(name + ".perspective.yfov", "must be in (0, pi)");
-        // 0 where the file has none (check_gltf_types refuses a 0 it has).
+        // In degrees and as the float the camera keeps: a yfov just inside
+        // (0, pi) may round to 0 or 180 degrees. 0 where the file has none
+        // (check_gltf_types refuses a 0 it has).
+        const float yfov = float(cam.perspective.yfov * 180.0 / 3.14159265358979323846);
+        if (!(yfov > 0.0f && yfov < 180.0f))
+            fail(name + ".perspective.yfov", "must be in (0, pi), and not so near either end that it rounds to it "
+                                             "as a float (" + std::to_string(cam.perspective.yfov) + ")");
         Camera c;
-        c.position = glm::vec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
+        const glm::dvec3 position(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
+        c.position = glm::vec3(position);
         if (!is_finite(c.position)) fail(node, "the camera's position is not finite");
-        c.look_at = c.position + direction(world, {0.0, 0.0, -1.0}, node, "view");
-        c.up = direction(world, {0.0, 1.0, 0.0}, node, "up");
-        if (!(glm::length(glm::cross(c.look_at - c.position, c.up)) > 1e-6f))
+        const glm::dvec3 view = direction(world, {0.0, 0.0, -1.0}, node, "view");
+        const glm::dvec3 up = direction(world, {0.0, 1.0, 0.0}, node, "up");
+        if (!(glm::length(glm::cross(view, up)) > 1e-6))
             fail(node, "the camera's up is parallel to its view direction");
-        c.fov_y_degrees = float(yfov);
+        // As far along the view as the camera is from the origin: a point
+        // a unit away from a far camera would round its direction away.
+        c.look_at = glm::vec3(position + view * std::max(1.0, glm::length(position)));
+        c.up = glm::vec3(up);
+        c.fov_y_degrees = yfov;
         image_size(cam.perspective.aspectRatio, name, c);
         contents_.cameras.push_back({cam.name, c});
     }
@@ -397,11 +406,11 @@ private:
         if (l.type == "point") {
             light = point_light(position, glm::vec3(value));
         } else if (l.type == "directional") {
-            light = directional_light(direction(world, {0.0, 0.0, -1.0}, field, "light"), glm::vec3(value), problem);
+            light = directional_light(glm::vec3(direction(world, {0.0, 0.0, -1.0}, field, "light")), glm::vec3(value), problem);
         } else if (l.type == "spot") {
             constexpr double kDegrees = 180.0 / 3.14159265358979323846;
             const double inner = l.spot.innerConeAngle * kDegrees, outer = l.spot.outerConeAngle * kDegrees;
-            light = spot_light(position, direction(world, {0.0, 0.0, -1.0}, field, "light"), glm::vec3(value),
+            light = spot_light(position, glm::vec3(direction(world, {0.0, 0.0, -1.0}, field, "light")), glm::vec3(value),
                                float(inner), float(outer), problem);
             if (problem.field == "outer_cone_degrees") fail(name + ".spot.outerConeAngle", "must be from 0 to pi/2");
             if (problem.field == "inner_cone_degrees") fail(name + ".spot.innerConeAngle", "must be from 0 to outerConeAngle");

@@ -313,18 +313,26 @@ std::uint32_t GltfMaterials::texture(int index, int tex_coord, const tinygltf::E
             throw InputError(file, sampler + ".minFilter",
                              "must be 9728 (NEAREST), 9729 (LINEAR) or 9984 to 9987 (the mipmap kinds), not " +
                                  std::to_string(s.minFilter));
-        // Without mipmaps or ray footprints a lookup cannot tell
-        // magnification from minification: magFilter decides (minFilter
-        // where it is the only one given), and a minFilter that would pick
-        // texels otherwise is noted.
-        const bool min_nearest = s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST ||
-                                 s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
-                                 s.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR;
+        // A lookup whose footprint is under a texel (magnification) filters
+        // as magFilter says (minFilter's kind where it is the only one
+        // given). minFilter NEAREST or LINEAR asks for no mipmaps: every
+        // lookup then filters as magnification does, and a minFilter of the
+        // other kind is noted. The mipmap kinds all read trilinearly,
+        // noted where another was asked for.
+        const int min_filter = s.minFilter;
+        const bool min_nearest = min_filter == TINYGLTF_TEXTURE_FILTER_NEAREST ||
+                                 min_filter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST ||
+                                 min_filter == TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR;
         sampling.nearest = s.magFilter >= 0 ? s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST : min_nearest;
-        if (s.minFilter >= 0 && min_nearest != sampling.nearest)
+        sampling.mipmaps =
+            min_filter != TINYGLTF_TEXTURE_FILTER_NEAREST && min_filter != TINYGLTF_TEXTURE_FILTER_LINEAR;
+        if (!sampling.mipmaps && min_nearest != sampling.nearest)
             notes_.add(sampler + ".minFilter", std::string("is ") + (min_nearest ? "nearest" : "linear") +
                                                    " but magFilter " + (sampling.nearest ? "nearest" : "linear") +
-                                                   ": there are no mipmaps, and every lookup filters as magFilter says");
+                                                   ": without mipmaps, every lookup filters as magFilter says");
+        if (sampling.mipmaps && min_filter >= 0 && min_filter != TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR)
+            notes_.add(sampler + ".minFilter", "is " + std::to_string(min_filter) +
+                                                   ": minified lookups are trilinear (9987, LINEAR_MIPMAP_LINEAR)");
     }
     return sampled_texture(scene_, image(t.source), sampling);
 }

@@ -26,6 +26,9 @@ struct TextureSampling {
     std::uint32_t wrap_u = gpu::kTextureWrapRepeat;
     std::uint32_t wrap_v = gpu::kTextureWrapRepeat;
     bool nearest = false;
+    // Minified lookups read the mipmap chain (add_mipmaps); false where a
+    // glTF sampler's minFilter is NEAREST or LINEAR, which have none.
+    bool mipmaps = true;
     // u' = t[0] u + t[1] v + t[2], v' = t[3] u + t[4] v + t[5].
     std::array<float, 6> uv_transform{1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f};
 };
@@ -34,6 +37,18 @@ struct TextureSampling {
 // sampled as `sampling`: `image` itself where that is how it samples, or
 // else a record sharing its texels, made once for each sampling.
 std::uint32_t sampled_texture(Scene& scene, std::uint32_t image, const TextureSampling& sampling);
+
+// Gives every texture that the materials sample, and that may have one
+// (TextureSampling::mipmaps), its image's mipmap chain
+// (gpu::TextureInfo::mip_offset; kTextureMipmapped): each level half the
+// size of the one above (rounded down, at least 1 texel), each texel the
+// mean of the texels of the level above that its area covers (a box filter,
+// with fractional weights where a size is odd). Colour textures (base
+// colour, emissive) are averaged as linear values and stored in sRGB again;
+// the others, and alpha, as they are. Textures that share an image share
+// its chain, made once; one that is also read as colour is averaged as
+// colour. The chains add at most a third to the scene's texels.
+void add_mipmaps(Scene& scene);
 
 // Loads a PNG or JPEG (stb_image; grey, grey-alpha and RGB get alpha 1) and
 // adds it. When it is missing or cannot be decoded, throws InputError
@@ -54,6 +69,8 @@ inline constexpr std::uint64_t kMaxTexels = std::uint64_t(1) << 27;
 // declares; or "" (decoding then says what else may be wrong). stb_image allocates the pixels a header
 // declares however small the file: a 1 MB PNG of 16384 x 16384 zeros took
 // 2 GB and 8.5 s to decode before kMaxTexels refused it.
-std::string encoded_image_problem(const unsigned char* bytes, std::size_t size);
+// Where the header gives its size and there is no problem, `texels` (if
+// not null) gets its width x height; 0 where it does not.
+std::string encoded_image_problem(const unsigned char* bytes, std::size_t size, std::uint64_t* texels = nullptr);
 
 }  // namespace lc::loader

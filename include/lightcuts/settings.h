@@ -15,6 +15,7 @@ inline constexpr std::uint32_t kMaxImageSide = 16384;  // width and height
 inline constexpr float kMaxRelativeError = 1.0f;       // lightcuts threshold, as a fraction
 inline constexpr std::uint32_t kMaxLightSamples = 1u << 24;  // area-light samples, environment directions
 inline constexpr std::uint32_t kMaxLightSamplesPerPoint = 65536;  // sampled, stochastic: light_samples
+inline constexpr std::uint64_t kMaxPathsPerPixel = 1u << 24;  // path: spp x light_samples (32-bit sample order)
 inline constexpr std::uint32_t kMaxVpls = 1u << 24;    // render.indirect.vpls
 inline constexpr std::uint32_t kMaxBounces = 1024;     // max_bounces (path and indirect); 0 = unlimited
 // CPU threads (--threads; 0 = one per core). Each thread costs a stack and

@@ -74,11 +74,12 @@ struct SurfacePoint {
     vec3 wo;
     uint material;  // index of the material record
     vec2 uv;
-    Material mat;   // lc_material_at(material, uv)
+    vec4 footprint;   // the camera ray's cone on the surface, in uv (lc_uv_footprint); 0 for others
+    Material mat;     // lc_material_at(material, uv, footprint)
 };
 
 // A shaded point from its parts (the G-buffer's, or a test's).
-SurfacePoint lc_make_surface(vec3 p, vec3 n, vec3 wo, uint material, vec2 uv) {
+SurfacePoint lc_make_surface(vec3 p, vec3 n, vec3 wo, uint material, vec2 uv, vec4 footprint) {
     SurfacePoint sp;
     sp.p = p;
     sp.n = n;
@@ -86,11 +87,15 @@ SurfacePoint lc_make_surface(vec3 p, vec3 n, vec3 wo, uint material, vec2 uv) {
     sp.wo = wo;
     sp.material = material;
     sp.uv = uv;
-    sp.mat = lc_material_at(material, uv);
+    sp.footprint = footprint;
+    sp.mat = lc_material_at(material, uv, footprint);
     return sp;
 }
 
-SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) {
+// The point at barycentrics (b1, b2) of triangle tri_index, hit by a ray
+// along ray_dir whose cone is cone_width wide there (0 for a ray without
+// one: its textures are read at full resolution).
+SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir, float cone_width) {
     Triangle tri = LC_TRIANGLE(tri_index);
     TriangleNormals tn = LC_NORMALS(tri_index);
     vec3 v0 = lc_tri_v0(tri);
@@ -100,13 +105,16 @@ SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) 
     // Barycentric interpolation is more accurate than org + t * dir.
     vec3 p = b0 * v0 + b1 * v1 + b2 * v2;
     vec3 ng = normalize(cross(v1 - v0, v2 - v0));
+    TriangleUvs tuv = LC_UVS(tri_index);
+    vec4 footprint = kEnableTextures && cone_width > 0.0f ? lc_uv_footprint(cone_width, ray_dir, v0, v1, v2, tuv)
+                                                          : vec4(0.0f);
     vec3 ns = b0 * vec3(tn.n0_x, tn.n0_y, tn.n0_z) + b1 * vec3(tn.n1_x, tn.n1_y, tn.n1_z) +
               b2 * vec3(tn.n2_x, tn.n2_y, tn.n2_z);
     float ns_len = length(ns);
     ns = ns_len > 1e-12f ? ns / ns_len : ng;
     vec2 uv = lc_triangle_uv(tri_index, b1, b2);
-    Material mat = lc_material_at(tri.material, uv);
-    ns = lc_normal_mapped(mat, uv, ns, v0, v1, v2, LC_UVS(tri_index));
+    Material mat = lc_material_at(tri.material, uv, footprint);
+    ns = lc_normal_mapped(mat, uv, footprint, ns, v0, v1, v2, tuv);
     // Two-sided surfaces: both normals turn to the side the ray came from.
     if (dot(ng, ray_dir) > 0.0f) ng = -ng;
     if (dot(ns, ng) < 0.0f) ns = -ns;
@@ -117,6 +125,7 @@ SurfacePoint lc_surface_point(uint tri_index, float b1, float b2, vec3 ray_dir) 
     sp.wo = -ray_dir;
     sp.material = tri.material;
     sp.uv = uv;
+    sp.footprint = footprint;
     sp.mat = mat;
     return sp;
 }
@@ -137,7 +146,7 @@ vec3 lc_environment_radiance(LC_IN(FrameParams) f, vec3 d) {
 // Radiance a triangle emits at barycentrics (b1, b2) towards -ray_dir: its
 // material's emission (times its emissive texture) on the side its
 // geometric normal (counter-clockwise winding) points to, or on both sides.
-vec3 lc_surface_emission(uint tri_index, float b1, float b2, vec3 ray_dir) {
+vec3 lc_surface_emission(uint tri_index, float b1, float b2, vec3 ray_dir, vec4 footprint) {
     Triangle tri = LC_TRIANGLE(tri_index);
     Material m = LC_MATERIAL(tri.material);
     if ((m.flags & kMaterialEmissive) == 0u) return vec3(0.0f);
@@ -146,18 +155,17 @@ vec3 lc_surface_emission(uint tri_index, float b1, float b2, vec3 ray_dir) {
     if (!front && (m.flags & kMaterialEmitsBothSides) == 0u) return vec3(0.0f);
     vec3 e = vec3(m.emission_r, m.emission_g, m.emission_b);
     if (lc_has_texture(m, m.emissive_texture))
-        e *= vec3(lc_texture_sample(m.emissive_texture, lc_triangle_uv(tri_index, b1, b2), true));
+        e *= vec3(lc_texture_sample(m.emissive_texture, lc_triangle_uv(tri_index, b1, b2), true, footprint));
     return e;
 }
 
 // Sample `s` of pixel (x, y) traced into the scene: the triangle hit
-// (kInvalidIndex when the ray leaves the scene), its barycentrics, and the
-// ray's direction.
-uint lc_camera_trace(LC_IN(FrameParams) f, uint x, uint y, uint s, LC_OUT(vec3) dir, LC_OUT(float) b1,
-                     LC_OUT(float) b2) {
+// (kInvalidIndex when the ray leaves the scene), its distance and
+// barycentrics, and the ray's direction.
+uint lc_camera_trace(LC_IN(FrameParams) f, uint x, uint y, uint s, LC_OUT(vec3) dir, LC_OUT(float) t,
+                     LC_OUT(float) b1, LC_OUT(float) b2) {
     dir = lc_camera_ray_dir(f, lc_pixel_sample(x, y, s, f.spp, f.seed));
     vec3 org = vec3(f.cam_pos_x, f.cam_pos_y, f.cam_pos_z);
-    float t;
 #ifdef LC_TRACE_CLOSEST
     // The includer's own closest-hit query (the CPU's 8-wide BVH).
     return LC_TRACE_CLOSEST(org, dir, kRayInfinity, t, b1, b2);
@@ -170,10 +178,10 @@ uint lc_camera_trace(LC_IN(FrameParams) f, uint x, uint y, uint s, LC_OUT(vec3) 
 // the scene.
 bool lc_camera_hit(LC_IN(FrameParams) f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp) {
     vec3 dir;
-    float b1, b2;
-    uint tri = lc_camera_trace(f, x, y, s, dir, b1, b2);
+    float t, b1, b2;
+    uint tri = lc_camera_trace(f, x, y, s, dir, t, b1, b2);
     if (tri == kInvalidIndex) return false;
-    sp = lc_surface_point(tri, b1, b2, dir);
+    sp = lc_surface_point(tri, b1, b2, dir, f.pixel_spread * t);
     return true;
 }
 
@@ -181,14 +189,14 @@ bool lc_camera_hit(LC_IN(FrameParams) f, uint x, uint y, uint s, LC_OUT(SurfaceP
 // surface's emission, or the environment where the ray leaves the scene.
 bool lc_camera_sample(LC_IN(FrameParams) f, uint x, uint y, uint s, LC_OUT(SurfacePoint) sp, LC_OUT(vec3) seen) {
     vec3 dir;
-    float b1, b2;
-    uint tri = lc_camera_trace(f, x, y, s, dir, b1, b2);
+    float t, b1, b2;
+    uint tri = lc_camera_trace(f, x, y, s, dir, t, b1, b2);
     if (tri == kInvalidIndex) {
         seen = lc_environment_radiance(f, dir);
         return false;
     }
-    sp = lc_surface_point(tri, b1, b2, dir);
-    seen = lc_surface_emission(tri, b1, b2, dir);
+    sp = lc_surface_point(tri, b1, b2, dir, f.pixel_spread * t);
+    seen = lc_surface_emission(tri, b1, b2, dir, sp.footprint);
     return true;
 }
 

@@ -1,5 +1,6 @@
 // Textures: lookups with glTF's samplers (repeated, clamped or mirrored;
-// bilinear or nearest) and uv transforms, sRGB decoding, and the material
+// bilinear or nearest; trilinear in mipmaps where a ray cone's footprint
+// covers several texels) and uv transforms, sRGB decoding, and the material
 // at a shaded point (its factors times its textures). Shared by the CPU
 // reference and the Vulkan kernels (see glsl_compat.h).
 //
@@ -53,21 +54,44 @@ uint lc_wrap_texel(int i, uint n, uint wrap) {
     return uint(i + int(n)) % n;
 }
 
-// Texture `index` at uv: transformed where the texture says so, wrapped as
-// its sampler says, and the nearest texel or a bilinear blend of four.
-// Texel centres sit at (i + 0.5) / width; colour textures are decoded
-// before they are filtered, so the filter blends linear values.
-vec4 lc_texture_sample(uint index, vec2 uv, bool srgb) {
-    TextureInfo t = LC_TEXTURE(index);
-    if ((t.sampling & kTextureTransformed) != 0u)
-        uv = vec2(t.uv_transform[0] * uv.x + t.uv_transform[1] * uv.y + t.uv_transform[2],
-                  t.uv_transform[3] * uv.x + t.uv_transform[4] * uv.y + t.uv_transform[5]);
-    uint wrap_u = t.sampling & 3u;
-    uint wrap_v = (t.sampling >> kTextureWrapVShift) & 3u;
-    // Wrap first, so the integer texel coordinates below stay small.
-    float u = lc_wrap_coordinate(uv.x, wrap_u);
-    float v = lc_wrap_coordinate(uv.y, wrap_v);
-    if ((t.sampling & kTextureNearest) != 0u)
+// A lookup's footprint is an ellipse in texture coordinates, the section of
+// a ray cone by the surface (lc_uv_footprint): xy its long axis, zw its
+// short one, each from one side to the other. It is zero where no ray cone
+// comes with the lookup (the points that paths and virtual point lights
+// bounce off, the area lights' emission): full resolution. Along a long
+// axis of up to kMaxAnisotropy times the short one, that many lookups in
+// the level the short axis picks are averaged (as a GPU's anisotropic
+// filter does); a longer one reads a coarser level.
+LC_KCONST uint kMaxAnisotropy = 8u;
+
+// How many levels texture t's mipmap chain has, level 0 included: down to
+// 1 x 1 texels.
+uint lc_texture_levels(LC_IN(TextureInfo) t) { return uint(findMSB(max(t.width, t.height))) + 1u; }
+
+// Level `level` of texture t's chain as a texture of its own (its offset,
+// width and height; level 0 is t).
+TextureInfo lc_texture_level(TextureInfo t, uint level) {
+    if (level == 0u) return t;
+    uint w = max(t.width >> 1u, 1u);
+    uint h = max(t.height >> 1u, 1u);
+    uint offset = t.mip_offset;
+    for (uint l = 1u; l < level; ++l) {
+        offset += w * h;
+        w = max(w >> 1u, 1u);
+        h = max(h >> 1u, 1u);
+    }
+    t.offset = offset;
+    t.width = w;
+    t.height = h;
+    return t;
+}
+
+// Texture t at coordinates (u, v) already wrapped (lc_wrap_coordinate): the
+// nearest texel, or a bilinear blend of four. Texel centres sit at
+// (i + 0.5) / width; colour textures are decoded before they are filtered,
+// so the filter blends linear values.
+vec4 lc_texture_filtered(LC_IN(TextureInfo) t, float u, float v, uint wrap_u, uint wrap_v, bool nearest, bool srgb) {
+    if (nearest)
         return lc_texel(t, lc_wrap_texel(int(floor(u * float(t.width))), t.width, wrap_u),
                         lc_wrap_texel(int(floor(v * float(t.height))), t.height, wrap_v), srgb);
     float x = u * float(t.width) - 0.5f;
@@ -85,6 +109,94 @@ vec4 lc_texture_sample(uint index, vec2 uv, bool srgb) {
     return mix(top, bottom, ay);
 }
 
+// Texture `index` at uv, seen through `footprint`: transformed where the
+// texture says so (its axes too) and wrapped as its sampler says. Where the
+// footprint's long axis is under a texel (or the image has no mipmaps), the
+// nearest texel or a bilinear blend of four at full resolution, as the
+// sampler says; where it is longer, the mean of lookups spread along it,
+// each a trilinear blend of the two levels whose texels are nearest the
+// footprint's width over their count.
+vec4 lc_texture_sample(uint index, vec2 uv, bool srgb, vec4 footprint) {
+    TextureInfo t = LC_TEXTURE(index);
+    vec2 major = vec2(footprint.x, footprint.y);
+    vec2 minor = vec2(footprint.z, footprint.w);
+    if ((t.sampling & kTextureTransformed) != 0u) {
+        vec2 tu = vec2(t.uv_transform[0], t.uv_transform[1]);
+        vec2 tv = vec2(t.uv_transform[3], t.uv_transform[4]);
+        uv = vec2(dot(tu, uv) + t.uv_transform[2], dot(tv, uv) + t.uv_transform[5]);
+        major = vec2(dot(tu, major), dot(tv, major));
+        minor = vec2(dot(tu, minor), dot(tv, minor));
+    }
+    uint wrap_u = t.sampling & 3u;
+    uint wrap_v = (t.sampling >> kTextureWrapVShift) & 3u;
+    vec2 size = vec2(float(t.width), float(t.height));
+    float major_texels = length(major * size);
+    float minor_texels = length(minor * size);
+    if (major_texels < minor_texels) {  // a transform or the image's aspect turned them
+        vec2 a = major;
+        major = minor;
+        minor = a;
+        float l = major_texels;
+        major_texels = minor_texels;
+        minor_texels = l;
+    }
+    // Under a texel (NaN too: a cone met edge-on on a triangle without uv
+    // area), full resolution. Wrap first, so the integer texel coordinates
+    // stay small.
+    if ((t.sampling & kTextureMipmapped) == 0u || !(major_texels > 1.0f))
+        return lc_texture_filtered(t, lc_wrap_coordinate(uv.x, wrap_u), lc_wrap_coordinate(uv.y, wrap_v), wrap_u,
+                                   wrap_v, (t.sampling & kTextureNearest) != 0u, srgb);
+    float ratio = major_texels / max(minor_texels, 1.0f);
+    uint taps = ratio < float(kMaxAnisotropy) ? uint(ceil(ratio)) : kMaxAnisotropy;
+    uint last = lc_texture_levels(t) - 1u;
+    float lod = min(max(log2(major_texels / float(taps)), 0.0f), float(last));
+    float level = floor(lod);
+    float blend = lod - level;
+    TextureInfo fine = lc_texture_level(t, uint(level));
+    TextureInfo coarse = lc_texture_level(t, min(uint(level) + 1u, last));
+    vec4 sum = vec4(0.0f);
+    for (uint i = 0u; i < taps; ++i) {
+        vec2 p = uv + major * ((float(i) + 0.5f) / float(taps) - 0.5f);
+        float u = lc_wrap_coordinate(p.x, wrap_u);
+        float v = lc_wrap_coordinate(p.y, wrap_v);
+        vec4 c = lc_texture_filtered(fine, u, v, wrap_u, wrap_v, false, srgb);
+        if (blend > 0.0f) c = mix(c, lc_texture_filtered(coarse, u, v, wrap_u, wrap_v, false, srgb), blend);
+        sum += c;
+    }
+    return sum / float(taps);
+}
+
+// Texture `index` at uv at full resolution (no footprint).
+vec4 lc_texture_sample(uint index, vec2 uv, bool srgb) { return lc_texture_sample(index, uv, srgb, vec4(0.0f)); }
+
+// The footprint (above) of a ray cone `cone_width` wide, along ray_dir,
+// where it meets the triangle with vertices v0, v1, v2 and texture
+// coordinates `t` (ray cones: Akenine-Moller et al., "Texture Level of
+// Detail Strategies for Real-Time Ray Tracing", Ray Tracing Gems, 2019,
+// with the ellipse's two axes kept apart): across the ray's direction the
+// cone's width, along it that over the cosine (at most 1000 times), each
+// mapped into texture coordinates by the triangle's gradients of u and v.
+vec4 lc_uv_footprint(float cone_width, vec3 ray_dir, vec3 v0, vec3 v1, vec3 v2, LC_IN(TriangleUvs) t) {
+    vec3 e1 = v1 - v0;
+    vec3 e2 = v2 - v0;
+    vec3 n = cross(e1, e2);
+    float n2 = dot(n, n);
+    // A vector w in the plane is s e1 + r e2 with s = dot(w, cross(e2, n)) / n2
+    // and r = dot(w, cross(n, e1)) / n2.
+    vec3 gs = cross(e2, n) / n2;
+    vec3 gr = cross(n, e1) / n2;
+    vec3 grad_u = (t.u1 - t.u0) * gs + (t.u2 - t.u0) * gr;
+    vec3 grad_v = (t.v1 - t.v0) * gs + (t.v2 - t.v0) * gr;
+    float cos_theta = abs(dot(ray_dir, n)) / sqrt(n2);
+    vec3 across = cross(n, ray_dir);
+    // Head-on, every direction in the plane is as good.
+    if (!(dot(across, across) > 1e-12f * n2)) across = e1;
+    across = normalize(across);
+    vec3 along = normalize(cross(across, n)) * (cone_width / max(cos_theta, 1e-3f));
+    across *= cone_width;
+    return vec4(dot(grad_u, along), dot(grad_v, along), dot(grad_u, across), dot(grad_v, across));
+}
+
 // Whether material m has texture `index` (one of its *_texture fields).
 bool lc_has_texture(LC_IN(Material) m, uint index) {
     return kEnableTextures && (m.flags & kMaterialTextured) != 0u && index != kInvalidIndex;
@@ -97,28 +209,28 @@ vec2 lc_triangle_uv(uint tri_index, float b1, float b2) {
     return b0 * vec2(t.u0, t.v0) + b1 * vec2(t.u1, t.v1) + b2 * vec2(t.u2, t.v2);
 }
 
-// Material `index` at texture coordinates uv: its factors times its
-// textures. Base colour scales kd (both kinds); metallic-roughness scales
+// Material `index` at texture coordinates uv, its textures seen through
+// `footprint` (lc_texture_sample): its factors times its textures. Base colour scales kd (both kinds); metallic-roughness scales
 // roughness by G and metallic by B (glTF), and alpha follows roughness;
 // the emissive texture scales emission. The normal map is applied where the
 // shading normal is made (lc_surface_point).
-Material lc_material_at(uint index, vec2 uv) {
+Material lc_material_at(uint index, vec2 uv, vec4 footprint) {
     Material m = LC_MATERIAL(index);
     if (!kEnableTextures || (m.flags & kMaterialTextured) == 0u) return m;
     if (lc_has_texture(m, m.base_color_texture)) {
-        vec4 c = lc_texture_sample(m.base_color_texture, uv, true);
+        vec4 c = lc_texture_sample(m.base_color_texture, uv, true, footprint);
         m.kd_r *= c.x;
         m.kd_g *= c.y;
         m.kd_b *= c.z;
     }
     if (lc_has_texture(m, m.metallic_roughness_texture)) {
-        vec4 c = lc_texture_sample(m.metallic_roughness_texture, uv, false);
+        vec4 c = lc_texture_sample(m.metallic_roughness_texture, uv, false, footprint);
         m.roughness *= c.y;
         m.metallic *= c.z;
         m.alpha = max(m.roughness * m.roughness, kMinGgxAlpha);
     }
     if (lc_has_texture(m, m.emissive_texture)) {
-        vec4 c = lc_texture_sample(m.emissive_texture, uv, true);
+        vec4 c = lc_texture_sample(m.emissive_texture, uv, true, footprint);
         m.emission_r *= c.x;
         m.emission_g *= c.y;
         m.emission_b *= c.z;
@@ -127,11 +239,11 @@ Material lc_material_at(uint index, vec2 uv) {
 }
 
 // The shading normal ns bent by material m's tangent-space normal map at
-// uv, on the triangle with vertices v0, v1, v2 and texture coordinates
+// uv (seen through `footprint`), on the triangle with vertices v0, v1, v2 and texture coordinates
 // `t`. The tangent frame is the triangle's: T along +u and B towards -v
 // (glTF's +Y, image up; v grows downwards), both made orthogonal to ns. A
 // triangle whose UVs are degenerate keeps ns.
-vec3 lc_normal_mapped(LC_IN(Material) m, vec2 uv, vec3 ns, vec3 v0, vec3 v1, vec3 v2, LC_IN(TriangleUvs) t) {
+vec3 lc_normal_mapped(LC_IN(Material) m, vec2 uv, vec4 footprint, vec3 ns, vec3 v0, vec3 v1, vec3 v2, LC_IN(TriangleUvs) t) {
     if (!lc_has_texture(m, m.normal_texture)) return ns;
     vec3 dp1 = v1 - v0;
     vec3 dp2 = v2 - v0;
@@ -147,7 +259,7 @@ vec3 lc_normal_mapped(LC_IN(Material) m, vec2 uv, vec3 ns, vec3 v0, vec3 v1, vec
     tangent /= tangent_len;
     vec3 bitangent = cross(ns, tangent);
     if (dot(bitangent, -dpdv) < 0.0f) bitangent = -bitangent;
-    vec4 c = lc_texture_sample(m.normal_texture, uv, false);
+    vec4 c = lc_texture_sample(m.normal_texture, uv, false, footprint);
     vec3 tn = vec3((2.0f * c.x - 1.0f) * m.normal_scale, (2.0f * c.y - 1.0f) * m.normal_scale, 2.0f * c.z - 1.0f);
     vec3 bent = tn.x * tangent + tn.y * bitangent + tn.z * ns;
     float bent_len = length(bent);

@@ -168,11 +168,15 @@ struct Material {
 // (glTF's KHR_texture_transform, MTL's -o and -s):
 //   u' = uv_transform[0] u + uv_transform[1] v + uv_transform[2]
 //   v' = uv_transform[3] u + uv_transform[4] v + uv_transform[5]
+// and kTextureMipmapped where the image has a mipmap chain: level l
+// (1 <= l < lc_texture_levels) is max(width >> l, 1) x max(height >> l, 1)
+// texels, the levels one after another from texel `mip_offset`.
 struct TextureInfo {
     uint offset;
     uint width, height;
     uint sampling;
     float uv_transform[6];
+    uint mip_offset;
 };
 LC_CONST uint kTextureWrapRepeat = 0u;     // the image repeats (glTF's REPEAT, the default)
 LC_CONST uint kTextureWrapClamp = 1u;      // the edge texels continue (CLAMP_TO_EDGE)
@@ -180,6 +184,8 @@ LC_CONST uint kTextureWrapMirror = 2u;     // every other repeat mirrored (MIRRO
 LC_CONST uint kTextureWrapVShift = 2u;     // the v wrapping's bits: (sampling >> kTextureWrapVShift) & 3
 LC_CONST uint kTextureNearest = 16u;
 LC_CONST uint kTextureTransformed = 32u;
+LC_CONST uint kTextureMipmapped = 64u;
+LC_CONST uint kTextureNoMipmaps = 128u;  // the host's: a sampler that asks for none (add_mipmaps)
 
 // One light (48 bytes).
 //   point:        position, radiant intensity (W/sr)
@@ -221,7 +227,7 @@ struct LightNode {
     float falloff_width;
 };
 
-// Per-pixel surface record written by the camera-ray kernel (48 bytes).
+// Per-pixel surface record written by the camera-ray kernel (64 bytes).
 // material == kInvalidIndex means the ray left the scene (black).
 struct GBufferTexel {
     float px, py, pz;        // hit point, already offset off the surface
@@ -229,6 +235,8 @@ struct GBufferTexel {
     float wo_x, wo_y, wo_z;  // unit direction towards the camera
     uint material;
     float u, v;              // texture coordinates of the hit
+    float footprint_major_u, footprint_major_v;  // the camera ray's footprint in them
+    float footprint_minor_u, footprint_minor_v;  // (SurfacePoint, textures.h)
 };
 
 // One entry of the per-pixel cut heap (8 bytes): a refinable interior node
@@ -282,7 +290,7 @@ struct FrameParams {
     uint light_samples;           // sampled: lights per camera sample; stochastic: draws per cluster
     uint light_pick;              // --method sampled: kLightPick*
     float vpl_min_distance2;      // VPLs' inverse-square clamp: min_distance2 or render.indirect.clamp^2
-    uint pad0;
+    float pixel_spread;           // angle a pixel spans at the image's centre (radians): camera rays' cones
 };
 
 #ifdef __cplusplus

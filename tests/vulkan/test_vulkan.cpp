@@ -175,6 +175,37 @@ TEST_F(Vulkan, PointLightAbovePlaneGivesAnalyticRadiance) {
     }
 }
 
+// One plane, its shading normals tilted 30 degrees, a point light under
+// it: the tilt turns the light's cosine positive at the plane's top, and
+// only the plane itself, as a blocker, keeps the light out. The kernels
+// may leave shadow rays out only where nothing can block a light
+// (PreparedScene::has_occluders); here they must trace them, and the plane
+// is black on both devices (before, lavapipe lit it through itself).
+TEST_F(Vulkan, PlaneWithTiltedNormalsShadowsALightBehindIt) {
+    Scene s;
+    s.materials = {test::lambert(glm::vec3(0.5f))};
+    add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
+    for (gpu::TriangleNormals& n : s.normals) {
+        n.n0_x = n.n1_x = n.n2_x = 0.5f;
+        n.n0_y = n.n1_y = n.n2_y = 0.8660254f;
+        n.n0_z = n.n1_z = n.n2_z = 0.0f;
+    }
+    s.lights = {test::point_light({1.0f, -0.5f, 0.0f}, glm::vec3(10.0f))};
+    s.camera = test::camera({0.0f, 2.0f, 0.0f}, {0.0f, 0.0f, 0.0f}, 40.0f, 16, 16);
+    update_bounds(s);
+    PreparedScene p = prepare_scene(std::move(s), 1);
+    EXPECT_TRUE(p.has_occluders);
+    for (const char* method : {"brute", "lightcuts"}) {
+        const RenderResult r = gpu(p, options(method, 16, 16));
+        const RenderResult c = render_cpu(p, options(method, 16, 16));
+        for (std::uint32_t y = 0; y < 16; ++y)
+            for (std::uint32_t x = 0; x < 16; ++x) {
+                ASSERT_EQ(r.image.at(x, y), glm::vec3(0.0f)) << method << " pixel " << x << "," << y;
+                ASSERT_EQ(c.image.at(x, y), glm::vec3(0.0f)) << method << " pixel " << x << "," << y;
+            }
+    }
+}
+
 // --- Against the CPU reference.
 
 TEST_F(Vulkan, BruteMatchesCpuOnRandomScenes) {

@@ -46,6 +46,8 @@ TEST_F(Vulkan, TexturedGltfSceneMatchesTheCpu) {
     s.render.area_light_samples = 1024;  // the glowing box; brute force sums every sample
     const PreparedScene p = prepare_scene(std::move(s), 1);
     ASSERT_EQ(p.scene.textures.size(), 4u);
+    // Minified at this size: the lookups read the mipmaps.
+    for (const gpu::TextureInfo& t : p.scene.textures) ASSERT_NE(t.sampling & gpu::kTextureMipmapped, 0u);
     const RenderOptions o = options("brute", 32, 24);
     expect_brute_matches(p, o, gpu(p, o), kTexturedRelative);
 }

@@ -209,7 +209,7 @@ def materials_doc():
                         "KHR_materials_clearcoat": {"clearcoatFactor": 0.6, "clearcoatRoughnessFactor": 0.2},
                         "KHR_materials_sheen": {"sheenColorFactor": [0.5, 0.25, 0.125]}}},
         # 1: what is noted and left out: TEXCOORD_1, BLEND, occlusion, a
-        # minFilter the magFilter overrides; the texture transform of the
+        # mipmap minFilter read trilinearly; the texture transform of the
         # extension's example (the image's lower-left quarter, turned).
         {"name": "noted",
          "pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1},
@@ -224,7 +224,7 @@ def materials_doc():
                               {"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 1},
                               {"attributes": {"POSITION": 0}}]}]
     return gltf(b, acc, meshes, [{"mesh": 0}], images=images, textures=textures,
-                samplers=[{"wrapS": 33071, "wrapT": 10497, "magFilter": 9728, "minFilter": 9728},
+                samplers=[{"wrapS": 33071, "wrapT": 10497, "magFilter": 9728, "minFilter": 9729},
                           {"wrapS": 33648, "wrapT": 33648, "magFilter": 9729, "minFilter": 9984}],
                 materials=materials,
                 extensionsUsed=["KHR_materials_emissive_strength", "KHR_materials_clearcoat",
@@ -363,6 +363,9 @@ def bad_cases():
                                             d["materials"][0].update(occlusionTexture={"index": 1})))
     # A PNG whose chunks are whole but whose pixels are not zlib data (corrupt.png).
     variant("bad_image_corrupt", lambda d: (textured(d, {}), d["images"].__setitem__(0, {"uri": "corrupt.png"})))
+    # Not bad: the same image in a texture that no material reads (it is not decoded).
+    variant("unused_image_corrupt", lambda d: (textured(d, {}), d["images"].append({"uri": "corrupt.png"}),
+                                               d["textures"].append({"source": 1})))
     variant("bad_mag_filter", lambda d: textured(d, {}, {"magFilter": 1}))
     variant("bad_min_filter", lambda d: textured(d, {}, {"minFilter": 9990}))
     variant("bad_transform_offset", lambda d: textured(d, {"extensions": {"KHR_texture_transform": {
@@ -384,6 +387,16 @@ def bad_cases():
     variant("bad_negative_view", lambda d: d["accessors"][0].update(bufferView=-5))
     variant("bad_aspect_zero", lambda d: (d.update(cameras=[{"type": "perspective", "perspective": {
         "yfov": 0.8, "aspectRatio": 0, "znear": 0.1}}]), d["nodes"].append({"camera": 0, "translation": [0, 0, 3]}),
+        d["scenes"][0]["nodes"].append(len(d["nodes"]) - 1)))
+    # A yfov inside (0, pi) that rounds to 180 degrees as a float.
+    variant("bad_yfov_rounds", lambda d: (d.update(cameras=[{"type": "perspective", "perspective": {
+        "yfov": math.pi - 1e-12, "znear": 0.1}}]), d["nodes"].append({"camera": 0, "translation": [0, 0, 3]}),
+        d["scenes"][0]["nodes"].append(len(d["nodes"]) - 1)))
+    # Not bad: a camera 1e8 from the origin, turned 10 degrees about x (it
+    # looks along (0, sin 10, -cos 10)).
+    variant("far_camera", lambda d: (d.update(cameras=[{"type": "perspective", "perspective": {
+        "yfov": 0.8, "znear": 0.1}}]), d["nodes"].append({"camera": 0, "translation": [0, 0, 1e8],
+        "rotation": [math.sin(math.radians(5.0)), 0, 0, math.cos(math.radians(5.0))]}),
         d["scenes"][0]["nodes"].append(len(d["nodes"]) - 1)))
     # Not bad: a camera whose aspect ratio would make the image wider than 16384 columns.
     variant("wide_camera", lambda d: (d.update(cameras=[{"type": "perspective", "perspective": {
