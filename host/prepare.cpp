@@ -256,10 +256,16 @@ gpu::FrameParams make_frame_params(const PreparedScene& prepared, const RenderOp
     float aspect = float(f.width) / float(f.height);
     right *= tan_half * aspect;
     up *= tan_half;
-    // The angle between neighbouring samples' rays at the image's centre:
-    // a pixel's, over the side of its grid of samples (lc_pixel_sample), so
-    // that the samples' footprints tile the pixel's (textures.h).
-    f.pixel_spread = float(2.0 * double(tan_half) / double(f.height) / std::sqrt(double(std::max(options.spp, 1u))));
+    // The angle a sample's stratum spans at the image's centre: a pixel's
+    // over the rows or columns of lc_pixel_sample's grid, whichever are
+    // fewer (its strata are about sqrt(spp) a side, or spp columns of full
+    // height), so that the samples' footprints cover the pixel's
+    // (textures.h).
+    const std::uint32_t spp = std::max(options.spp, 1u);
+    std::uint32_t cols = std::uint32_t(std::ceil(std::sqrt(double(spp))));
+    std::uint32_t rows = (spp + cols - 1) / cols;
+    if (cols * rows != spp) cols = spp, rows = 1;
+    f.pixel_spread = float(2.0 * double(tan_half) / double(f.height) / double(std::min(cols, rows)));
     f.cam_pos_x = cam.position.x; f.cam_pos_y = cam.position.y; f.cam_pos_z = cam.position.z;
     f.cam_right_x = right.x; f.cam_right_y = right.y; f.cam_right_z = right.z;
     f.cam_up_x = up.x; f.cam_up_y = up.y; f.cam_up_z = up.z;

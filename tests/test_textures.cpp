@@ -248,6 +248,33 @@ TEST(Mipmaps, LevelsAreBoxFilteredMeansOfTheLevelAbove) {
     EXPECT_EQ(t.scene.texels[r.mip_offset + 2], rgba(byte_of((byte_of(left) + byte_of(right)) / 510.0), 0, 0));
 }
 
+// One image read as base colour (sRGB) by one material and as a
+// metallic-roughness map (linear) by another, through one texture record:
+// a chain for each way, the second reader pointed at a copy of the record
+// (a 0/255 checker's mean is sRGB 188 as colour, 128 as data; one chain
+// averaged as colour read 0.737 as roughness).
+TEST(Mipmaps, AnImageReadAsColourAndAsDataGetsAChainEach) {
+    TextureScene t;
+    std::vector<std::uint32_t> checker(4);
+    for (std::uint32_t i = 0; i < 4; ++i) checker[i] = (i % 2 + i / 2) % 2 == 0 ? rgba(255, 255, 255) : rgba(0, 0, 0);
+    const std::uint32_t tex = t.add(2, 2, checker);
+    gpu::Material colour = loader::make_material(glm::vec3(1.0f), glm::vec3(0.0f), 1.0f);
+    loader::set_texture(colour, &gpu::Material::base_color_texture, tex);
+    gpu::Material data = colour;
+    data.base_color_texture = gpu::kInvalidIndex;
+    loader::set_texture(data, &gpu::Material::metallic_roughness_texture, tex);
+    t.scene.materials = {colour, data, colour};
+    loader::add_mipmaps(t.scene);
+    ASSERT_EQ(t.scene.textures.size(), 2u);
+    const std::uint32_t copy = t.scene.materials[1].metallic_roughness_texture;
+    EXPECT_EQ(t.scene.materials[0].base_color_texture, tex);
+    EXPECT_EQ(t.scene.materials[2].base_color_texture, tex);
+    EXPECT_EQ(copy, 1u);
+    const std::uint32_t half = byte_of(linear_to_srgb(0.5));
+    EXPECT_EQ(t.scene.texels[t.scene.textures[tex].mip_offset], rgba(half, half, half));
+    EXPECT_EQ(t.scene.texels[t.scene.textures[copy].mip_offset], rgba(128, 128, 128));
+}
+
 // The level a lookup reads follows its footprint: under a texel, level 0
 // as the sampler says; a texel of level l wide, level l; between two
 // levels, a blend; wider than the image, its mean. A transform that
@@ -261,10 +288,15 @@ TEST(Mipmaps, FootprintPicksTheLevel) {
     loader::TextureSampling doubled;
     doubled.uv_transform = {2.0f, 0.0f, 0.0f, 0.0f, 2.0f, 0.0f};
     const std::uint32_t stretched = loader::sampled_texture(t.scene, tex, doubled);
+    loader::TextureSampling point;
+    point.nearest = true;
+    const std::uint32_t nearest = loader::sampled_texture(t.scene, tex, point);
     gpu::Material m = loader::make_material(glm::vec3(1.0f), glm::vec3(0.0f), 1.0f);
     loader::set_texture(m, &gpu::Material::metallic_roughness_texture, tex);
     loader::set_texture(m, &gpu::Material::normal_texture, stretched);
-    t.scene.materials = {m};
+    gpu::Material m2 = m;
+    loader::set_texture(m2, &gpu::Material::normal_texture, nearest);
+    t.scene.materials = {m, m2};
     loader::add_mipmaps(t.scene);
     cpu::TextureKernel& k = t.kernel();
     const gpu::TextureInfo& info = t.scene.textures[tex];
@@ -294,6 +326,15 @@ TEST(Mipmaps, FootprintPicksTheLevel) {
                      0.5f * (k.lc_texture_sample(tex, p - glm::vec2(0.125f, 0.0f), false) +
                              k.lc_texture_sample(tex, p + glm::vec2(0.125f, 0.0f), false)),
                      1e-6f, "anisotropic");
+    // So magnified (a texel apart), a nearest sampler's lookups read one
+    // texel each.
+    ASSERT_NE(t.scene.textures[nearest].sampling & gpu::kTextureMipmapped, 0u);
+    expect_vec4_near(k.lc_texture_sample(nearest, p, false, glm::vec4(0.0f, 0.125f, 0.5f, 0.0f)),
+                     0.5f * (k.lc_texture_sample(nearest, p - glm::vec2(0.125f, 0.0f), false) +
+                             k.lc_texture_sample(nearest, p + glm::vec2(0.125f, 0.0f), false)),
+                     1e-6f, "anisotropic, nearest");
+    expect_vec4_near(k.lc_texture_sample(nearest, p - glm::vec2(0.125f, 0.0f), false), unpack(texels[5]), 1e-6f,
+                     "one texel");
 }
 
 // A ray cone's footprint in texture coordinates: across the ray the cone's
@@ -994,7 +1035,9 @@ TEST(NormalMap, PlaneWithANormalMapCanShadow) {
     }
 }
 
-// The cone's angle is a pixel's, over the side of its grid of samples.
+// The cone's angle is a pixel's, over the rows or columns of its grid of
+// samples, whichever are fewer (lc_pixel_sample: 16 samples in 4 x 4, 6
+// in 3 x 2, 2 in columns of the pixel's height).
 TEST(Mipmaps, PixelSpreadFollowsTheFieldOfViewAndTheSamples) {
     Scene s;
     s.materials = {loader::make_material(glm::vec3(0.5f), glm::vec3(0.0f), 1.0f)};
@@ -1006,8 +1049,10 @@ TEST(Mipmaps, PixelSpreadFollowsTheFieldOfViewAndTheSamples) {
     const PreparedScene p = prepare_scene(std::move(s), 1);
     RenderOptions o = test::options("brute", 0);
     EXPECT_FLOAT_EQ(make_frame_params(p, o).pixel_spread, 2.0f / 32.0f);
-    o.spp = 16;
-    EXPECT_FLOAT_EQ(make_frame_params(p, o).pixel_spread, 2.0f / 32.0f / 4.0f);
+    for (const auto& [spp, side] : {std::pair(16u, 4.0f), std::pair(6u, 2.0f), std::pair(2u, 1.0f)}) {
+        o.spp = spp;
+        EXPECT_FLOAT_EQ(make_frame_params(p, o).pixel_spread, 2.0f / 32.0f / side) << spp;
+    }
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include <stb_image.h>
@@ -146,44 +147,48 @@ void append_level(std::vector<std::uint32_t>& texels, std::size_t offset, std::u
 }  // namespace
 
 void add_mipmaps(Scene& scene) {
-    // The images (by their first texel) that get a chain, and how.
-    struct Image {
+    // A material's texture slots, and whether each reads colour (sRGB).
+    constexpr std::pair<std::uint32_t gpu::Material::*, bool> kSlots[] = {
+        {&gpu::Material::base_color_texture, true},
+        {&gpu::Material::emissive_texture, true},
+        {&gpu::Material::metallic_roughness_texture, false},
+        {&gpu::Material::normal_texture, false},
+    };
+    const auto chained = [&](std::uint32_t texture) {
+        const gpu::TextureInfo& t = scene.textures.at(texture);
+        return (t.sampling & gpu::kTextureNoMipmaps) == 0u && std::max(t.width, t.height) >= 2;
+    };
+    // The chains to make: one for each image (by its first texel) and way
+    // it is read.
+    struct Chain {
         std::uint32_t width = 0, height = 0;
-        bool srgb = false;
         std::uint32_t mip_offset = 0;
     };
-    std::map<std::uint32_t, Image> images;
-    const auto use = [&](std::uint32_t texture, bool colour) {
-        if (texture == gpu::kInvalidIndex) return;
-        const gpu::TextureInfo& t = scene.textures.at(texture);
-        if ((t.sampling & gpu::kTextureNoMipmaps) != 0u || std::max(t.width, t.height) < 2) return;
-        Image& image = images[t.offset];
-        image.width = t.width;
-        image.height = t.height;
-        image.srgb |= colour;
-    };
+    std::map<std::pair<std::uint32_t, bool>, Chain> chains;
     for (const gpu::Material& m : scene.materials) {
         if ((m.flags & gpu::kMaterialTextured) == 0u) continue;
-        use(m.base_color_texture, true);
-        use(m.emissive_texture, true);
-        use(m.metallic_roughness_texture, false);
-        use(m.normal_texture, false);
+        for (const auto& [slot, srgb] : kSlots) {
+            const std::uint32_t texture = m.*slot;
+            if (texture == gpu::kInvalidIndex || !chained(texture)) continue;
+            const gpu::TextureInfo& t = scene.textures[texture];
+            chains[{t.offset, srgb}] = {t.width, t.height, 0};
+        }
     }
     // Reserved at once: append_level reads the level above from the vector
     // it appends to.
     std::size_t added = 0;
-    for (const auto& [offset, image] : images)
-        for (std::uint32_t w = image.width, h = image.height; w > 1 || h > 1;) {
+    for (const auto& [key, chain] : chains)
+        for (std::uint32_t w = chain.width, h = chain.height; w > 1 || h > 1;) {
             w = std::max(w / 2, 1u);
             h = std::max(h / 2, 1u);
             added += std::size_t(w) * h;
         }
     scene.texels.reserve(scene.texels.size() + added);
-    for (auto& [offset, image] : images) {
-        const MipFilter filter(image.srgb);
-        image.mip_offset = std::uint32_t(scene.texels.size());
-        std::size_t level = offset;
-        for (std::uint32_t w = image.width, h = image.height; w > 1 || h > 1;) {
+    for (auto& [key, chain] : chains) {
+        const MipFilter filter(key.second);
+        chain.mip_offset = std::uint32_t(scene.texels.size());
+        std::size_t level = key.first;
+        for (std::uint32_t w = chain.width, h = chain.height; w > 1 || h > 1;) {
             const std::size_t next = scene.texels.size();
             append_level(scene.texels, level, w, h, filter);
             level = next;
@@ -191,11 +196,27 @@ void add_mipmaps(Scene& scene) {
             h = std::max(h / 2, 1u);
         }
     }
-    for (gpu::TextureInfo& t : scene.textures) {
-        const auto found = images.find(t.offset);
-        if (found == images.end() || (t.sampling & gpu::kTextureNoMipmaps) != 0u) continue;
-        t.sampling |= gpu::kTextureMipmapped;
-        t.mip_offset = found->second.mip_offset;
+    // Each record read gets the chain of the way it is read; a record read
+    // both ways, a copy for the second.
+    std::map<std::pair<std::uint32_t, bool>, std::uint32_t> records;  // (record, srgb) -> record
+    for (gpu::Material& m : scene.materials) {
+        if ((m.flags & gpu::kMaterialTextured) == 0u) continue;
+        for (const auto& [slot, srgb] : kSlots) {
+            const std::uint32_t texture = m.*slot;
+            if (texture == gpu::kInvalidIndex || !chained(texture)) continue;
+            const auto [found, fresh] = records.try_emplace({texture, srgb}, texture);
+            if (fresh) {
+                const auto other = records.find({texture, !srgb});
+                if (other != records.end() && other->second == texture) {
+                    scene.textures.push_back(scene.textures[texture]);
+                    found->second = std::uint32_t(scene.textures.size() - 1);
+                }
+                gpu::TextureInfo& t = scene.textures[found->second];
+                t.sampling |= gpu::kTextureMipmapped;
+                t.mip_offset = chains.at({t.offset, srgb}).mip_offset;
+            }
+            m.*slot = found->second;
+        }
     }
 }
 

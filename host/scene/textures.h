@@ -46,8 +46,10 @@ std::uint32_t sampled_texture(Scene& scene, std::uint32_t image, const TextureSa
 // with fractional weights where a size is odd). Colour textures (base
 // colour, emissive) are averaged as linear values and stored in sRGB again;
 // the others, and alpha, as they are. Textures that share an image share
-// its chain, made once; one that is also read as colour is averaged as
-// colour. The chains add at most a third to the scene's texels.
+// its chain, made once for each way it is read; a texture record read both
+// ways gets a copy for the second, and the materials that read it so are
+// pointed at the copy. The chains add a third to a square image's texels,
+// up to as many again for an image one texel wide.
 void add_mipmaps(Scene& scene);
 
 // Loads a PNG or JPEG (stb_image; grey, grey-alpha and RGB get alpha 1) and

@@ -115,7 +115,8 @@ vec4 lc_texture_filtered(LC_IN(TextureInfo) t, float u, float v, uint wrap_u, ui
 // nearest texel or a bilinear blend of four at full resolution, as the
 // sampler says; where it is longer, the mean of lookups spread along it,
 // each a trilinear blend of the two levels whose texels are nearest the
-// footprint's width over their count.
+// footprint's width over their count (at full resolution, as the sampler
+// says, where that is under a texel).
 vec4 lc_texture_sample(uint index, vec2 uv, bool srgb, vec4 footprint) {
     TextureInfo t = LC_TEXTURE(index);
     vec2 major = vec2(footprint.x, footprint.y);
@@ -149,7 +150,11 @@ vec4 lc_texture_sample(uint index, vec2 uv, bool srgb, vec4 footprint) {
     float ratio = major_texels / max(minor_texels, 1.0f);
     uint taps = ratio < float(kMaxAnisotropy) ? uint(ceil(ratio)) : kMaxAnisotropy;
     uint last = lc_texture_levels(t) - 1u;
-    float lod = min(max(log2(major_texels / float(taps)), 0.0f), float(last));
+    float lod = log2(major_texels / float(taps));
+    // Taps under a texel apart magnify: full resolution, as the sampler's
+    // magFilter says (a GPU's rule, level of detail <= 0).
+    bool nearest = !(lod > 0.0f) && (t.sampling & kTextureNearest) != 0u;
+    lod = min(max(lod, 0.0f), float(last));
     float level = floor(lod);
     float blend = lod - level;
     TextureInfo fine = lc_texture_level(t, uint(level));
@@ -159,7 +164,7 @@ vec4 lc_texture_sample(uint index, vec2 uv, bool srgb, vec4 footprint) {
         vec2 p = uv + major * ((float(i) + 0.5f) / float(taps) - 0.5f);
         float u = lc_wrap_coordinate(p.x, wrap_u);
         float v = lc_wrap_coordinate(p.y, wrap_v);
-        vec4 c = lc_texture_filtered(fine, u, v, wrap_u, wrap_v, false, srgb);
+        vec4 c = lc_texture_filtered(fine, u, v, wrap_u, wrap_v, nearest, srgb);
         if (blend > 0.0f) c = mix(c, lc_texture_filtered(coarse, u, v, wrap_u, wrap_v, false, srgb), blend);
         sum += c;
     }
