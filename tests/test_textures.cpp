@@ -883,6 +883,21 @@ TEST(TexturedAreaLights, SmallBrightFeaturesAreFoundThroughTheSampler) {
     EXPECT_EQ(wide_mean, 0.0f);
 }
 
+// A 2 x 2 plane at y = 0 whose material (kd 0.5) has `texture` as its base
+// colour, u along x and v along z from 0 to 1, lit straight down by a
+// directional light of 3, and a camera straight above whose size x size
+// image spans the plane (tan(fov / 2) = 1 / 4), +x to the right, -z up.
+void make_textured_plane(Scene& s, std::uint32_t texture, std::uint32_t size) {
+    gpu::Material m = loader::make_material(glm::vec3(0.5f), glm::vec3(0.0f), 1.0f);
+    loader::set_texture(m, &gpu::Material::base_color_texture, texture);
+    s.materials = {m};
+    test::add_quad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0);
+    s.uvs = {{0, 0, 0, 1, 1, 1}, {0, 0, 1, 1, 1, 0}};
+    s.lights = {test::directional_light({0, -1, 0}, glm::vec3(3.0f))};
+    s.camera = test::camera({0, 4, 0}, {0, 0, 0}, float(2.0 * std::atan(0.25) * 180.0 / 3.14159265358979), size, size);
+    s.camera.up = {0, 0, -1};
+}
+
 // Texture coordinates near 1e6 (a float step of 0.0625 there) render as
 // those near 0: prepare_scene moves each triangle's by whole periods where
 // its textures repeat (before, relative RMSE 0.36 against the same quad at
@@ -895,20 +910,13 @@ TEST(TexturedRender, FarTextureCoordinatesKeepTheirDetail) {
         const std::uint32_t image = loader::add_texture(s, 64, 64, rgba_bytes(texels).data(), "test", "texture");
         loader::TextureSampling sampling;
         if (clamp) sampling.wrap_u = gpu::kTextureWrapClamp;
-        gpu::Material m = loader::make_material(glm::vec3(0.5f), glm::vec3(0.0f), 1.0f);
-        loader::set_texture(m, &gpu::Material::base_color_texture, loader::sampled_texture(s, image, sampling));
-        s.materials = {m};
-        test::add_quad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0);
-        s.uvs = {{0, 0, 0, 1, 1, 1}, {0, 0, 1, 1, 1, 0}};
+        make_textured_plane(s, loader::sampled_texture(s, image, sampling), 32);
         for (gpu::TriangleUvs& uv : s.uvs) {
             for (float* c : {&uv.u0, &uv.u1, &uv.u2, &uv.v0, &uv.v1, &uv.v2}) *c += shift;
             // Past 1 by up to a period, the same area in texture space
             // (and so the same mipmap levels).
             if (u_past_one) uv.u0 += 1.0f, uv.u1 += 1.0f, uv.u2 += 1.0f;
         }
-        s.lights = {test::directional_light({0, -1, 0}, glm::vec3(3.0f))};
-        s.camera = test::camera({0, 4, 0}, {0, 0, 0}, float(2.0 * std::atan(0.25) * 180.0 / 3.14159265358979), 32, 32);
-        s.camera.up = {0, 0, -1};
         update_bounds(s);
         return render_cpu(prepare_scene(std::move(s), 1), test::options("brute", 32)).image;
     };
@@ -936,17 +944,7 @@ TEST(TexturedRender, PlaneShowsItsTextureOnBothHalves) {
     std::vector<std::uint32_t> texels(64);
     for (int y = 0; y < 8; ++y)
         for (int x = 0; x < 8; ++x) texels[std::size_t(8 * y + x)] = (x < 4) == (y < 4) ? rgba(255, 255, 255) : rgba(0, 0, 0);
-    const std::uint32_t tex = loader::add_texture(s, 8, 8, rgba_bytes(texels).data(), "test", "texture");
-    gpu::Material m = loader::make_material(glm::vec3(0.5f), glm::vec3(0.0f), 1.0f);
-    loader::set_texture(m, &gpu::Material::base_color_texture, tex);
-    s.materials = {m};
-    // x in [-1, 1] is u in [0, 1]; z in [-1, 1] is v in [0, 1].
-    test::add_quad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0);
-    s.uvs = {{0, 0, 0, 1, 1, 1}, {0, 0, 1, 1, 1, 0}};
-    s.lights = {test::directional_light({0, -1, 0}, glm::vec3(3.0f))};
-    // tan(fov / 2) = 1 / 4: the image spans x and z in [-1, 1].
-    s.camera = test::camera({0, 4, 0}, {0, 0, 0}, float(2.0 * std::atan(0.25) * 180.0 / 3.14159265358979), 16, 16);
-    s.camera.up = {0, 0, -1};
+    make_textured_plane(s, loader::add_texture(s, 8, 8, rgba_bytes(texels).data(), "test", "texture"), 16);
     update_bounds(s);
     PreparedScene p = prepare_scene(std::move(s), 1);
     ASSERT_TRUE(p.has_textures);
@@ -985,14 +983,7 @@ TEST(TexturedRender, DistantCheckerIsItsMeanWithMipmaps) {
         const std::uint32_t image = loader::add_texture(s, kSize, kSize, rgba_bytes(texels).data(), "test", "texture");
         loader::TextureSampling sampling;
         sampling.mipmaps = mipmaps;
-        gpu::Material m = loader::make_material(glm::vec3(0.5f), glm::vec3(0.0f), 1.0f);
-        loader::set_texture(m, &gpu::Material::base_color_texture, loader::sampled_texture(s, image, sampling));
-        s.materials = {m};
-        test::add_quad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0);
-        s.uvs = {{0, 0, 0, 1, 1, 1}, {0, 0, 1, 1, 1, 0}};
-        s.lights = {test::directional_light({0, -1, 0}, glm::vec3(3.0f))};
-        s.camera = test::camera({0, 4, 0}, {0, 0, 0}, float(2.0 * std::atan(0.25) * 180.0 / 3.14159265358979), 16, 16);
-        s.camera.up = {0, 0, -1};
+        make_textured_plane(s, loader::sampled_texture(s, image, sampling), 16);
         update_bounds(s);
         return render_cpu(prepare_scene(std::move(s), 1), test::options("brute", 16)).image;
     };
