@@ -175,8 +175,10 @@ void OutputSet::commit() {
 
 OutputSet reserve_render_outputs(const RenderOutputs& outputs, const fs::path& scene_file, std::string_view method,
                                  const std::vector<fs::path>& inputs) {
+    // ".exr" alone is a name with no extension (a hidden file's).
     if (outputs.image.extension() != ".exr")
-        throw std::invalid_argument("image " + outputs.image.string() + ": must end in .exr");
+        throw std::invalid_argument("image " + outputs.image.string() + ": must end in .exr" +
+                                    (outputs.image.filename() == ".exr" ? ", after a name" : ""));
     if (!outputs.cut_heatmap.empty() && !method_selects_cuts(method))
         throw std::invalid_argument("cut heatmap " + outputs.cut_heatmap.string() +
                                     ": needs method lightcuts or stochastic, not " + std::string(method));

@@ -196,6 +196,7 @@ for bad in "--max-cut=0" "--max-cut=4294967296"; do
 for bad in "--seed=-1" "--seed=4294967296"; do
   expect_error "--seed: $integer 0 to 4294967295" render "$mini" -o "$tmp/edge2.exr" "$bad"
   expect_error "--seed: $integer 0 to 4294967295" info "$mini" "$bad"; done
+expect_error "image $tmp/.exr: must end in .exr, after a name" render "$mini" -o "$tmp/.exr"
 # Each within its range, their product past the path tracer's paths per pixel.
 expect_error "method path: spp x light_samples (paths per pixel) is 16785409, more than 16777216" \
   render "$mini" -o "$tmp/edge2.exr" --method path --spp 4097 --light-samples 4097
