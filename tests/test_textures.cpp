@@ -362,6 +362,12 @@ TEST(Mipmaps, ConeFootprintOnATriangle) {
     EXPECT_NEAR(std::abs(grazing.x), 250.0f, 1e-3f);
     // Degenerate texture coordinates: no footprint at all (level 0).
     EXPECT_EQ(k.lc_uv_footprint(0.5f, {0, -1, 0}, v0, v1, v2, gpu::TriangleUvs{}), glm::vec4(0.0f));
+    // Triangles of any size: a cone as many times wider on a triangle as
+    // many times larger has the same footprint (the cross product's square
+    // overflowed a float at 1e10 and underflowed at 1e-10).
+    for (const float scale : {1e-15f, 1e-10f, 1e10f, 1e15f})
+        expect_near(k.lc_uv_footprint(0.5f * scale, {s60, -0.5f, 0}, v0 * scale, v1 * scale, v2 * scale, uvs),
+                    slanted, "scaled");
 }
 
 TEST(TextureLookup, MaterialAtAppliesEveryTexture) {

@@ -182,14 +182,21 @@ vec4 lc_texture_sample(uint index, vec2 uv, bool srgb) { return lc_texture_sampl
 // cone's width, along it that over the cosine (at most 1000 times), each
 // mapped into texture coordinates by the triangle's gradients of u and v.
 vec4 lc_uv_footprint(float cone_width, vec3 ray_dir, vec3 v0, vec3 v1, vec3 v2, LC_IN(TriangleUvs) t) {
+    // The edges in units of their largest coordinate: n2 below goes with
+    // the fourth power of their length, past the float range for edges of
+    // 1e10 and under it for 1e-10.
     vec3 e1 = v1 - v0;
     vec3 e2 = v2 - v0;
+    vec3 a = max(abs(e1), abs(e2));
+    float unit = max(a.x, max(a.y, a.z));
+    e1 /= unit;
+    e2 /= unit;
     vec3 n = cross(e1, e2);
     float n2 = dot(n, n);
     // A vector w in the plane is s e1 + r e2 with s = dot(w, cross(e2, n)) / n2
-    // and r = dot(w, cross(n, e1)) / n2.
-    vec3 gs = cross(e2, n) / n2;
-    vec3 gr = cross(n, e1) / n2;
+    // and r = dot(w, cross(n, e1)) / n2 (here per unit).
+    vec3 gs = cross(e2, n) / (n2 * unit);
+    vec3 gr = cross(n, e1) / (n2 * unit);
     vec3 grad_u = (t.u1 - t.u0) * gs + (t.u2 - t.u0) * gr;
     vec3 grad_v = (t.v1 - t.v0) * gs + (t.v2 - t.v0) * gr;
     float cos_theta = abs(dot(ray_dir, n)) / sqrt(n2);
