@@ -319,8 +319,8 @@ TEST(Mipmaps, FootprintPicksTheLevel) {
     expect_vec4_near(k.lc_texture_sample(stretched, uv * 0.5f, false, round(0.25f)), level_texel(info.mip_offset),
                      1e-6f, "stretched: level 1");
     // Two texels long, half a texel wide: two bilinear lookups at level 0,
-    // a texel apart along the long axis (here v: the axes are taken in
-    // either order).
+    // a texel apart along the long axis (along u, given second: the axes
+    // are taken in either order).
     const glm::vec2 p(0.4f, 0.45f);
     expect_vec4_near(k.lc_texture_sample(tex, p, false, glm::vec4(0.0f, 0.125f, 0.5f, 0.0f)),
                      0.5f * (k.lc_texture_sample(tex, p - glm::vec2(0.125f, 0.0f), false) +
@@ -729,6 +729,24 @@ TEST(TextureLimits, OversizedOrTruncatedImagesAreRefusedFromTheirHeaders) {
                                              ": tinygltf: images[0] ('big.png') is 16384 x 16384 texels, more than the "
                                              "134217728 that textures may hold in all");
     }
+    // Each within the limit, the images the materials read past it
+    // together: refused from the second one's header, before it is
+    // decoded. A third image no material reads does not count.
+    const std::vector<std::uint8_t> white = {255, 255, 255, 255};
+    ASSERT_NE(stbi_write_png((dir.path() / "one.png").string().c_str(), 1, 1, 4, white.data(), 4), 0);
+    dir.write("wide.png", png_header(16384, 8192));
+    const std::filesystem::path two = dir.write("two.gltf", R"({"asset": {"version": "2.0"},
+        "images": [{"uri": "wide.png"}, {"uri": "one.png"}, {"uri": "wide.png"}],
+        "textures": [{"source": 0}, {"source": 1}, {"source": 2}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 1}}, "normalTexture": {"index": 2}}]})");
+    try {
+        load_scene(two);
+        FAIL() << "no error for the glTF";
+    } catch (const InputError& e) {
+        EXPECT_EQ(std::string(e.what()), two.lexically_normal().string() +
+                                             ": tinygltf: images[2] ('wide.png'): the images the materials read would "
+                                             "hold more than 134217728 texels in all");
+    }
 }
 
 // Textures are PNG or JPEG: stb_image's decoders of other formats (BMP,
@@ -1011,24 +1029,27 @@ TEST(TexturedRender, DistantCheckerIsItsMeanWithMipmaps) {
 }
 
 // A single plane lets the Vulkan kernels leave shadow rays out
-// (PreparedScene::has_occluders false), unless a normal map bends its
-// shading normals: then a light behind it can pass the cosine, and only
-// the plane's shadow ray blocks it (tests/vulkan: tilted normals).
-TEST(NormalMap, PlaneWithANormalMapCanShadow) {
-    for (const bool mapped : {false, true}) {
+// (PreparedScene::has_occluders false), unless a normal map or its vertex
+// normals bend its shading normals: then a light behind it can pass the
+// cosine, and only the plane's shadow ray blocks it (tests/vulkan: tilted
+// normals rendered).
+TEST(NormalMap, PlaneWithBentNormalsCanShadow) {
+    enum class Bent { no, mapped, tilted };
+    for (const Bent bent : {Bent::no, Bent::mapped, Bent::tilted}) {
         Scene s;
         gpu::Material m = loader::make_material(glm::vec3(0.5f), glm::vec3(0.0f), 1.0f);
-        if (mapped)
+        if (bent == Bent::mapped)
             loader::set_texture(m, &gpu::Material::normal_texture,
                                 loader::add_texture(s, 2, 2, rgba_bytes(kTwoByTwo).data(), "test", "texture"));
         s.materials = {m};
         test::add_quad(s, {-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}, 0);
+        if (bent == Bent::tilted) s.normals[1].n2_x = 0.1f;
         s.uvs = {{0, 0, 0, 1, 1, 1}, {0, 0, 1, 1, 1, 0}};
         s.lights = {test::directional_light({0, -1, 0}, glm::vec3(3.0f))};
         s.camera = test::camera({0, 4, 0}, {0, 0, 0}, 40.0f, 8, 8);
         s.camera.up = {0, 0, -1};
         update_bounds(s);
-        EXPECT_EQ(prepare_scene(std::move(s), 1).has_occluders, mapped);
+        EXPECT_EQ(prepare_scene(std::move(s), 1).has_occluders, bent != Bent::no) << int(bent);
     }
 }
 

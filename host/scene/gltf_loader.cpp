@@ -2,6 +2,7 @@
 #include "gltf_loader.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <array>
 #include <cctype>
 #include <cmath>
@@ -360,10 +361,14 @@ private:
         // In degrees and as the float the camera keeps: a yfov just inside
         // (0, pi) may round to 0 or 180 degrees. 0 where the file has none
         // (check_gltf_types refuses a 0 it has).
-        const float yfov = float(cam.perspective.yfov * 180.0 / 3.14159265358979323846);
+        const double radians = cam.perspective.yfov;
+        const float yfov = float(radians * 180.0 / 3.14159265358979323846);
+        if (!(radians > 0.0 && radians < 3.14159265358979323846))
+            fail(name + ".perspective.yfov", "must be in (0, pi)");
         if (!(yfov > 0.0f && yfov < 180.0f))
-            fail(name + ".perspective.yfov", "must be in (0, pi), and not so near either end that it rounds to it "
-                                             "as a float (" + std::to_string(cam.perspective.yfov) + ")");
+            fail(name + ".perspective.yfov", "is so near " + std::string(yfov > 0.0f ? "pi" : "0") +
+                                                 " that it is " + (yfov > 0.0f ? "180" : "0") +
+                                                 " degrees as a float");
         Camera c;
         const glm::dvec3 position(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
         c.position = glm::vec3(position);
@@ -372,9 +377,20 @@ private:
         const glm::dvec3 up = direction(world, {0.0, 1.0, 0.0}, node, "up");
         if (!(glm::length(glm::cross(view, up)) > 1e-6))
             fail(node, "the camera's up is parallel to its view direction");
-        // As far along the view as the camera is from the origin: a point
-        // a unit away from a far camera would round its direction away.
-        c.look_at = glm::vec3(position + view * std::max(1.0, glm::length(position)));
+        // As far along the view as the camera is from the origin (a point a
+        // unit away from a far camera would round its direction away), but
+        // not so far that the square of the distance leaves the float range
+        // (the JSON loader's limit on camera.look_at).
+        // Farther out the floats round the direction away (past 1e25 or
+        // so), which is refused.
+        c.look_at = glm::vec3(position + view * std::clamp(glm::length(position), 1.0, 1e18));
+        const glm::dvec3 forward = glm::dvec3(c.look_at) - glm::dvec3(c.position);
+        if (!(glm::dot(forward, view) > (1.0 - 1e-6) * glm::length(forward))) {
+            char distance[32];
+            std::snprintf(distance, sizeof distance, "%.3g", glm::length(position));
+            fail(node, "the camera is too far from the origin (" + std::string(distance) +
+                           ") for a float to keep its view direction");
+        }
         c.up = glm::vec3(up);
         c.fov_y_degrees = yfov;
         image_size(cam.perspective.aspectRatio, name, c);

@@ -65,9 +65,8 @@ std::uint32_t sampled_texture(Scene& scene, std::uint32_t image, const TextureSa
 
 namespace {
 
-// One level of a mipmap chain from the level above: sizes in texels, and
-// how a texel of one reads (decode) and is written (encode) as a value in
-// [0, 1].
+// How a mipmap chain's texels read (decode) and are written (encode) as
+// values in [0, 1]: colour through sRGB, the rest and alpha as stored.
 struct MipFilter {
     std::array<float, 256> decode_colour{};  // sRGB code -> linear
     bool srgb = false;
@@ -174,8 +173,8 @@ void add_mipmaps(Scene& scene) {
             chains[{t.offset, srgb}] = {t.width, t.height, 0};
         }
     }
-    // Reserved at once: append_level reads the level above from the vector
-    // it appends to.
+    // Reserved at once, so that the chains' levels do not grow the vector a
+    // level at a time.
     std::size_t added = 0;
     for (const auto& [key, chain] : chains)
         for (std::uint32_t w = chain.width, h = chain.height; w > 1 || h > 1;) {

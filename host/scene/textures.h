@@ -72,7 +72,7 @@ inline constexpr std::uint64_t kMaxTexels = std::uint64_t(1) << 27;
 // declares however small the file: a 1 MB PNG of 16384 x 16384 zeros took
 // 2 GB and 8.5 s to decode before kMaxTexels refused it.
 // Where the header gives its size and there is no problem, `texels` (if
-// not null) gets its width x height; 0 where it does not.
+// not null) gets its width x height; otherwise it is left as it was.
 std::string encoded_image_problem(const unsigned char* bytes, std::size_t size, std::uint64_t* texels = nullptr);
 
 }  // namespace lc::loader

@@ -290,7 +290,7 @@ struct FrameParams {
     uint light_samples;           // sampled: lights per camera sample; stochastic: draws per cluster
     uint light_pick;              // --method sampled: kLightPick*
     float vpl_min_distance2;      // VPLs' inverse-square clamp: min_distance2 or render.indirect.clamp^2
-    float pixel_spread;           // angle a pixel spans at the image's centre (radians): camera rays' cones
+    float pixel_spread;           // angle of a sample's stratum at the image's centre (radians): camera rays' cones
 };
 
 #ifdef __cplusplus

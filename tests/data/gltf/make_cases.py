@@ -177,6 +177,15 @@ def modes_doc():
                 extensionsUsed=["KHR_lights_punctual"], extensions=point_light_ext())
 
 
+def corrupt_png():
+    """A PNG whose chunks are whole but whose pixels are not zlib data."""
+    def chunk(kind, data):
+        return (struct.pack(">I", len(data)) + kind + data +
+                struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 2, 2, 8, 6, 0, 0, 0)) +
+            chunk(b"IDAT", b"not zlib data") + chunk(b"IEND", b""))
+
+
 def png_uri(width, height, pixel):
     path = os.path.join(HERE, "_tmp.png")
     make_gltf.write_png(path, width, height, pixel)
@@ -363,9 +372,12 @@ def bad_cases():
                                             d["materials"][0].update(occlusionTexture={"index": 1})))
     # A PNG whose chunks are whole but whose pixels are not zlib data (corrupt.png).
     variant("bad_image_corrupt", lambda d: (textured(d, {}), d["images"].__setitem__(0, {"uri": "corrupt.png"})))
-    # Not bad: the same image in a texture that no material reads (it is not decoded).
-    variant("unused_image_corrupt", lambda d: (textured(d, {}), d["images"].append({"uri": "corrupt.png"}),
-                                               d["textures"].append({"source": 1})))
+    # Not bad: the same image in a texture that no material reads (it is not decoded); in a data
+    # URI, so that the fuzzer's copy of the file (which is alone in its folder) reaches it.
+    variant("unused_image_corrupt", lambda d: (
+        textured(d, {}),
+        d["images"].append({"uri": "data:image/png;base64," + base64.b64encode(corrupt_png()).decode()}),
+        d["textures"].append({"source": 1})))
     variant("bad_mag_filter", lambda d: textured(d, {}, {"magFilter": 1}))
     variant("bad_min_filter", lambda d: textured(d, {}, {"minFilter": 9990}))
     variant("bad_transform_offset", lambda d: textured(d, {"extensions": {"KHR_texture_transform": {
@@ -391,6 +403,12 @@ def bad_cases():
     # A yfov inside (0, pi) that rounds to 180 degrees as a float.
     variant("bad_yfov_rounds", lambda d: (d.update(cameras=[{"type": "perspective", "perspective": {
         "yfov": math.pi - 1e-12, "znear": 0.1}}]), d["nodes"].append({"camera": 0, "translation": [0, 0, 3]}),
+        d["scenes"][0]["nodes"].append(len(d["nodes"]) - 1)))
+    # A camera 3e38 from the origin, looking away from it: a point along its view is the
+    # camera's own position as a float.
+    variant("bad_camera_too_far", lambda d: (d.update(cameras=[{"type": "perspective", "perspective": {
+        "yfov": 0.8, "znear": 0.1}}]), d["nodes"].append({"camera": 0, "translation": [3e38, 0, 0],
+        "rotation": [0, -math.sin(math.radians(45.0)), 0, math.cos(math.radians(45.0))]}),
         d["scenes"][0]["nodes"].append(len(d["nodes"]) - 1)))
     # Not bad: a camera 1e8 from the origin, turned 10 degrees about x (it
     # looks along (0, sin 10, -cos 10)).
@@ -426,11 +444,7 @@ def main():
     for name, doc in bad_cases().items():
         write(name + ".gltf", doc)
     with open(os.path.join(HERE, "corrupt.png"), "wb") as f:
-        def chunk(kind, data):
-            return (struct.pack(">I", len(data)) + kind + data +
-                    struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
-        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", 2, 2, 8, 6, 0, 0, 0)) +
-                chunk(b"IDAT", b"not zlib data") + chunk(b"IEND", b""))
+        f.write(corrupt_png())
     with open(os.path.join(HERE, "bad_json.gltf"), "w", encoding="ascii") as f:
         f.write('{"asset": {"version": "2.0"}, "nodes": [\n')
     # A JSON scene with an OBJ and two glTF files (one placed by a transform), next to its own lights.
