@@ -142,31 +142,39 @@ vec4 lc_texture_sample(uint index, vec2 uv, bool srgb, vec4 footprint) {
         minor_texels = l;
     }
     // Under a texel (NaN too: a cone met edge-on on a triangle without uv
-    // area), full resolution. Wrap first, so the integer texel coordinates
-    // stay small.
-    if ((t.sampling & kTextureMipmapped) == 0u || !(major_texels > 1.0f))
-        return lc_texture_filtered(t, lc_wrap_coordinate(uv.x, wrap_u), lc_wrap_coordinate(uv.y, wrap_v), wrap_u,
-                                   wrap_v, (t.sampling & kTextureNearest) != 0u, srgb);
-    float ratio = major_texels / max(minor_texels, 1.0f);
-    uint taps = ratio < float(kMaxAnisotropy) ? uint(ceil(ratio)) : kMaxAnisotropy;
-    uint last = lc_texture_levels(t) - 1u;
-    float lod = log2(major_texels / float(taps));
-    // Taps under a texel apart magnify: full resolution, as the sampler's
-    // magFilter says (a GPU's rule, level of detail <= 0).
-    bool nearest = !(lod > 0.0f) && (t.sampling & kTextureNearest) != 0u;
-    lod = min(max(lod, 0.0f), float(last));
+    // area), one lookup at full resolution as the sampler says.
+    uint taps = 1u;
+    float lod = 0.0f;
+    bool nearest = (t.sampling & kTextureNearest) != 0u;
+    if ((t.sampling & kTextureMipmapped) != 0u && major_texels > 1.0f) {
+        float ratio = major_texels / max(minor_texels, 1.0f);
+        taps = ratio < float(kMaxAnisotropy) ? uint(ceil(ratio)) : kMaxAnisotropy;
+        lod = log2(major_texels / float(taps));
+        // Taps under a texel apart magnify: full resolution, as the
+        // sampler's magFilter says (a GPU's rule, level of detail <= 0).
+        nearest = nearest && !(lod > 0.0f);
+        lod = min(max(lod, 0.0f), float(lc_texture_levels(t) - 1u));
+    } else {
+        major = vec2(0.0f);
+    }
     float level = floor(lod);
     float blend = lod - level;
+    uint levels = blend > 0.0f ? 2u : 1u;
     TextureInfo fine = lc_texture_level(t, uint(level));
-    TextureInfo coarse = lc_texture_level(t, min(uint(level) + 1u, last));
+    TextureInfo coarse = fine;
+    if (levels == 2u) coarse = lc_texture_level(t, uint(level) + 1u);
+    // One loop over the taps and their levels, so that the kernels hold one
+    // copy of the bilinear lookup for each texture they read (lavapipe
+    // compiles every copy for every pipeline).
     vec4 sum = vec4(0.0f);
-    for (uint i = 0u; i < taps; ++i) {
-        vec2 p = uv + major * ((float(i) + 0.5f) / float(taps) - 0.5f);
-        float u = lc_wrap_coordinate(p.x, wrap_u);
-        float v = lc_wrap_coordinate(p.y, wrap_v);
-        vec4 c = lc_texture_filtered(fine, u, v, wrap_u, wrap_v, nearest, srgb);
-        if (blend > 0.0f) c = mix(c, lc_texture_filtered(coarse, u, v, wrap_u, wrap_v, false, srgb), blend);
-        sum += c;
+    for (uint k = 0u; k < taps * levels; ++k) {
+        bool second = k % levels == 1u;
+        vec2 p = uv + major * ((float(k / levels) + 0.5f) / float(taps) - 0.5f);
+        TextureInfo at = fine;
+        if (second) at = coarse;
+        float weight = levels == 1u ? 1.0f : (second ? blend : 1.0f - blend);
+        sum += weight * lc_texture_filtered(at, lc_wrap_coordinate(p.x, wrap_u), lc_wrap_coordinate(p.y, wrap_v),
+                                            wrap_u, wrap_v, nearest, srgb);
     }
     return sum / float(taps);
 }
