@@ -60,8 +60,8 @@ bool nothing_can_shadow(const Scene& scene) {
 
 // Adds `lights` to the running totals; an InputError naming the scene file
 // and `field` where a per-type total leaves the float range, ending with
-// `why`. Positions
-// are not checked: these lights lie on the geometry or have none.
+// `why`. Positions are not checked: these lights lie on the geometry or
+// have none.
 void check_generated_totals(const Scene& scene, loader::LightLimits& limits, std::span<const gpu::Light> lights,
                             const char* field, const char* why) {
     for (const gpu::Light& l : lights) {

@@ -68,13 +68,13 @@ namespace {
 // How a mipmap chain's texels read (decode) and are written (encode) as
 // values in [0, 1]: colour through sRGB, the rest and alpha as stored.
 struct MipFilter {
-    std::array<float, 256> decode_colour{};  // sRGB code -> linear
+    std::array<float, 256> decode{};  // a stored byte -> its value (linear for sRGB)
     bool srgb = false;
 
-    MipFilter(bool srgb_) : srgb(srgb_) {
+    explicit MipFilter(bool srgb_) : srgb(srgb_) {
         for (int i = 0; i < 256; ++i) {
             const double c = i / 255.0;
-            decode_colour[std::size_t(i)] =
+            decode[std::size_t(i)] =
                 float(srgb ? (c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4)) : c);
         }
     }
@@ -134,7 +134,7 @@ void append_level(std::vector<std::uint32_t>& texels, std::size_t offset, std::u
                     if (weight == 0.0) continue;
                     const std::uint32_t t =
                         texels[offset + std::size_t(rows[y].first + j) * w + columns[x].first + i];
-                    for (int c = 0; c < 3; ++c) sum[c] += weight * filter.decode_colour[t >> (8 * c) & 0xFFu];
+                    for (int c = 0; c < 3; ++c) sum[c] += weight * filter.decode[t >> (8 * c) & 0xFFu];
                     sum[3] += weight * double(t >> 24) / 255.0;
                 }
             }
