@@ -144,7 +144,8 @@ vec3 lc_environment_radiance(LC_IN(FrameParams) f, vec3 d) {
 }
 
 // Radiance a triangle emits at barycentrics (b1, b2) towards -ray_dir: its
-// material's emission (times its emissive texture) on the side its
+// material's emission (times its emissive texture, seen through
+// `footprint`: lc_texture_sample) on the side its
 // geometric normal (counter-clockwise winding) points to, or on both sides.
 vec3 lc_surface_emission(uint tri_index, float b1, float b2, vec3 ray_dir, vec4 footprint) {
     Triangle tri = LC_TRIANGLE(tri_index);
