@@ -283,6 +283,15 @@ TEST(Gltf, UnusedImagesAreNotDecoded) {
     EXPECT_EQ(s.textures.size(), 1u);
 }
 
+// --camera takes the first camera node of its name, in node order, and
+// notes that there are others.
+TEST(Gltf, CameraOnTwoNodesIsTakenFromTheFirstWithANote) {
+    const Scene s = load("camera_on_two_nodes.gltf", "a");
+    expect_near(s.camera.position, {0, 0, 3}, 0.0f, "the first node's");
+    EXPECT_TRUE(has_note(s, "--camera: 2 camera nodes are named 'a'; the first in node order is used"));
+    EXPECT_FALSE(has_note(load("lights.gltf", "near"), "--camera"));
+}
+
 // A camera 1e8 from the origin keeps its view direction (a look-at point a
 // unit away was rounded onto the camera, and the load failed as if up
 // were parallel to the view).

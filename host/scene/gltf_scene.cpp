@@ -1,4 +1,5 @@
 // load_gltf_scene: a glTF file as a whole scene (gltf_loader.h).
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -60,14 +61,19 @@ Scene load_gltf_scene(const std::filesystem::path& file, const std::string& came
     update_bounds(scene);
 
     if (!camera.empty()) {
-        std::string names;
-        for (const GltfCamera& c : contents.cameras) {
-            if (c.name == camera) {
-                scene.camera = c.camera;
-                return scene;
-            }
-            names += (names.empty() ? "" : ", ") + ("'" + c.name + "'");
+        // The first in node order; a camera on several nodes, or several
+        // cameras of one name, are each a match.
+        const auto named = [&](const GltfCamera& c) { return c.name == camera; };
+        const auto first = std::find_if(contents.cameras.begin(), contents.cameras.end(), named);
+        if (first != contents.cameras.end()) {
+            scene.camera = first->camera;
+            if (const auto count = std::count_if(contents.cameras.begin(), contents.cameras.end(), named); count > 1)
+                scene.load_notes.push_back(name + ": --camera: " + std::to_string(count) + " camera nodes are named '" +
+                                           camera + "'; the first in node order is used");
+            return scene;
         }
+        std::string names;
+        for (const GltfCamera& c : contents.cameras) names += (names.empty() ? "" : ", ") + ("'" + c.name + "'");
         throw InputError(name, "--camera", "no perspective camera named '" + camera + "' (the file has " +
                                                (names.empty() ? std::string("none") : names) + ")");
     }

@@ -410,6 +410,11 @@ def bad_cases():
         "yfov": 0.8, "znear": 0.1}}]), d["nodes"].append({"camera": 0, "translation": [3e38, 0, 0],
         "rotation": [0, -math.sin(math.radians(45.0)), 0, math.cos(math.radians(45.0))]}),
         d["scenes"][0]["nodes"].append(len(d["nodes"]) - 1)))
+    # Not bad: one camera, named, on two nodes (--camera takes the first, with a note).
+    variant("camera_on_two_nodes", lambda d: (d.update(cameras=[{"name": "a", "type": "perspective", "perspective": {
+        "yfov": 0.8, "znear": 0.1}}]), d["nodes"].append({"camera": 0, "translation": [0, 0, 3]}),
+        d["nodes"].append({"camera": 0, "translation": [0, 0, 5]}),
+        d["scenes"][0]["nodes"].extend([len(d["nodes"]) - 2, len(d["nodes"]) - 1])))
     # Not bad: a camera 1e8 from the origin, turned 10 degrees about x (it
     # looks along (0, sin 10, -cos 10)).
     variant("far_camera", lambda d: (d.update(cameras=[{"type": "perspective", "perspective": {
