@@ -114,4 +114,18 @@ private:
 // the tree's lights (oriented area-light samples included).
 double light_power(const gpu::Light& light, double radius);
 
+// The unit geometric normal of `tri` (its winding's) turned to the side a
+// ray along `ray_dir` arrives from, as lc_surface_point turns it; `fallback`
+// for a triangle of no area. Light paths and the path tracer's bounces
+// reflect only into this side: a shading normal (vertex normals, a normal
+// map) may lean past it, but an opaque surface reflects nothing through
+// itself (Veach 1997, section 5.3; pbrt's BSDF::f tests the same side).
+inline glm::vec3 facing_normal(const gpu::Triangle& tri, glm::vec3 ray_dir, glm::vec3 fallback) {
+    const glm::vec3 v0(tri.v0_x, tri.v0_y, tri.v0_z);
+    glm::vec3 n = glm::cross(glm::vec3(tri.v1_x, tri.v1_y, tri.v1_z) - v0, glm::vec3(tri.v2_x, tri.v2_y, tri.v2_z) - v0);
+    const float length = glm::length(n);
+    n = length > 0.0f ? n / length : fallback;
+    return glm::dot(n, ray_dir) > 0.0f ? -n : n;
+}
+
 }  // namespace lc::path

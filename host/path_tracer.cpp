@@ -207,13 +207,16 @@ PathTracer::PathTracer(const PreparedScene& prepared, const RenderOptions& optio
 glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, PathRays& rays,
                              std::uint32_t j) const {
     Kernel k = kernel_;
-    SurfacePoint sp;
-    glm::vec3 seen;
-    const bool hit = k.lc_camera_sample(frame_, x, y, s, sp, seen);
+    // lc_camera_sample's steps, keeping the triangle for its normal.
+    glm::vec3 dir;
+    float t0, b1_0, b2_0;
+    const std::uint32_t first = k.lc_camera_trace(frame_, x, y, s, dir, t0, b1_0, b2_0);
     // What the camera ray itself finds counts fully: no other technique
     // reaches the first surface.
-    glm::vec3 radiance = seen;
-    if (!hit) return radiance;
+    if (first == gpu::kInvalidIndex) return k.lc_environment_radiance(frame_, dir);
+    SurfacePoint sp = k.lc_surface_point(first, b1_0, b2_0, dir, frame_.pixel_spread * t0);
+    glm::vec3 radiance = k.lc_surface_emission(first, b1_0, b2_0, dir, sp.footprint);
+    glm::vec3 ng = facing_normal(prepared_.scene.triangles[first], dir, sp.n);
     std::uint32_t stream = k.lc_sample_stream(frame_.seed, x, y, s);
     if (j > 0) stream = k.lc_substream(stream, 0x70617468u + j);  // further paths of the same camera ray
     glm::vec3 throughput(1.0f);
@@ -228,6 +231,7 @@ glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, 
         const BsdfSample b = sample_bsdf(k, m, lobes, sp.n, sp.wo, rnd.unit(kDimLobe), rnd.unit(kDimDirection0),
                                          rnd.unit(kDimDirection1));
         if (!(b.pdf > 0.0f)) break;
+        if (!(glm::dot(ng, b.wi) > 0.0f)) break;  // into the surface: an opaque one reflects nothing there
         throughput *= b.weight;
         float t, b1, b2;
         const std::uint32_t tri = k.lc_trace_first_hit(sp.p, b.wi, Kernel::kRayInfinity, t, b1, b2);
@@ -255,6 +259,7 @@ glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, 
             throughput /= q;
         }
         sp = k.lc_surface_point(tri, b1, b2, b.wi, 0.0f);
+        ng = facing_normal(prepared_.scene.triangles[tri], b.wi, sp.n);
     }
     return radiance;
 }

@@ -175,21 +175,33 @@ std::size_t trace_path(cpu::ShadeKernel& kernel, const Emitters& emitters, std::
                              ((m.flags & gpu::kMaterialDisney) != 0u ? 1.0f - m.metallic : 1.0f);
         const float survive = std::min(kMaxSurvival, std::max({kd.x, kd.y, kd.z}));
         if (!(survive > 0.0f)) return bounce - 1;
+        // Shading normals (vertex normals, normal maps). The flux that
+        // reaches the point spreads over the surface by the geometric
+        // cosine, while the path tracer weighs the light arriving there by
+        // the shading cosine: the ratio of the two brings the VPL to the
+        // path tracer's radiance. Leaving, the light crosses the surface's
+        // own plane by the geometric cosine, so the VPL emits around the
+        // geometric normal, on the side the path came from, and never
+        // through the surface (Veach 1997, section 5.3).
+        const glm::vec3 ng = path::facing_normal(kernel.triangles[tri], dir, sp.n);
+        const float cos_geometric = -glm::dot(ng, dir), cos_shading = -glm::dot(sp.n, dir);
+        if (!(cos_geometric > 0.0f) || !(cos_shading > 0.0f)) return bounce - 1;
+        const double shading = double(cos_shading) / double(cos_geometric);
         if (out) {
-            const glm::dvec3 vpl = flux * glm::dvec3(kd) * (scale / double(kPi));
+            const glm::dvec3 vpl = flux * glm::dvec3(kd) * (shading * scale / double(kPi));
             gpu::Light l{};
             l.x = sp.p.x; l.y = sp.p.y; l.z = sp.p.z;
             const glm::vec3 c = loader::without_subnormals(glm::vec3(vpl));
             l.r = c.r; l.g = c.g; l.b = c.b;
-            l.axis_x = sp.n.x; l.axis_y = sp.n.y; l.axis_z = sp.n.z;
+            l.axis_x = ng.x; l.axis_y = ng.y; l.axis_z = ng.z;
             l.type = gpu::kLightVpl;
             out->push_back(l);
         }
         if (max_bounces != 0 && bounce >= max_bounces) return bounce;
         if (rng.next() >= survive) return bounce;
-        flux *= glm::dvec3(kd) / double(survive);
+        flux *= glm::dvec3(kd) * (shading / double(survive));
         org = sp.p;
-        dir = cosine_direction(kernel, sp.n, rng);
+        dir = cosine_direction(kernel, ng, rng);
     }
 }
 
@@ -200,6 +212,15 @@ VplSet trace_vpls(const Scene& scene, const Bvh& bvh, std::span<const gpu::Light
     VplSet set;
     const Emitters source(emitters, scene);
     if (settings.vpls == 0 || source.empty() || scene.triangles.empty()) return set;
+    // Without a surface that reflects diffusely no path can leave a VPL, and
+    // the pilot, finding none, would have 64 paths a VPL traced for nothing
+    // (about 10^9 at the largest count).
+    const bool reflects = std::any_of(scene.materials.begin(), scene.materials.end(), [](const gpu::Material& m) {
+        const float kd = std::max({m.kd_r, m.kd_g, m.kd_b});
+        return kd > 0.0f && ((m.flags & gpu::kMaterialDisney) == 0u || m.metallic < 1.0f ||
+                             m.metallic_roughness_texture != gpu::kInvalidIndex);  // may lower the metallic
+    });
+    if (!reflects) return set;
 
     cpu::ShadeKernel k;
     k.bvh_nodes = bvh.nodes.data();

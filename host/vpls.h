@@ -33,11 +33,13 @@ struct VplSet {
 // cosine-weighted for an oriented light, from a disk as wide as the scene
 // for a directional light), carrying flux Phi = I(w) / (P(light) pdf(w)).
 // Where it hits a surface with Lambert albedo kd it leaves a one-sided
-// cosine emitter on the side it came from, of intensity Phi kd / pi along
-// the shading normal, divided by the number of paths; then it continues in
-// a cosine-weighted direction with flux Phi kd / q, where q = min(0.95,
-// max(kd)) is the chance it survives Russian roulette, until it has left
-// settings.max_bounces VPLs (0: until roulette ends it).
+// cosine emitter on the side it came from, of intensity Phi s kd / pi along
+// the triangle's geometric normal, divided by the number of paths; then it
+// continues in a direction cosine-weighted around that normal with flux
+// Phi s kd / q, where q = min(0.95, max(kd)) is the chance it survives
+// Russian roulette, until it has left settings.max_bounces VPLs (0: until
+// roulette ends it). s = cos(shading) / cos(geometric) of the direction it
+// arrived along corrects for shading normals (docs/lightcuts.md).
 //
 // Only the Lambert lobe reflects light along a path: light that a glossy
 // lobe would reflect on to other surfaces is missing (docs/lightcuts.md);
