@@ -80,21 +80,22 @@ bool tally(Worker& t, const cpu::ShadeKernel::ShadeStats& ss) {
 
 PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Method method, std::uint32_t x,
                         std::uint32_t y, Worker& t) {
-    glm::vec3 sum(0.0f);
+    const float per_sample = 1.0f / float(frame.spp);
+    glm::vec3 mean(0.0f);
     std::uint64_t cut_sum = 0;
     std::uint32_t froze = 0;
     for (std::uint32_t s = 0; s < frame.spp; ++s) {
         cpu::ShadeKernel::SurfacePoint sp;
         glm::vec3 seen;
         const bool hit = k.lc_camera_sample(frame, x, y, s, sp, seen);
-        sum += seen;
+        mean += seen * per_sample;
         if (!hit) continue;
         cpu::ShadeKernel::ShadeStats ss{};
-        sum += shade_point(k, frame, method, sp, k.lc_sample_stream(frame.seed, x, y, s), ss);
+        mean += shade_point(k, frame, method, sp, k.lc_sample_stream(frame.seed, x, y, s), ss) * per_sample;
         cut_sum += ss.cut_size;
         froze += tally(t, ss) ? 1u : 0u;
     }
-    return {sum / float(frame.spp), float(double(cut_sum) / frame.spp), float(double(froze) / frame.spp)};
+    return {mean, float(double(cut_sum) / frame.spp), float(double(froze) / frame.spp)};
 }
 
 // The block of N pixels at (x0, y0) (those inside the image), its samples
@@ -109,7 +110,8 @@ constexpr std::uint32_t block_y(std::uint32_t q) { return q >> 1u & 1u; }
 template <std::uint32_t N>
 bool shade_block(cpu::ShadeKernel& k, const gpu::FrameParams& frame, std::uint32_t x0, std::uint32_t y0, Worker& t,
                  PixelResult* out) {
-    glm::vec3 sum[N] = {};
+    const float per_sample = 1.0f / float(frame.spp);
+    glm::vec3 mean[N] = {};
     std::uint64_t cut_sum[N] = {};
     std::uint32_t froze[N] = {};
     cpu::BlockHeap<N>* heap;
@@ -125,7 +127,7 @@ bool shade_block(cpu::ShadeKernel& k, const gpu::FrameParams& frame, std::uint32
             if (x >= frame.width || y >= frame.height) continue;
             glm::vec3 seen;
             if (k.lc_camera_sample(frame, x, y, s, sp[q], seen)) active |= 1u << q;
-            sum[q] += seen;
+            mean[q] += seen * per_sample;
         }
         if (active == 0u) continue;
         glm::vec3 radiance[N];
@@ -133,14 +135,14 @@ bool shade_block(cpu::ShadeKernel& k, const gpu::FrameParams& frame, std::uint32
         block.shade(sp, active, radiance, ss);
         for (std::uint32_t q = 0; q < N; ++q) {
             if ((active >> q & 1u) == 0u) continue;
-            sum[q] += radiance[q];
+            mean[q] += radiance[q] * per_sample;
             cut_sum[q] += ss[q].cut_size;
             froze[q] += tally(t, ss[q]) ? 1u : 0u;
             hit = hit || ss[q].hit_max_cut != 0u;
         }
     }
     for (std::uint32_t q = 0; q < N; ++q)
-        out[q] = {sum[q] / float(frame.spp), float(double(cut_sum[q]) / frame.spp),
+        out[q] = {mean[q], float(double(cut_sum[q]) / frame.spp),
                   float(double(froze[q]) / frame.spp)};
     return hit;
 }
@@ -237,14 +239,15 @@ RenderResult render_cpu(const PreparedScene& prepared, const RenderOptions& opti
         if (camera_only) {
             for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); ++y)
                 for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); ++x) {
-                    glm::vec3 sum(0.0f);
+                    const float per_sample = 1.0f / float(frame.spp);
+                    glm::vec3 mean(0.0f);
                     for (std::uint32_t s = 0; s < frame.spp; ++s) {
                         cpu::ShadeKernel::SurfacePoint sp;
                         glm::vec3 seen;
                         k.lc_camera_sample(frame, x, y, s, sp, seen);
-                        sum += seen;
+                        mean += seen * per_sample;
                     }
-                    store(x, y, {sum / float(frame.spp), 0.0f, 0.0f});
+                    store(x, y, {mean, 0.0f, 0.0f});
                 }
             progress.update(double(tiles_done.fetch_add(1) + 1) / tile_count);
             return;

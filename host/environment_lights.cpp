@@ -35,13 +35,13 @@ struct Totals {
 // direction stands for it. (Whole texel rows of a map 1 to 8 texels tall
 // reach from pole to pole, or most of the way; a part of one such row put
 // its light on the row's middle latitude: under a constant 65536 x 1 sky
-// an upward plane was black, under a 4096 x 2 one 41% too bright.) Only
-// where there are fewer directions than texels: with more, a texel's
-// several samples spread over its latitudes (emit_texel), which was
-// better for a few directions over a whole sphere (a 1 x 1 map's 8 in
-// two bands lit a tilted plane 14.5% wrong, against 4.8%). So maps of the
-// usual 2:1 shape with fewer directions than texels keep sub = 1 (the
-// shipped sky's 512 x 256 with 3000), and so do those with more.
+// an upward plane was black, under a 4096 x 2 one 41% too bright.) For any
+// count, not only for fewer directions than texels: a texel given a single
+// direction put it on the horizon the same way (black at 65536 x 1 with
+// 65536 directions). Where a cell still gets several directions, they
+// spread over its latitudes (emit_texel). Maps of the usual 2:1 shape keep
+// sub = 1 up to about 83,000 directions for 256 rows (the shipped sky's
+// 512 x 256 with 3000).
 class Splitter {
 public:
     Splitter(const Environment& map, std::uint32_t count, std::vector<gpu::Light>& out) : map_(map), out_(out) {
@@ -53,10 +53,8 @@ public:
         // At most 2^22 rows x columns beyond the map's own (each level of the
         // split passes over them all).
         const double texels = double(map.width) * map.height;
-        sub_ = count >= texels ? 1u
-                               : std::uint32_t(std::clamp(
-                                     std::min(wanted, std::floor(std::max(texels, 4194304.0) / texels)), 1.0,
-                                     double(count)));
+        sub_ = std::uint32_t(
+            std::clamp(std::min(wanted, std::floor(std::max(texels, 4194304.0) / texels)), 1.0, double(count)));
         // Where a texel row straddles the equator (an odd number of rows),
         // an even number of bands puts a boundary on it, the horizon of a
         // plane facing a pole.

@@ -173,9 +173,12 @@ bool lc_loops_were_cut_short() {
     return rounds != frame.loop_probe_rounds;
 }
 
-// Samples are summed in sample order, the way the CPU reference sums them;
-// the host divides by spp.
+// Samples are added in sample order, each divided by spp first, the way
+// the CPU reference adds them: a sum of spp samples near FLT_MAX each
+// would overflow before a division at the end (a sky of radiance 1e37 at
+// 64 spp came out infinite).
 void lc_accumulate(uint pixel, vec3 c) {
+    c *= 1.0f / float(frame.spp);
     radiance[3u * pixel + 0u] += c.x;
     radiance[3u * pixel + 1u] += c.y;
     radiance[3u * pixel + 2u] += c.z;

@@ -483,11 +483,12 @@ TEST(EnvironmentLight, FewSamplesOfTallTexelsSpreadOverLatitudes) {
             const double got = plane_radiance(lights, {0, 0, 0}, n).x;
             std::printf("[ measured ] constant sky, %ux%u map, %u directions, normal y %.0f: rho L = 0.75, got %.6f\n",
                         width, height, count, n.y, got);
-            // The samples of a texel cover it in a few rows, each at its
-            // middle cosine: where a row straddles the plane's horizon the
-            // plane misses that row's upper part. Measured: exact but for
-            // 0.3% (8 x 1, 100 directions) and 6.25% (1 x 1, 8 directions:
-            // three rows, the middle one across the horizon); before, 0.
+            // The samples of a texel (or of a band of it) cover it in a
+            // few rows, each at its middle cosine: where a row straddles
+            // the plane's horizon the plane misses that row's upper part.
+            // Measured: exact but for 4.4% (8 x 1, 16 directions, in two
+            // bands); before the bands, 0.3% (8 x 1, 100 directions) and
+            // 6.25% (1 x 1, 8 directions), and before the rows, 0.
             EXPECT_NEAR(got, 0.75, 0.07 * 0.75) << width << "x" << height << ", " << count;
         }
     }
@@ -501,14 +502,20 @@ TEST(EnvironmentLight, FewSamplesOfTallTexelsSpreadOverLatitudes) {
     }
 }
 
-// Maps only a few texels tall, with fewer directions than texels: a part
-// of the map with one direction must not reach far in latitude. (Before,
-// a part of a texel row took the row's middle latitude: under a constant
-// 65536 x 1 sky an upward plane was black, under 4096 x 2 41% too bright,
-// 8192 x 4 8%.)
+// Maps only a few texels tall: a part of the map with one direction must
+// not reach far in latitude, whether there are fewer directions than
+// texels or about as many. (Before, a part of a texel row took the row's
+// middle latitude: under a constant 65536 x 1 sky an upward plane was
+// black, under 4096 x 2 41% too bright, 8192 x 4 8%; and until the rows
+// were cut into bands for any count, not only for fewer directions than
+// texels, a texel given one direction did the same: black again at 65536 x 1
+// with 65536 directions, 0.5 of 0.75 with 98304, 41% too bright at 4096 x 2
+// with 8192.)
 TEST(EnvironmentLight, FewRowsWithFewerDirectionsThanTexels) {
-    for (const auto& [width, height, count] : {std::tuple{65536u, 1u, 3000u}, {256u, 1u, 64u}, {4096u, 2u, 3000u},
-                                               {8192u, 4u, 3000u}, {128u, 8u, 500u}, {64u, 32u, 64u}}) {
+    for (const auto& [width, height, count] :
+         {std::tuple{65536u, 1u, 3000u}, {256u, 1u, 64u}, {4096u, 2u, 3000u}, {8192u, 4u, 3000u}, {128u, 8u, 500u},
+          {64u, 32u, 64u}, {65536u, 1u, 65536u}, {65536u, 1u, 98304u}, {4096u, 2u, 8192u}, {4096u, 2u, 12000u},
+          {1000u, 3u, 4500u}}) {
         const Environment map = constant_map(width, height, 1.5f);
         const std::vector<gpu::Light> lights = environment_lights(map, count);
         ASSERT_EQ(lights.size(), count);
@@ -591,6 +598,50 @@ TEST(GeneratedLights, TotalsPastTheFloatRangeAreRefused) {
                    std::uint32_t(glow.materials.size() - 1));
     update_bounds(glow);
     expect_refused(std::move(glow), "emissive surfaces");
+}
+
+// The brightest sky the loader accepts (4 pi L just below FLT_MAX) renders
+// finite pixels with every method at 64 spp: each sample is divided by spp
+// before it is added (a sum of 64 samples of a 1e37 sky overflowed to
+// infinity), and the sampled methods divide by the pick's probability last
+// (intensity / pdf overflowed at the tree pick's small probabilities). Two
+// point lights, one of 3e38 far away, picked uniformly: the same.
+TEST(GeneratedLights, BrightestAcceptedLightsRenderFinitePixels) {
+    Scene s;
+    s.materials = {test::lambert(glm::vec3(0.5f))};
+    test::add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
+    test::add_box(s, {-0.3f, 0.0f, -0.3f}, {0.3f, 0.6f, 0.3f}, 0);
+    s.camera = test::camera({0.0f, 1.0f, 3.0f}, {0.0f, 0.5f, 0.0f}, 60.0f, 8, 8);  // the top row sees the sky
+    s.environment.width = 4;
+    s.environment.height = 2;
+    s.environment.rgb.assign(4 * 2 * 3, 2.7e37f);  // 3.39e38 in all
+    update_bounds(s);
+    const PreparedScene sky = prepare_scene(s, 1);
+    for (const char* method : {"brute", "lightcuts", "sampled", "stochastic"}) {
+        RenderOptions o = test::options(method, 8);
+        o.spp = 64;
+        const Image image = render_cpu(sky, o).image;
+        for (std::size_t i = 0; i < image.rgb.size(); ++i) ASSERT_TRUE(std::isfinite(image.rgb[i])) << method << " " << i;
+        EXPECT_NEAR(image.rgb[0], 2.7e37, 1e-6 * 2.7e37) << method;  // the sky itself
+    }
+
+    s.environment = {};
+    s.lights = {test::point_light({0.0f, 1e9f, 0.0f}, glm::vec3(3e38f)),
+                test::point_light({0.0f, 2.0f, 0.0f}, glm::vec3(1.0f))};
+    update_bounds(s);
+    const PreparedScene far = prepare_scene(s, 1);
+    const Image reference = render_cpu(far, test::options("brute", 8)).image;
+    for (const char* pick : {"uniform", "power", "tree"}) {
+        RenderOptions o = test::options("sampled", 8);
+        o.light_pick = pick;
+        o.light_samples = 64;
+        const Image image = render_cpu(far, o).image;
+        for (std::size_t i = 0; i < image.rgb.size(); ++i) ASSERT_TRUE(std::isfinite(image.rgb[i])) << pick << " " << i;
+        double sum = 0.0, sum_reference = 0.0;
+        for (std::size_t i = 0; i < image.rgb.size(); ++i) sum += image.rgb[i], sum_reference += reference.rgb[i];
+        EXPECT_GT(sum, 0.5 * sum_reference) << pick;  // unbiased, but noisy: the right order of magnitude
+        EXPECT_LT(sum, 2.0 * sum_reference) << pick;
+    }
 }
 
 }  // namespace

@@ -168,7 +168,7 @@ void TileScheduler::split_finer(const Tile& tile, std::uint32_t cut_short) {
 }
 
 void TileScheduler::read_back(const Tile& tile, RenderResult& result) const {
-    // The tile's sums, readable since its last pass's fence signalled.
+    // The tile's means, readable since its last pass's fence signalled.
     const float* sums = resources_.radiance_sums();
     const gpu::PixelStats* pixel_stats = resources_.pixel_stats_sums();
     const double spp = double(frame_.spp);
@@ -177,7 +177,7 @@ void TileScheduler::read_back(const Tile& tile, RenderResult& result) const {
         const std::uint32_t x = tile.x0 + gpu::lc_tile_column(i, tile.width, tile.height);
         const std::uint32_t y = tile.y0 + gpu::lc_tile_row(i, tile.width, tile.height);
         const glm::vec3 sum(sums[3 * i], sums[3 * i + 1], sums[3 * i + 2]);
-        result.image.set(x, y, sum / float(frame_.spp));
+        result.image.set(x, y, sum);  // lc_accumulate divided each sample by spp
         const gpu::PixelStats& ps = pixel_stats[i];
         out.shadow_rays += gpu::count64(ps.shadow_rays_lo, ps.shadow_rays_hi);
         out.max_cut_pixels += ps.max_cut_samples;

@@ -252,7 +252,10 @@ vec3 lc_shade_sampled(LC_IN(SurfacePoint) sp, LC_IN(FrameParams) f, uint stream,
         uint light = lc_pick_light(sp, f, lc_substream(stream, k), pdf);
         if (light == kInvalidIndex || !(pdf > 0.0f)) continue;
         Light l = LC_LIGHT(light);
-        sum += lc_light_unit_shadowed(sp, l, f.min_distance2, stats) * (lc_light_intensity(l) / pdf);
+        // Divided by pdf last: pdf <= 1, so no step overflows where the
+        // result does not (intensity / pdf did, for a light of 1e38 picked
+        // with probability 0.5, or a dim one at the tree pick's 2^-24).
+        sum += (lc_light_unit_shadowed(sp, l, f.min_distance2, stats) * lc_light_intensity(l)) / pdf;
     }
     return sum;
 }
@@ -272,5 +275,5 @@ vec3 lc_shade_cluster_stochastic(LC_IN(SurfacePoint) sp, uint node_index, float 
                             lc_substream(lc_substream(stream, node_index), draw), pdf);
     if (!(pdf > 0.0f)) return vec3(0.0f);
     Light l = LC_LIGHT(light);
-    return lc_light_unit_shadowed(sp, l, min_distance2, stats) * (lc_light_intensity(l) / pdf);
+    return (lc_light_unit_shadowed(sp, l, min_distance2, stats) * lc_light_intensity(l)) / pdf;  // as lc_shade_sampled
 }

@@ -294,5 +294,32 @@ INSTANTIATE_TEST_SUITE_P(Kinds, VulkanLights,
                          case_name);
 INSTANTIATE_TEST_SUITE_P(Kinds, VulkanSampled, ::testing::ValuesIn(kLightModelCases), case_name);
 
+// The brightest sky the loader accepts (4 pi L just below FLT_MAX) at 64
+// spp: lc_accumulate divides each sample by spp before adding it, as the
+// CPU does (a sum of 64 samples of a 1e37 sky overflowed to infinity), and
+// the images agree with the CPU's.
+class VulkanBright : public Vulkan {};
+
+TEST_F(VulkanBright, BrightestAcceptedSkyRendersFinitePixels) {
+    Scene s;
+    s.materials = {test::lambert(glm::vec3(0.5f))};
+    test::add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
+    test::add_box(s, {-0.3f, 0.0f, -0.3f}, {0.3f, 0.6f, 0.3f}, 0);
+    s.camera = test::camera({0.0f, 1.0f, 3.0f}, {0.0f, 0.5f, 0.0f}, 60.0f, 8, 8);  // the top row sees the sky
+    s.environment.width = 4;
+    s.environment.height = 2;
+    s.environment.rgb.assign(4 * 2 * 3, 2.7e37f);  // 3.39e38 in all
+    update_bounds(s);
+    const PreparedScene p = prepare_scene(s, 1);
+    for (const char* method : {"brute", "lightcuts", "sampled"}) {
+        const RenderOptions o = options(method, 8, 8, 64);
+        const RenderResult g = gpu(p, o);
+        for (std::size_t i = 0; i < g.image.rgb.size(); ++i)
+            ASSERT_TRUE(std::isfinite(g.image.rgb[i])) << method << " " << i;
+        EXPECT_NEAR(g.image.rgb[0], 2.7e37, 1e-6 * 2.7e37) << method;  // the sky itself
+        if (std::string(method) == "brute") expect_brute_matches(p, o, g);
+    }
+}
+
 }  // namespace
 }  // namespace lc
