@@ -257,6 +257,16 @@ TEST(Gltf, PunctualLightsArePlacedByTheirNodes) {
     expect_near(value(sun), glm::vec3(3.0f), 0.0f, "irradiance");
 }
 
+// pi/2 written as a float, 1.5707964, lies a hair above pi/2: exporters
+// that keep angles in floats write it, and it means a hemisphere.
+TEST(Gltf, SpotConeOfFloatHalfPiIsAHemisphere) {
+    const Scene s = load("spot_float_half_pi.gltf");
+    ASSERT_EQ(s.lights.size(), 1u);
+    EXPECT_EQ(s.lights[0].type, gpu::kLightSpot);
+    EXPECT_NEAR(s.lights[0].cos_outer, 0.0f, 1e-7f);
+    EXPECT_EQ(s.lights[0].cos_inner, s.lights[0].cos_outer);
+}
+
 TEST(Gltf, FirstPerspectiveCameraOrTheOneNamed) {
     const Scene s = load("lights.gltf");
     EXPECT_TRUE(has_note(s, "cameras[0]: camera type \"orthographic\" is skipped"));
@@ -488,6 +498,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_transform_scale.gltf", "materials[0].pbrMetallicRoughness.baseColorTexture.extensions."
                                             "KHR_texture_transform.scale[0]: must be a finite number"},
         BadCase{"bad_spot_cone.gltf", "extensions.KHR_lights_punctual.lights[0].spot.outerConeAngle"},
+        BadCase{"bad_spot_past_float_half_pi.gltf",
+                "extensions.KHR_lights_punctual.lights[0].spot.outerConeAngle: must be from 0 to pi/2"},
         BadCase{"bad_position_type.gltf", "accessors[0].componentType: is UNSIGNED_SHORT, expected FLOAT"},
         BadCase{"bad_json.gltf", "tinygltf: "},
         BadCase{"bad_roughness_string.gltf",

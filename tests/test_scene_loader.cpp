@@ -1261,6 +1261,32 @@ TEST(PointsCsv, EmptyFileGivesNoLights) {
     EXPECT_TRUE(load_points_csv(kFixtures / "header_only.csv").empty());
 }
 
+// ... and the scene says so, naming the file (before: not a word).
+TEST(PointsCsv, SceneNotesAFileOfNoLights) {
+    TempDir dir;
+    dir.write("empty.csv", "x,y,z,r,g,b\n# nothing yet\n");
+    dir.write("t.obj", "v 0 0 0\nv 1 0 0\nv 0 0 1\nf 1 3 2\n");
+    const fs::path scene = dir.write("scene.json", R"({"camera": {"position": [0, 1, 3], "look_at": [0, 0, 0]},
+        "meshes": [{"obj": "t.obj"}],
+        "lights": [{"type": "point", "position": [0, 2, 0], "intensity": [1, 1, 1]},
+                   {"type": "points_csv", "file": "empty.csv"}]})");
+    const Scene s = load_scene(scene);
+    EXPECT_EQ(s.lights.size(), 1u);
+    ASSERT_EQ(s.load_notes.size(), 1u);
+    EXPECT_NE(s.load_notes[0].find("scene.json: lights[1].file: "), std::string::npos) << s.load_notes[0];
+    EXPECT_NE(s.load_notes[0].find("empty.csv holds no lights"), std::string::npos) << s.load_notes[0];
+}
+
+// UTF-16 (a spreadsheet's "Unicode text") is refused by name, not read as
+// a header of one field.
+TEST(PointsCsv, Utf16IsRefused) {
+    TempDir dir;
+    const std::string utf16("\xFF\xFE" "1\0,\0" "2\0", 8);
+    const fs::path file = dir.write("u16.csv", utf16);
+    const std::string message = input_error_of([&] { load_points_csv(file); });
+    EXPECT_NE(message.find("u16.csv: is UTF-16 text"), std::string::npos) << message;
+}
+
 struct CsvError {
     const char* name;
     const char* text;
@@ -1290,6 +1316,12 @@ const CsvError kCsvErrors[] = {
     {"signs_after_plus", "1,2,3,++0,5,6\n", "line 1: ", "column 4 (r): '++0' is not a number"},
     {"typo_in_first_line_is_not_a_header", "1,2,3,4,5,x\n1,2,3,4,5,6\n", "line 1: ", "'x' is not a number"},
     {"second_header", "x,y,z,r,g,b\n1,2,3,4,5,6\nx,y,z,r,g,b\n", "line 3: ", "is not a number"},
+    // A first line of no number is a header only with the format's column
+    // count: a file of semicolons (one field a line), or a spots file's
+    // header, was skipped as one, and a one-line file then gave no light.
+    {"semicolons", "0;2.5;-1;1;1;1\n", "line 1: ", "a header of 1 field (no number in it), where the 6 columns are"},
+    {"spots_header", "# spots\nx,y,z,r,g,b,dx,dy,dz,inner,outer\n1,2,3,4,5,6\n", "line 2: ",
+     "a header of 11 fields"},
     {"nan", "1,2,3,nan,5,6\n", "line 1: ", "column 4 (r): 'nan' is not finite"},
     {"inf", "1,2,3,4,5,6\n-inf,2,3,4,5,6\n", "line 2: ", "is not finite"},
     {"overflow", "1,2,3,4,5,1e999\n", "line 1: ", "out of range"},

@@ -226,14 +226,24 @@ std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::pa
                                  unsigned threads, std::size_t chunk_bytes) {
     const std::string name = display(file);
     const std::string text = read_input_file(file);
+    if (text.starts_with("\xFF\xFE") || text.starts_with("\xFE\xFF"))
+        throw InputError(name, "", "is UTF-16 text (it starts with a UTF-16 byte-order mark); save it as UTF-8 or ASCII");
     std::string_view all = without_bom(text);  // spreadsheets write one
 
     // A header is only the first content line, and only if nothing in it is
     // a number, so that a typo in the first data line is still an error:
-    // skipped here, before the rest is cut into chunks.
+    // skipped here, before the rest is cut into chunks. It must name as many
+    // columns as the format has, so that a file of another format (or of
+    // other separators: a line "0;2.5;-1;1;1;1" is one field, no number) is
+    // not taken for a header and skipped without a word.
     std::size_t first_line = 1;
     for_each_content_line(all, 1, [&](std::size_t line_number, std::string_view line) {
-        if (is_header(split_fields(line))) {
+        if (const Fields fields = split_fields(line); is_header(fields)) {
+            if (fields.count != format.columns)
+                throw InputError(name, line_field(line_number),
+                                 "a header of " + std::to_string(fields.count) + " field" +
+                                     (fields.count == 1 ? "" : "s") + " (no number in it), where the " +
+                                     std::to_string(format.columns) + " columns are " + format.spelled);
             for (; first_line <= line_number; ++first_line) {
                 const std::size_t eol = all.find('\n');
                 all.remove_prefix(eol == std::string_view::npos ? all.size() : eol + 1);

@@ -424,8 +424,12 @@ private:
         } else if (l.type == "directional") {
             light = directional_light(glm::vec3(direction(world, {0.0, 0.0, -1.0}, field, "light")), glm::vec3(value), problem);
         } else if (l.type == "spot") {
-            constexpr double kDegrees = 180.0 / 3.14159265358979323846;
-            const double inner = l.spot.innerConeAngle * kDegrees, outer = l.spot.outerConeAngle * kDegrees;
+            constexpr double kHalfPi = 1.57079632679489661923, kDegrees = 90.0 / kHalfPi;
+            // Exporters that keep angles in floats write pi/2 as 1.5707964,
+            // the shortest decimal of float(pi/2), a hair above pi/2: any
+            // angle that rounds to that float is taken as pi/2.
+            const auto angle = [&](double a) { return a > kHalfPi && float(a) <= float(kHalfPi) ? kHalfPi : a; };
+            const double inner = angle(l.spot.innerConeAngle) * kDegrees, outer = angle(l.spot.outerConeAngle) * kDegrees;
             light = spot_light(position, glm::vec3(direction(world, {0.0, 0.0, -1.0}, field, "light")), glm::vec3(value),
                                float(inner), float(outer), problem);
             if (problem.field == "outer_cone_degrees") fail(name + ".spot.outerConeAngle", "must be from 0 to pi/2");

@@ -383,6 +383,9 @@ private:
             const fs::path csv = existing_file(j, path, "file");
             std::vector<gpu::Light> loaded =
                 type == "points_csv" ? read_points_csv(csv, limits_, threads_) : read_spots_csv(csv, limits_, threads_);
+            if (loaded.empty())
+                scene_.load_notes.push_back(in_.file() + ": " + path + ".file: " + display(csv) +
+                                            " holds no lights (no line but comments, blanks or a header)");
             if (scene_.lights.empty())
                 scene_.lights = std::move(loaded);  // no copy of a file of 10^7 lights
             else

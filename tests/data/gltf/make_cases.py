@@ -386,6 +386,12 @@ def bad_cases():
         "scale": [1e39, 1]}}}))
     variant("bad_spot_cone", lambda d: d["extensions"]["KHR_lights_punctual"]["lights"][0].update(
         type="spot", spot={"innerConeAngle": 0.5, "outerConeAngle": 2.0}))
+    # Not bad: pi/2 as exporters that keep angles in floats write it, a hair above pi/2.
+    variant("spot_float_half_pi", lambda d: d["extensions"]["KHR_lights_punctual"]["lights"][0].update(
+        type="spot", spot={"innerConeAngle": 1.5707964, "outerConeAngle": 1.5707964}))
+    # Bad: the next float above that.
+    variant("bad_spot_past_float_half_pi", lambda d: d["extensions"]["KHR_lights_punctual"]["lights"][0].update(
+        type="spot", spot={"innerConeAngle": 0.5, "outerConeAngle": 1.5707965}))
     variant("bad_position_type", lambda d: d["accessors"][0].update(componentType=USHORT))
     # Values of the wrong JSON type, which tinygltf 2.7 would replace by its default.
     variant("bad_roughness_string", lambda d: (d.update(materials=[{"pbrMetallicRoughness": {
