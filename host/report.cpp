@@ -214,9 +214,16 @@ std::string report_text(const RenderReport& r) {
     if (r.spp != r.spp_requested)
         text += format("  stopped at the time limit after %u of %u spp\n", r.spp, r.spp_requested);
     if (r.method == "path") {
+        // What was traced: a render stopped at its time limit has fewer
+        // paths along each camera ray than asked for (paths go round the
+        // camera rays, so some may have one more).
         const std::uint32_t along = r.sampling ? r.sampling->light_samples : 1u;
+        const std::uint32_t camera_rays = std::max(1u, r.spp_requested / std::max(along, 1u));
+        const std::uint32_t done = r.spp / camera_rays;
         const std::string split =
-            along > 1 ? format(" (%u along each camera ray)", along) : std::string();
+            along <= 1                   ? std::string()
+            : r.spp % camera_rays == 0u ? format(" (%u along each camera ray)", done)
+                                        : format(" (%u or %u along each of %u camera rays)", done, done + 1, camera_rays);
         text += format("  %u path(s) per pixel%s, %s\n", r.spp, split.c_str(),
                        r.max_bounces ? format("at most %u bounce(s)", r.max_bounces).c_str()
                                      : "of any length (Russian roulette)");

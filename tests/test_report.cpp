@@ -128,6 +128,14 @@ TEST(Report, StochasticMethodsReportTheirSampling) {
     EXPECT_THAT(report_json(report), HasSubstr("\"time_limit\": 2.5"));
     EXPECT_THAT(report_text(report), HasSubstr("4 path(s) per pixel (4 along each camera ray)"));
     EXPECT_THAT(report_text(report), Not(HasSubstr("light sample(s) per camera sample")));
+    // Stopped by the time limit, it says what was traced, not what was
+    // asked for (before: "3 path(s) per pixel (4 along each camera ray)").
+    report.spp = 3;
+    EXPECT_THAT(report_text(report), HasSubstr("stopped at the time limit after 3 of 4 spp"));
+    EXPECT_THAT(report_text(report), HasSubstr("3 path(s) per pixel (3 along each camera ray)"));
+    report.spp_requested = 8;  // two camera rays of 4 paths each, stopped after 5 paths
+    report.spp = 5;
+    EXPECT_THAT(report_text(report), HasSubstr("5 path(s) per pixel (2 or 3 along each of 2 camera rays)"));
 }
 
 TEST(Report, BruteForceHasNoLightcutsPart) {
