@@ -59,10 +59,8 @@ glm::vec3 shade_point(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Method
         case Method::kLightcuts: return k.lc_shade_lightcuts(sp, frame, ss);
         case Method::kStochastic: return k.lc_shade_stochastic(sp, frame, stream, ss);
         case Method::kSampled:
-            // As the Vulkan kernel does: the sum over the light samples, then
-            // times 1/k.
-            return k.lc_shade_sampled(sp, frame, stream, 0u, frame.light_samples, ss) *
-                   (1.0f / float(frame.light_samples));
+            // The mean over the light samples, as the Vulkan kernel makes it.
+            return k.lc_shade_sampled(sp, frame, stream, 0u, frame.light_samples, ss);
         case Method::kBrute: break;
     }
     return k.lc_shade_brute_packets(sp, frame.light_count, frame.min_distance2, ss);

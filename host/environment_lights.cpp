@@ -39,9 +39,10 @@ struct Totals {
 // count, not only for fewer directions than texels: a texel given a single
 // direction put it on the horizon the same way (black at 65536 x 1 with
 // 65536 directions). Where a cell still gets several directions, they
-// spread over its latitudes (emit_texel). Maps of the usual 2:1 shape keep
-// sub = 1 up to about 83,000 directions for 256 rows (the shipped sky's
-// 512 x 256 with 3000).
+// spread over its latitudes (emit_texel). Maps of the usual 2:1 shape with
+// H rows keep sub = 1 up to about 1.3 H^2 directions (83,000 for the
+// shipped sky's 512 x 256, rendered with 3000; a 64 x 32 map gets two
+// bands a row from about 1300).
 class Splitter {
 public:
     Splitter(const Environment& map, std::uint32_t count, std::vector<gpu::Light>& out) : map_(map), out_(out) {

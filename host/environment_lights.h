@@ -24,10 +24,10 @@ void environment_direction(float u, float v, float out[3]);
 // part holds one sample. Each light points at the power-weighted mean
 // direction of its part and carries the part's irradiance (the integral of
 // L over its solid angle), so the lights' total is the map's. A texel that
-// gets several samples splits into a stratified grid of directions. With
-// fewer samples than texels, rows much taller in angle than a sample's
-// share of the sphere (maps of a few rows) are first cut into bands of
-// equal solid angle.
+// gets several samples splits into a stratified grid of directions. Rows
+// much taller in angle than a sample's share of the sphere (maps of a few
+// rows, or a 2:1 map of H rows with more than about 1.3 H^2 samples) are
+// first cut into bands of equal solid angle.
 std::vector<gpu::Light> environment_lights(const Environment& map, std::uint32_t count);
 
 }  // namespace lc

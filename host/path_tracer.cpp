@@ -226,7 +226,7 @@ glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, 
         VertexRandom rnd(k, stream, bounce);
         const gpu::Material& m = sp.mat;
         const LobeWeights lobes = lobe_weights(m, sp.n, sp.wo);
-        add(radiance, throughput * next_event(k, sp, lobes, rnd, rays.shadow));
+        add(radiance, throughput * next_event(k, sp, ng, lobes, rnd, rays.shadow));
 
         const BsdfSample b = sample_bsdf(k, m, lobes, sp.n, sp.wo, rnd.unit(kDimLobe), rnd.unit(kDimDirection0),
                                          rnd.unit(kDimDirection1));
@@ -264,22 +264,24 @@ glm::vec3 PathTracer::sample(std::uint32_t x, std::uint32_t y, std::uint32_t s, 
     return radiance;
 }
 
-glm::vec3 PathTracer::next_event(Kernel& k, const SurfacePoint& sp, const LobeWeights& lobes, VertexRandom& rnd,
-                                 std::uint64_t& shadow_rays) const {
+glm::vec3 PathTracer::next_event(Kernel& k, const SurfacePoint& sp, glm::vec3 ng, const LobeWeights& lobes,
+                                 VertexRandom& rnd, std::uint64_t& shadow_rays) const {
     if (emitters_.empty()) return glm::vec3(0.0f);
     float pmf;
     const Emitter e = emitters_.pick(rnd.fine(kDimLightPick), pmf);
     switch (e.kind) {
         case EmitterKind::kLight: return light_sample(k, sp, e.index, pmf, shadow_rays);
-        case EmitterKind::kTriangle: return triangle_sample(k, sp, lobes, e.index, rnd, shadow_rays);
-        case EmitterKind::kEnvironment: return environment_sample(k, sp, lobes, pmf, rnd, shadow_rays);
+        case EmitterKind::kTriangle: return triangle_sample(k, sp, ng, lobes, e.index, rnd, shadow_rays);
+        case EmitterKind::kEnvironment: return environment_sample(k, sp, ng, lobes, pmf, rnd, shadow_rays);
     }
     return glm::vec3(0.0f);
 }
 
 // A point, spot or directional light: a delta, which no BRDF ray can find,
 // so NEE takes it with weight 1. lc_light_unit is the brute-force
-// renderer's exact term (with its clamp of 1/d^2 at min_distance2).
+// renderer's exact term (with its clamp of 1/d^2 at min_distance2); as
+// there, a light below the geometric normal is left to the shadow ray,
+// which the surface itself blocks.
 glm::vec3 PathTracer::light_sample(Kernel& k, const SurfacePoint& sp, std::uint32_t light, float pmf,
                                    std::uint64_t& shadow_rays) const {
     const gpu::Light& l = prepared_.scene.lights[light];
@@ -295,7 +297,7 @@ glm::vec3 PathTracer::light_sample(Kernel& k, const SurfacePoint& sp, std::uint3
 // An emissive triangle: a point uniform over its area, whose density per
 // unit solid angle at sp is triangle_light_pdf (pick() gave this
 // triangle with probability triangle_pmf).
-glm::vec3 PathTracer::triangle_sample(Kernel& k, const SurfacePoint& sp, const LobeWeights& lobes,
+glm::vec3 PathTracer::triangle_sample(Kernel& k, const SurfacePoint& sp, glm::vec3 ng, const LobeWeights& lobes,
                                       std::uint32_t tri, VertexRandom& rnd, std::uint64_t& shadow_rays) const {
     const gpu::Triangle& t = prepared_.scene.triangles[tri];
     const glm::vec3 a = k.lc_tri_v0(t), b = k.lc_tri_v1(t), c = k.lc_tri_v2(t);
@@ -307,7 +309,7 @@ glm::vec3 PathTracer::triangle_sample(Kernel& k, const SurfacePoint& sp, const L
     if (!(d > 0.0f)) return glm::vec3(0.0f);
     const glm::vec3 wi = to_light / d;
     const float cos_i = glm::dot(sp.n, wi);
-    if (!(cos_i > 0.0f)) return glm::vec3(0.0f);
+    if (!(cos_i > 0.0f) || !(glm::dot(ng, wi) > 0.0f)) return glm::vec3(0.0f);
     const glm::vec3 emitted = k.lc_surface_emission(tri, su * (1.0f - v), su * v, wi, glm::vec4(0.0f));
     if (black(emitted)) return glm::vec3(0.0f);  // sp sees its back
     const float light_pdf = triangle_light_pdf(tri, wi, d);
@@ -335,14 +337,14 @@ float PathTracer::triangle_light_pdf(std::uint32_t tri, glm::vec3 wi, float t) c
 }
 
 // The environment: a direction by luminance x solid angle (EnvironmentSampler).
-glm::vec3 PathTracer::environment_sample(Kernel& k, const SurfacePoint& sp, const LobeWeights& lobes, float pmf,
-                                         VertexRandom& rnd, std::uint64_t& shadow_rays) const {
+glm::vec3 PathTracer::environment_sample(Kernel& k, const SurfacePoint& sp, glm::vec3 ng, const LobeWeights& lobes,
+                                         float pmf, VertexRandom& rnd, std::uint64_t& shadow_rays) const {
     float direction_pdf;
     const glm::vec3 wi = emitters_.environment().sample(rnd.fine(kDimLight0), rnd.fine(kDimLight1),
                                                         rnd.unit(kDimLight2), rnd.unit(kDimLight3), direction_pdf);
     const float cos_i = glm::dot(sp.n, wi);
     const float light_pdf = pmf * direction_pdf;
-    if (!(cos_i > 0.0f) || !(light_pdf > 0.0f)) return glm::vec3(0.0f);
+    if (!(cos_i > 0.0f) || !(glm::dot(ng, wi) > 0.0f) || !(light_pdf > 0.0f)) return glm::vec3(0.0f);
     const glm::vec3 sky = k.lc_environment_radiance(frame_, wi);
     if (black(sky)) return glm::vec3(0.0f);
     const gpu::Material& m = sp.mat;

@@ -83,14 +83,17 @@ public:
 private:
     class VertexRandom;
 
-    glm::vec3 next_event(Kernel& k, const SurfacePoint& sp, const LobeWeights& lobes, VertexRandom& rnd,
-                         std::uint64_t& shadow_rays) const;
+    // NEE at sp, whose geometric normal (facing_normal) is ng: the
+    // emitters MIS weighs against the BRDF's rays take nothing from where
+    // those rays end, into the surface.
+    glm::vec3 next_event(Kernel& k, const SurfacePoint& sp, glm::vec3 ng, const LobeWeights& lobes,
+                         VertexRandom& rnd, std::uint64_t& shadow_rays) const;
     glm::vec3 light_sample(Kernel& k, const SurfacePoint& sp, std::uint32_t light, float pmf,
                            std::uint64_t& shadow_rays) const;
-    glm::vec3 triangle_sample(Kernel& k, const SurfacePoint& sp, const LobeWeights& lobes, std::uint32_t tri,
-                              VertexRandom& rnd, std::uint64_t& shadow_rays) const;
-    glm::vec3 environment_sample(Kernel& k, const SurfacePoint& sp, const LobeWeights& lobes, float pmf,
-                                 VertexRandom& rnd, std::uint64_t& shadow_rays) const;
+    glm::vec3 triangle_sample(Kernel& k, const SurfacePoint& sp, glm::vec3 ng, const LobeWeights& lobes,
+                              std::uint32_t tri, VertexRandom& rnd, std::uint64_t& shadow_rays) const;
+    glm::vec3 environment_sample(Kernel& k, const SurfacePoint& sp, glm::vec3 ng, const LobeWeights& lobes,
+                                 float pmf, VertexRandom& rnd, std::uint64_t& shadow_rays) const;
     // Density with which NEE picks the point of triangle `tri` hit at
     // distance t along wi, per unit solid angle.
     float triangle_light_pdf(std::uint32_t tri, glm::vec3 wi, float t) const;

@@ -1,8 +1,8 @@
 // Light sampling (--method sampled): light samples
 // [push.light_first, push.light_first + push.light_count) of the
 // frame.light_samples drawn at the G-buffer point of every tile pixel
-// (shared/sampling.h), one shadow ray each; their sum times
-// 1 / frame.light_samples is added to the pixel's sum. The host covers all
+// (shared/sampling.h), one shadow ray each; their sum, each divided by
+// frame.light_samples, is added to the pixel's sum. The host covers all
 // light samples in one dispatch, or in several ranges where the driver
 // limits the loop iterations.
 #version 460
@@ -25,7 +25,7 @@ void main() {
     stats.cut_indirect = 0u;
     uint stream = lc_sample_stream(frame.seed, lc_tile_x(i), lc_tile_y(i), push.sample_index);
     vec3 c = lc_shade_sampled(lc_texel_surface(g), frame, stream, push.light_first, push.light_count, stats);
-    lc_accumulate(i, c * (1.0f / float(frame.light_samples)));
+    lc_accumulate(i, c);
     lc_count_add(pixel_stats[i].shadow_rays_lo, pixel_stats[i].shadow_rays_hi, stats.shadow_rays);
     if (lc_loops_were_cut_short()) pixel_stats[i].flags |= kPixelLoopLimit;
 }

@@ -242,10 +242,12 @@ uint lc_pick_light(LC_IN(SurfacePoint) sp, LC_IN(FrameParams) f, uint stream, LC
 
 // --method sampled: light samples [first, first + count) of the point's
 // f.light_samples, each one light picked by lc_pick_light and one shadow
-// ray; returns their sum of contribution / probability (the caller divides
-// by f.light_samples, after every range is summed).
+// ray; returns their sum of contribution / probability / f.light_samples
+// (each divided before it is added: a sum of estimates near FLT_MAX each
+// would overflow before a division at the end).
 vec3 lc_shade_sampled(LC_IN(SurfacePoint) sp, LC_IN(FrameParams) f, uint stream, uint first, uint count,
                       LC_INOUT(ShadeStats) stats) {
+    float per_sample = 1.0f / float(f.light_samples);
     vec3 sum = vec3(0.0f);
     for (uint k = first; k < first + count; ++k) {
         float pdf;
@@ -255,7 +257,7 @@ vec3 lc_shade_sampled(LC_IN(SurfacePoint) sp, LC_IN(FrameParams) f, uint stream,
         // Divided by pdf last: pdf <= 1, so no step overflows where the
         // result does not (intensity / pdf did, for a light of 1e38 picked
         // with probability 0.5, or a dim one at the tree pick's 2^-24).
-        sum += (lc_light_unit_shadowed(sp, l, f.min_distance2, stats) * lc_light_intensity(l)) / pdf;
+        sum += ((lc_light_unit_shadowed(sp, l, f.min_distance2, stats) * lc_light_intensity(l)) / pdf) * per_sample;
     }
     return sum;
 }
