@@ -319,7 +319,7 @@ TEST(Gltf, AWideCameraKeepsItsShapeWithinTheImageLimit) {
     const Scene s = load("wide_camera.gltf");
     EXPECT_EQ(s.camera.width, 16384u);
     EXPECT_EQ(s.camera.height, 164u);
-    EXPECT_TRUE(has_note(s, "cameras[0].perspective.aspectRatio: the image is 16384x164")) << s.load_notes.size();
+    EXPECT_TRUE(has_note(s, "cameras[0].perspective.aspectRatio: the camera's image is 16384x164")) << s.load_notes.size();
 }
 
 TEST(Gltf, UnsupportedPartsAreSkippedWithOneNoteEach) {

@@ -344,8 +344,9 @@ private:
         c.height = std::uint32_t(height);
         if (height != kGltfImageHeight)
             notes_.add(name + ".perspective.aspectRatio",
-                       "the image is " + std::to_string(c.width) + "x" + std::to_string(c.height) + " to keep each side within " +
-                           std::to_string(kMaxImageSide) + " pixels");
+                       "the camera's image is " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+                           " to keep each side within " + std::to_string(kMaxImageSide) +
+                           " pixels (--width and --height choose another)");
     }
 
     void add_camera(int index, const std::string& node, const glm::dmat4& world) {
