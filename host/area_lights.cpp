@@ -174,17 +174,21 @@ double TriangleEmission::power(std::size_t i) const {
     const double area = 0.5 * glm::length(glm::cross(b - a, c - a));
     const double sides = (m.flags & gpu::kMaterialEmitsBothSides) ? 2.0 : 1.0;
     double luminance = gpu::lc_luminance(mean(i));
-    // The points can all miss a texture's small bright features; a triangle
-    // with no power gets no samples, so its light would be lost (a black
-    // 64 x 64 emissive texture with one white texel lit nothing). Where
-    // the texels under the triangle's uv box are not all black it gets as
-    // much as one of the points would have found on the brightest of them:
-    // its samples carry the texture at their own points, so any share
-    // that is not zero keeps the estimate unbiased.
-    if (luminance == 0.0 && has_emissive_texture(m) && uvs_.size() == triangles_.size()) {
+    // The points can miss a texture's small bright features, or graze
+    // them; a triangle with no power gets no samples, so its light would be
+    // lost (a black 64 x 64 emissive texture with one white texel lit
+    // nothing), and one whose points only graze the feature got a share
+    // hundreds of times below a neighbour's that had none and took the
+    // floor below (a quad lit from its wrong half, 0 to 3 times too
+    // bright over seeds). Where the texels under the triangle's uv box are
+    // not all black it gets at least as much as one of the points would
+    // have found on the brightest of them: its samples carry the texture
+    // at their own points, so any share that is not zero keeps the
+    // estimate unbiased.
+    if (has_emissive_texture(m) && uvs_.size() == triangles_.size()) {
         const double brightest = brightest_in_footprint(i);
         const double floor = brightest < 0.0 ? gpu::lc_luminance(emission(m)) : brightest;
-        luminance = floor / kMeanPoints;
+        luminance = std::max(luminance, floor / kMeanPoints);
     }
     return 3.14159265358979323846 * area * sides * luminance;
 }

@@ -33,13 +33,14 @@ public:
     // with one, the mean over kMeanPoints stratified points.
     glm::vec3 mean(std::size_t i) const;
     // Emitted power pi A lum(mean) per emitting side (0: does not emit);
-    // where the points of `mean` all found black but a texel the triangle's
-    // uv box covers is not, as if one of them had found the brightest such
-    // texel (or, past 65,536 texels, the material's emission).
+    // with an emissive texture at least as if one of the points of `mean`
+    // had found the brightest texel the triangle's uv box covers (or, past
+    // 65,536 texels, the material's emission).
     double power(std::size_t i) const;
     // power(i) of every triangle, on up to `threads` threads (0: every
     // core; one below 16,384 triangles): with an emissive texture each
-    // takes 256 texture reads.
+    // takes 256 texture reads and one of each texel under its uv box (at
+    // most 65,536).
     std::vector<double> powers(unsigned threads = 0) const;
 
     static constexpr std::uint32_t kMeanPoints = 256;

@@ -850,6 +850,52 @@ TEST(TexturedAreaLights, SmallBrightFeaturesStillGetSamples) {
     EXPECT_NEAR(total / seeds, integral, 0.1 * integral);
 }
 
+// A quad under a texture black but for one texel: the triangle whose
+// points only graze the texel (a mean far below the texel's share) still
+// gets at least the floor, as its neighbour with no bright texel under it
+// gets nothing. Before, the floor applied only to a mean of exactly 0: the
+// half that emits got about 0.4% of the samples and the half that does
+// not the rest (the audit: a lamp from 0 to 3 times too bright over seeds,
+// black at 16384 samples for 7 of 8 seeds).
+TEST(TexturedAreaLights, AGrazedBrightTexelGetsTheFloor) {
+    // The audit's lamp: a unit quad of MTL map_Ke, a 64 x 64 texture black
+    // but for the texel at column 21, row 40.
+    test::TempDir dir;
+    std::vector<std::uint32_t> texels(64 * 64, rgba(0, 0, 0));
+    texels[40 * 64 + 21] = rgba(255, 255, 255);
+    write_png(dir.path() / "dot.png", 64, 64, texels);
+    dir.write("lamp.mtl", "newmtl e\nKd 0 0 0\nKe 1 1 1\nmap_Ke dot.png\n");
+    dir.write("lamp.obj", "mtllib lamp.mtl\nv -0.5 1 -0.5\nv 0.5 1 -0.5\nv 0.5 1 0.5\nv -0.5 1 0.5\n"
+                          "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nusemtl e\nf 1/1 2/2 3/3 4/4\n");
+    const Scene s = load_scene(dir.write("lamp.json", R"({"camera": {"position": [0, 3, 4], "look_at": [0, 0.3, 0]},
+        "meshes": [{"obj": "lamp.obj"}]})"));
+    ASSERT_EQ(s.triangles.size(), 2u);
+    const TriangleEmission emission(s);
+    std::printf("[ measured ] means %.3g and %.3g, powers %.3g and %.3g\n", double(emission.mean(0).x),
+                double(emission.mean(1).x), emission.power(0), emission.power(1));
+    // One triangle's points graze the texel, the other's find nothing:
+    // both take the floor (their uv boxes both cover the texel).
+    EXPECT_GT(std::max(emission.mean(0).x, emission.mean(1).x), 0.0f);
+    EXPECT_EQ(std::min(emission.mean(0).x, emission.mean(1).x), 0.0f);
+    EXPECT_EQ(emission.power(0), emission.power(1));
+    double integral = 0.0;
+    const std::uint32_t fine = 1u << 20;
+    for (std::uint32_t i = 0; i < 2; ++i)
+        for (std::uint32_t k = 0; k < fine; ++k) {
+            const glm::vec2 b = triangle_sample_barycentrics(k, fine, 0.0f, 0.5f / float(fine));
+            integral += emission.at(i, b.x, b.y).x * (0.5 / fine);
+        }
+    // About 4096 / 2 / 4096 of a seed's samples land where the texel
+    // shines: 2 a seed, so the mean over 200 seeds spreads by about 5%.
+    double total = 0.0;
+    const int seeds = 200;
+    for (int seed = 1; seed <= seeds; ++seed)
+        for (const gpu::Light& l : sample_area_lights(s, 4096, std::uint32_t(seed))) total += l.r;
+    std::printf("[ measured ] samples' intensity %.6f over %d seeds, the emission's integral %.6f\n",
+                total / seeds, seeds, integral);
+    EXPECT_NEAR(total / seeds, integral, 0.15 * integral);
+}
+
 // The floor above reads the texels the lookups read: through a uv
 // transform, and wrapped as the texture's sampler wraps.
 TEST(TexturedAreaLights, SmallBrightFeaturesAreFoundThroughTheSampler) {
