@@ -504,6 +504,9 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"bad_json.gltf", "tinygltf: "},
         BadCase{"bad_roughness_string.gltf",
                 "materials[0].pbrMetallicRoughness.roughnessFactor: must be a number, not a string"},
+        // The value as written, not in 40 digits (std::to_string's %f).
+        BadCase{"bad_emissive_strength_huge.gltf", "materials[0].extensions.KHR_materials_emissive_strength."
+                                                   "emissiveStrength: must be from 0 to FLT_MAX, got 1e+39"},
         BadCase{"bad_emissive_strength_number.gltf",
                 "materials[0].extensions.KHR_materials_emissive_strength: must be an object, not a number"},
         BadCase{"bad_lights_array.gltf", "extensions.KHR_lights_punctual: must be an object, not an array"},

@@ -2,6 +2,7 @@
 #include "gltf_materials.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -61,9 +62,14 @@ public:
     explicit FactorReader(const std::string& file) : file_(file) {}
 
     float in_range(double v, double hi, const std::string& field) const {
-        if (!(v >= 0.0 && v <= hi))
+        if (!(v >= 0.0 && v <= hi)) {
+            // The shortest text that reads back as v (std::to_string's %f
+            // wrote 1e39 in 40 digits and 1e-9 as 0.000000).
+            char text[32];
+            const auto end = std::to_chars(text, text + sizeof text, v).ptr;
             throw InputError(file_, field, "must be from 0 to " + std::string(hi == 1.0 ? "1" : "FLT_MAX") +
-                                               ", got " + std::to_string(v));
+                                               ", got " + std::string(text, end));
+        }
         return float(v);
     }
 

@@ -399,6 +399,10 @@ def bad_cases():
     variant("bad_emissive_strength_number", lambda d: (d.update(materials=[{"emissiveFactor": [1, 1, 1],
         "extensions": {"KHR_materials_emissive_strength": 5}}]), d["meshes"][0]["primitives"][0].update(material=0),
         d.update(extensionsUsed=d.get("extensionsUsed", []) + ["KHR_materials_emissive_strength"])))
+    variant("bad_emissive_strength_huge", lambda d: (d.update(materials=[{"emissiveFactor": [1, 1, 1],
+        "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 1e39}}}]),
+        d["meshes"][0]["primitives"][0].update(material=0),
+        d.update(extensionsUsed=d.get("extensionsUsed", []) + ["KHR_materials_emissive_strength"])))
     variant("bad_lights_array", lambda d: d["extensions"].update(KHR_lights_punctual=[1]))
     variant("bad_light_string", lambda d: d["extensions"]["KHR_lights_punctual"]["lights"].__setitem__(0, "point"))
     variant("bad_node_light_number", lambda d: d["nodes"][1]["extensions"].update(KHR_lights_punctual=0))
