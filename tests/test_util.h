@@ -298,6 +298,22 @@ inline Scene room_scene(std::vector<gpu::Light> lights, std::uint32_t size) {
     return s;
 }
 
+// A ground plane and a box under a constant sky of 2.7e37, the brightest
+// the loader accepts (4 pi L = 3.39e38, just below FLT_MAX); 8 x 8, the
+// top row of pixels sees the sky.
+inline Scene brightest_sky_scene() {
+    Scene s;
+    s.materials = {lambert(glm::vec3(0.5f))};
+    add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
+    add_box(s, {-0.3f, 0.0f, -0.3f}, {0.3f, 0.6f, 0.3f}, 0);
+    s.camera = camera({0.0f, 1.0f, 3.0f}, {0.0f, 0.5f, 0.0f}, 60.0f, 8, 8);
+    s.environment.width = 4;
+    s.environment.height = 2;
+    s.environment.rgb.assign(4 * 2 * 3, 2.7e37f);
+    update_bounds(s);
+    return s;
+}
+
 inline RenderOptions options(const std::string& method, std::uint32_t size) {
     RenderOptions o;
     o.method = method;

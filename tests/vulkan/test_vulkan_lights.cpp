@@ -301,15 +301,7 @@ INSTANTIATE_TEST_SUITE_P(Kinds, VulkanSampled, ::testing::ValuesIn(kLightModelCa
 class VulkanBright : public Vulkan {};
 
 TEST_F(VulkanBright, BrightestAcceptedSkyRendersFinitePixels) {
-    Scene s;
-    s.materials = {test::lambert(glm::vec3(0.5f))};
-    test::add_quad(s, {-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}, 0);
-    test::add_box(s, {-0.3f, 0.0f, -0.3f}, {0.3f, 0.6f, 0.3f}, 0);
-    s.camera = test::camera({0.0f, 1.0f, 3.0f}, {0.0f, 0.5f, 0.0f}, 60.0f, 8, 8);  // the top row sees the sky
-    s.environment.width = 4;
-    s.environment.height = 2;
-    s.environment.rgb.assign(4 * 2 * 3, 2.7e37f);  // 3.39e38 in all
-    update_bounds(s);
+    const Scene s = test::brightest_sky_scene();
     const PreparedScene p = prepare_scene(s, 1);
     for (const char* method : {"brute", "lightcuts", "sampled"}) {
         RenderOptions o = options(method, 8, 8, 64);
