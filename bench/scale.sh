@@ -35,7 +35,8 @@ extra=()
 if [ "$oriented" = 1 ]; then
   scene="$root/scenes/panels/panels.json"
   extra=(--area-samples "$count")
-elif [ ! -f "$lights" ]; then
+elif [ ! -f "$lights" ] || [ "$(grep -c -v -e '^#' -e '^[[:space:]]*$' "$lights")" != "$((count + 1))" ]; then
+  # Made again unless a whole list of COUNT lights (and its header) is there.
   python3 "$root/scripts/gen_lights.py" --shape room --count "$count" --seed 1 --out "$lights"
 fi
 # The shipped room with this light file (paths relative to the scene file).
@@ -67,10 +68,10 @@ for run in cpu cpu_pixel vulkan; do
   env "${env[@]}" /usr/bin/time -f "peak resident memory %M KiB, wall %e s, user %U s, sys %S s" \
     "$exe" render "$scene" "${extra[@]}" -o "$out/$run.exr" --device "$device" --width "$size" --height "$size" \
     --stats "$out/$run.json" "${args[@]}" 2>&1 | grep -v '^\s*$'
-  python3 - "$out/$run.json" "$count" <<'PY'
+  python3 - "$out/$run.json" <<'PY'
 import json, sys
-s = json.load(open(sys.argv[1])); n = int(sys.argv[2]); sec = s["seconds"]
-print(f"  load {sec['load']:.2f} s, area-light sampling {sec['light_sampling']:.2f} s, "
+s = json.load(open(sys.argv[1])); n = s["lights"]; sec = s["seconds"]
+print(f"  {n} lights; load {sec['load']:.2f} s, area-light sampling {sec['light_sampling']:.2f} s, "
       f"light tree {sec['light_tree_build']:.2f} s, render {sec['render']:.2f} s")
 b = s.get("buffer_bytes", {})
 per_light = b.get("lights", 0) + b.get("light_tree_nodes", 0)

@@ -10,7 +10,9 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <system_error>
+#include <vector>
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -210,6 +212,51 @@ void write_exr(const fs::path& file, const Image& image) {
     write_via_temp(file, [&](const fs::path& tmp) { return write_bytes(tmp, bytes); });
 }
 
+namespace {
+
+// Refuses the header attributes on which tinyexr (1.0.1, Debian's shared
+// library, built with its asserts on) aborts the process instead of
+// returning an error: a `tiles` attribute of other than 9 bytes, a tile
+// level or rounding mode outside the format's, a `type` it does not know
+// or one that contradicts the version's tiled flag. The attributes are
+// walked as the format lays them out (name, type name, 4-byte size,
+// value); where the list itself is broken, tinyexr's own parse says so.
+void check_exr_attributes(std::string_view bytes, const EXRVersion& version, const std::string& name) {
+    std::size_t at = 8;  // after the magic number and the version field
+    const auto text = [&](std::string& out) {
+        const std::size_t end = bytes.find('\0', at);
+        if (end == std::string_view::npos || end - at > 255) return false;
+        out.assign(bytes.substr(at, end - at));
+        at = end + 1;
+        return true;
+    };
+    for (;;) {
+        std::string attribute, type;
+        if (!text(attribute) || attribute.empty() || !text(type) || bytes.size() - at < 4) return;
+        std::uint32_t size = 0;
+        for (int i = 0; i < 4; ++i) size |= std::uint32_t(std::uint8_t(bytes[at + std::size_t(i)])) << (8 * i);
+        at += 4;
+        if (size > bytes.size() - at) return;
+        const std::string_view value = bytes.substr(at, size);
+        at += size;
+        if (attribute == "tiles") {
+            if (size != 9) throw InputError(name, "tiles", "holds " + std::to_string(size) + " bytes, not 9");
+            const unsigned mode = std::uint8_t(value[8]);
+            if ((mode & 0x0fu) > 2u || (mode >> 4) > 1u)
+                throw InputError(name, "tiles", "level or rounding mode is not one of OpenEXR's");
+        } else if (attribute == "type") {
+            const std::string kind(value.substr(0, value.find('\0')));
+            const bool tiled = kind == "tiledimage" || kind == "deeptile";
+            if (!tiled && kind != "scanlineimage" && kind != "deepscanline")
+                throw InputError(name, "type", "'" + kind + "' is not an OpenEXR part type");
+            if (tiled != bool(version.tiled))
+                throw InputError(name, "type", "'" + kind + "' contradicts the file's tiled flag");
+        }
+    }
+}
+
+}  // namespace
+
 Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
     const std::string name = file.string();
     // The file is read once and decoded from memory. tinyexr's file calls
@@ -223,6 +270,8 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
         throw InputError(name, "", "is not an OpenEXR file");
     if (version.multipart || version.non_image)
         throw InputError(name, "", "multi-part and deep OpenEXR files are not supported");
+
+    check_exr_attributes(bytes, version, name);
 
     // tinyexr fills the header (channels, attributes) even when parsing
     // fails, so the guard is in place before the parse.
@@ -244,6 +293,13 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
     if (std::uint64_t(width) * std::uint64_t(height) > max_pixels)
         throw InputError(name, "", "is " + std::to_string(width) + " x " + std::to_string(height) +
                                        " pixels, more than the " + std::to_string(max_pixels) + " it may hold");
+    // tinyexr asserts that a level's size plus a tile's does not overflow an
+    // int; no real file has tiles near 2^31 pixels a side.
+    constexpr int kMaxTileSide = 1 << 24;
+    if (header.tiled && (header.tile_size_x < 1 || header.tile_size_y < 1 || header.tile_size_x > kMaxTileSide ||
+                         header.tile_size_y > kMaxTileSide))
+        throw InputError(name, "tiles", "tile size " + std::to_string(header.tile_size_x) + " x " +
+                                            std::to_string(header.tile_size_y) + " is out of range");
 
     int rgb_channel[3] = {-1, -1, -1};
     for (int c = 0; c < header.num_channels; ++c) {
@@ -283,23 +339,35 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
             for (std::size_t i = 0; i < pixels; ++i) image.rgb[i * 3 + std::size_t(slot)] = src[i];
         }
     } else if (exr.tiles) {
-        // Level 0 of a tiled file: tiles are placed on a tile_size grid.
+        // Level 0 of a tiled file: tiles are placed on a tile_size grid, from
+        // coordinates the file gives (tinyexr takes any, negative ones too),
+        // so each tile must lie on the grid inside the image and every pixel
+        // must come from exactly one tile.
+        std::vector<std::uint8_t> covered(std::size_t(exr.width) * std::size_t(exr.height), 0);
+        std::uint64_t placed = 0;
         for (int t = 0; t < exr.num_tiles; ++t) {
             const EXRTile& tile = exr.tiles[t];
-            const long x0 = long(tile.offset_x) * header.tile_size_x;
-            const long y0 = long(tile.offset_y) * header.tile_size_y;
-            for (int slot = 0; slot < 3; ++slot) {
-                const float* src = reinterpret_cast<const float*>(tile.images[rgb_channel[slot]]);
-                for (int y = 0; y < tile.height; ++y) {
-                    for (int x = 0; x < tile.width; ++x) {
-                        const long px = x0 + x, py = y0 + y;
-                        if (px >= exr.width || py >= exr.height) continue;
-                        image.rgb[(std::size_t(py) * image.width + std::size_t(px)) * 3 + std::size_t(slot)] =
-                            src[std::size_t(y) * std::size_t(header.tile_size_x) + std::size_t(x)];
-                    }
+            const std::int64_t x0 = std::int64_t(tile.offset_x) * header.tile_size_x;
+            const std::int64_t y0 = std::int64_t(tile.offset_y) * header.tile_size_y;
+            if (tile.offset_x < 0 || tile.offset_y < 0 || x0 >= exr.width || y0 >= exr.height || tile.width < 0 ||
+                tile.height < 0 || tile.width > header.tile_size_x || tile.height > header.tile_size_y)
+                throw InputError(name, "tiles", "tile " + std::to_string(t) + " lies outside the image");
+            const int w = int(std::min<std::int64_t>(tile.width, exr.width - x0));
+            const int h = int(std::min<std::int64_t>(tile.height, exr.height - y0));
+            for (int y = 0; y < h; ++y) {
+                for (int x = 0; x < w; ++x) {
+                    const std::size_t pixel = std::size_t(y0 + y) * image.width + std::size_t(x0 + x);
+                    if (covered[pixel]++ != 0)
+                        throw InputError(name, "tiles", "tile " + std::to_string(t) + " overlaps another tile");
+                    ++placed;
+                    const std::size_t from = std::size_t(y) * std::size_t(header.tile_size_x) + std::size_t(x);
+                    for (int slot = 0; slot < 3; ++slot)
+                        image.rgb[pixel * 3 + std::size_t(slot)] =
+                            reinterpret_cast<const float*>(tile.images[rgb_channel[slot]])[from];
                 }
             }
         }
+        if (placed != covered.size()) throw InputError(name, "tiles", "some pixels lie in no tile");
     } else {
         throw InputError(name, "", "OpenEXR file holds no pixel data");
     }

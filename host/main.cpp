@@ -4,10 +4,12 @@
 //   lightcuts compare IMAGE REFERENCE [--heatmap]  error metrics between two EXRs
 //   lightcuts info SCENE [--area-samples N]        what a scene holds
 // SCENE is a scene JSON or a glTF 2.0 file (.gltf, .glb).
+#include <cerrno>
 #include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <future>
 #include <limits>
@@ -129,6 +131,25 @@ void print_load_notes(const std::string& file, const lc::Scene& scene) {
     for (const std::string& line : scene.load_notes) std::fprintf(stderr, "note: %s\n", line.c_str());
 }
 
+// The path tracer samples the emissive surfaces and the environment
+// themselves and finds indirect light itself: the point lights the others
+// become, and VPLs, would only cost time and memory (4M area samples took
+// 5.6 s of tree building for nothing). render and info both apply this.
+void drop_what_the_method_does_not_use(lc::Scene& scene, const std::string& method) {
+    if (method != "path") return;
+    scene.render.indirect.vpls = 0;
+    scene.render.area_light_samples = 0;
+    scene.environment.directions = 0;
+}
+
+// stdout holds the report of render and all that compare and info make:
+// a write to it that failed (a full disk, a closed pipe) is an error, not
+// a success with an empty file.
+void check_stdout() {
+    if (std::fflush(stdout) != 0 || std::ferror(stdout))
+        throw std::runtime_error(std::string("cannot write to standard output: ") + std::strerror(errno));
+}
+
 int run_render(RenderArgs a) {
     // Device "auto" renders through Vulkan only on a GPU, and finding out
     // loads every installed Vulkan driver (0.1 s where Mesa's are
@@ -148,15 +169,7 @@ int run_render(RenderArgs a) {
     if (a.vpls) scene.render.indirect.vpls = *a.vpls;
     if (a.vpl_bounces) scene.render.indirect.max_bounces = *a.vpl_bounces;
     if (a.vpl_clamp) scene.render.indirect.clamp = *a.vpl_clamp;
-    // The path tracer samples the emissive surfaces and the environment
-    // themselves and finds indirect light itself: the point lights the
-    // others become, and VPLs, would only cost time and memory (4M area
-    // samples took 5.6 s of tree building for nothing).
-    if (options.method == "path") {
-        scene.render.indirect.vpls = 0;
-        scene.render.area_light_samples = 0;
-        scene.environment.directions = 0;
-    }
+    drop_what_the_method_does_not_use(scene, options.method);
     lc::validate_render_options(options);
     if (const std::string note = unused_options_note(a, options.method, scene.render.indirect.vpls > 0);
         !note.empty())
@@ -171,6 +184,7 @@ int run_render(RenderArgs a) {
     const lc::RenderResult result = lc::render(prepared, options, a.device);
     const lc::RenderReport report = lc::make_report(a.scene, options, prepared, result, load_seconds);
     std::fputs(lc::report_text(report).c_str(), stdout);
+    check_stdout();  // before the outputs, which are then left unwritten
     lc::write_render_outputs(outputs, a.outputs, result, lc::report_json(report));
     return 0;
 }
@@ -233,6 +247,7 @@ int run_compare(const std::string& image, const std::string& reference, const st
         std::printf("mean difference      %+.4f%% (image mean luminance over the reference's)\n",
                     100.0 * c.mean_difference);
     }
+    check_stdout();
     // The heatmap's scale runs from 0 to 10% relative luminance error.
     if (!heatmap.empty()) {
         lc::write_file(outputs.temporary(heatmap), lc::encode_heatmap_png(a.width, a.height, c.per_pixel, 0.1f, heatmap),
@@ -246,6 +261,7 @@ int run_compare(const std::string& image, const std::string& reference, const st
 // prepared (the lights made from emissive surfaces and light paths).
 struct InfoArgs {
     std::optional<std::uint32_t> area_samples, vpls, vpl_bounces, seed;
+    std::string method;
 };
 
 int run_info(const std::string& file, const lc::SceneOptions& options, const InfoArgs& a) {
@@ -257,7 +273,10 @@ int run_info(const std::string& file, const lc::SceneOptions& options, const Inf
     // The render's seed, which places the area-light samples and the VPLs
     // (with seed 1 always, a scene of another seed got other VPL counts).
     const std::uint32_t seed = a.seed.value_or(scene.render.seed);
+    const std::string method = a.method.empty() ? scene.render.method : a.method;
+    drop_what_the_method_does_not_use(scene, method);
     std::printf("%s\n", file.c_str());
+    std::printf("  method             %s\n", method.c_str());
     std::printf("  triangles          %zu (%zu degenerate dropped)\n", scene.triangles.size(),
                 scene.degenerate_triangles_dropped);
     std::printf("  materials          %zu\n", scene.materials.size());
@@ -282,6 +301,7 @@ int run_info(const std::string& file, const lc::SceneOptions& options, const Inf
     std::printf("  buffers the kernels read (the host holds the scene's lights too, 48 B a light, and at the "
                 "tree's build about 330 B a light in all):\n%s",
                 lc::buffer_table(lc::scene_buffer_bytes(prepared)).c_str());
+    check_stdout();
     return 0;
 }
 
@@ -404,6 +424,10 @@ int main(int argc, char** argv) {
         ->transform(setting(lc::kSettingMaxBounces));
     info->add_option("--seed", info_args.seed, "Seed of the area-light samples and VPLs, as render's")
         ->transform(setting(lc::kSettingSeed));
+    info->add_option("--method", info_args.method,
+                     "The method to size the buffers for, as render's (path makes no area-light samples, VPLs "
+                     "or environment directions)")
+        ->check(ask(lc::method_problem));
 
     // A first word that is neither a subcommand nor an option: CLI11 would
     // say only that a subcommand is required.
@@ -458,10 +482,14 @@ int main(int argc, char** argv) {
         if (*info) return run_info(info_scene, info_options, info_args);
     } catch (const std::bad_alloc&) {
         // Where the memory went is not known here; what usually takes it is.
-        std::fprintf(stderr,
-                     "error: out of memory (the image's pixels and their statistics, the lights and the light tree, "
-                     "area-light samples and VPLs all grow with their settings; `lightcuts info SCENE` prints the "
-                     "buffers a scene needs)\n");
+        if (*compare)
+            std::fprintf(stderr, "error: out of memory reading the two images (their pixels are held as floats, 12 B "
+                                 "a pixel each, and decoded through a second copy)\n");
+        else
+            std::fprintf(stderr,
+                         "error: out of memory (the image's pixels and their statistics, the lights and the light "
+                         "tree, area-light samples and VPLs all grow with their settings; `lightcuts info SCENE` "
+                         "prints the buffers a scene needs)\n");
         return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "error: %s\n", e.what());

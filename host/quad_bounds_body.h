@@ -156,6 +156,7 @@ struct BoxCones {
     V outside, a_x, a_y, a_z, sin_c, cos_c;
 };
 
+template <class Kernel>
 LC_ALWAYS_INLINE inline BoxCones box_cones(const QuadLanes& q, const QuadNodes& n) {
     const V zero = v_zero(), one = v_set1(1.0f), half = v_set1(0.5f);
     const V c_x = v_mul(half, v_add(v_sub(n.min_x, q.px), v_sub(n.max_x, q.px)));
@@ -163,7 +164,7 @@ LC_ALWAYS_INLINE inline BoxCones box_cones(const QuadLanes& q, const QuadNodes& 
     const V c_z = v_mul(half, v_add(v_sub(n.min_z, q.pz), v_sub(n.max_z, q.pz)));
     const V dist = v_sqrt(dot4(c_x, c_y, c_z, c_x, c_y, c_z));
     BoxCones cone;
-    cone.outside = v_cmpgt(dist, n.radius);
+    cone.outside = v_cmpgt(dist, v_mul(n.radius, v_set1(Kernel::kOutsideSphere)));
     cone.a_x = v_div(c_x, dist), cone.a_y = v_div(c_y, dist), cone.a_z = v_div(c_z, dist);
     cone.sin_c = v_min(v_div(n.radius, dist), one);
     cone.cos_c = v_sqrt(v_max(v_sub(one, v_mul(cone.sin_c, cone.sin_c)), zero));
@@ -175,13 +176,17 @@ template <class Kernel>
 LC_ALWAYS_INLINE inline V cos_h_max(const QuadLanes& q, const BoxCones& cone) {
     const V one = v_set1(1.0f), half = v_set1(0.5f), zero = v_zero();
     const V cos_r = dot4(q.wr_x, q.wr_y, q.wr_z, cone.a_x, cone.a_y, cone.a_z);
-    const V in_cone = v_cmpge(cos_r, cone.cos_c);  // the mirror direction in the cone: 1
+    // theta_c + kAngleSlack.
+    const V slack_cos = v_set1(Kernel::kAngleSlackCos), slack_sin = v_set1(Kernel::kAngleSlackSin);
+    const V cos_c = v_sub(v_mul(cone.cos_c, slack_cos), v_mul(cone.sin_c, slack_sin));
+    const V sin_c = v_add(v_mul(cone.sin_c, slack_cos), v_mul(cone.cos_c, slack_sin));
+    const V in_cone = v_cmpge(cos_r, cos_c);  // the mirror direction in the cone: 1
     const V x_x = v_sub(v_mul(q.wr_y, cone.a_z), v_mul(cone.a_y, q.wr_z));
     const V x_y = v_sub(v_mul(q.wr_z, cone.a_x), v_mul(cone.a_z, q.wr_x));
     const V x_z = v_sub(v_mul(q.wr_x, cone.a_y), v_mul(cone.a_x, q.wr_y));
     const V sin_r = v_sqrt(dot4(x_x, x_y, x_z, x_x, x_y, x_z));
     const V cos_delta = v_min(
-        v_add(v_add(v_mul(cos_r, cone.cos_c), v_mul(sin_r, cone.sin_c)), v_set1(Kernel::kCosineAbsSlack)), one);
+        v_add(v_add(v_mul(cos_r, cos_c), v_mul(sin_r, sin_c)), v_set1(Kernel::kCosineAbsSlack)), one);
     const V narrowed =
         v_min(v_mul(v_sqrt(v_max(v_add(half, v_mul(half, cos_delta)), zero)), v_set1(Kernel::kBoundSlack)), one);
     const V wide = v_andnot(cone.outside, one);
@@ -364,7 +369,7 @@ LC_ALWAYS_INLINE inline V emission_bounds(const QuadNodes& n, V lo_x, V lo_y, V 
     const V h_x = v_sub(hi_x, lo_x), h_y = v_sub(hi_y, lo_y), h_z = v_sub(hi_z, lo_z);
     const V radius = v_mul(half, v_sqrt(dot4(h_x, h_y, h_z, h_x, h_y, h_z)));
     const V d = v_sqrt(dot4(c_x, c_y, c_z, c_x, c_y, c_z));
-    const V outside = v_cmpgt(d, radius);  // else any direction: 1
+    const V outside = v_cmpgt(d, v_mul(radius, v_set1(Kernel::kOutsideSphere)));  // else any direction: 1
     V cos_w = v_div(v_mul(dot4(n.axis_x, n.axis_y, n.axis_z, c_x, c_y, c_z), v_set1(-1.0f)), d);
     cos_w = v_min(v_max(cos_w, v_set1(-1.0f)), one);  // clamp
     cos_w = v_select(n.two_sided, v_abs(cos_w), cos_w);
@@ -434,7 +439,7 @@ LC_ALWAYS_INLINE inline bool cluster_errors(const QuadLanes& q, const QuadNodes&
     V g = v_mul(q.kd_g, cos_over_pi);
     V b = v_mul(q.kd_b, cos_over_pi);
     if (q.specular != 0u || q.disney != 0u) {
-        const BoxCones cone = box_cones(q, n);
+        const BoxCones cone = box_cones<Kernel>(q, n);
         const V cos_h = cos_h_max<Kernel>(q, cone);
         if (q.specular != 0u) {
             // The lobe counts at points that have one, where the cosine bound

@@ -196,9 +196,14 @@ def write_csv(path, lights, comment):
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     lines = ["# " + comment, "x,y,z,r,g,b"]
     lines.extend("%.6g,%.6g,%.6g,%.6g,%.6g,%.6g" % light for light in lights)
-    with open(path, "w", encoding="ascii", newline="\n") as f:
+    # Written beside the target and renamed onto it, so that a killed run
+    # leaves the old file or none, never half a list that a later run
+    # would take for a whole one.
+    part = path + ".part"
+    with open(part, "w", encoding="ascii", newline="\n") as f:
         f.write("\n".join(lines))
         f.write("\n")
+    os.replace(part, path)
 
 
 def parse_triple(text, what):

@@ -41,6 +41,14 @@ awk '/^relative RMSE/ { found = 1; ok = ($3 > 0 && $3 < 0.1) } END { exit !(foun
 "$exe" info "$root/scenes/panels/panels.json" --area-samples 5000 | grep "area-light samples 5000$" >/dev/null ||
   fail "info --area-samples"
 "$exe" info "$root/scenes/panels/panels.json" --area-samples 0 2>/dev/null && fail "info --area-samples 0 accepted"
+# ... and for none where the path tracer, which samples the surfaces itself, renders.
+"$exe" info "$root/scenes/panels/panels.json" --method path | grep "area-light samples 0$" >/dev/null ||
+  fail "info --method path"
+# A write to stdout that fails (a full disk) is an error, not an empty success.
+if [ -w /dev/full ]; then
+  "$exe" info "$root/scenes/room/room.json" >/dev/full 2>/dev/null && fail "info into a full disk succeeded"
+  "$exe" compare "$tmp/a.exr" "$tmp/a.exr" --json >/dev/full 2>/dev/null && fail "compare into a full disk succeeded"
+fi
 # ... and for the VPLs render would make with the same options and seed.
 v_info=$("$exe" info "$root/scenes/cornell/cornell.json" --vpls 2000 --seed 7 | sed -n 's/^  VPLs *\([0-9]*\) from.*/\1/p')
 v_render=$("$exe" render "$root/scenes/cornell/cornell.json" --vpls 2000 --seed 7 --width 8 --height 8 --no-png \

@@ -9,6 +9,7 @@
 #include <limits>
 #include <set>
 #include <string>
+#include <vector>
 
 #include <unistd.h>
 
@@ -145,6 +146,111 @@ TEST_F(ImageFiles, ReadExrReportsBadInputAsInputError) {
     const fs::path text = dir_ / "text.exr";
     std::ofstream(text) << "this is not an OpenEXR file\n";
     EXPECT_THROW(lc::read_exr(text), lc::InputError);
+}
+
+// A 4x4 tiled OpenEXR file of 2x2 uncompressed tiles, each pixel (x, y,
+// 1), laid out byte by byte as the format has it (tinyexr writes scanline
+// files only); tiles_at gets the file offsets of the four tile blocks, each
+// of which starts with its tile coordinates x, y as 4-byte integers.
+std::string tiled_exr(std::vector<std::uint64_t>& tiles_at) {
+    std::string bytes;
+    const auto put = [&](const auto& value) { bytes.append(reinterpret_cast<const char*>(&value), sizeof(value)); };
+    const auto attribute = [&](const std::string& name, const std::string& type, const std::string& value) {
+        bytes += name + '\0' + type + '\0';
+        put(std::uint32_t(value.size()));
+        bytes += value;
+    };
+    const auto pack = [](std::initializer_list<std::int32_t> words) {
+        return std::string(reinterpret_cast<const char*>(words.begin()), 4 * words.size());
+    };
+    put(std::uint32_t(20000630));  // the magic number
+    put(std::uint32_t(2 | 0x200));  // version 2, tiled
+    std::string channels;
+    for (const char* name : {"B", "G", "R"})
+        channels += std::string(name) + '\0' + pack({2, 0, 1, 1});  // FLOAT, pLinear and reserved 0, sampling 1, 1
+    attribute("channels", "chlist", channels + '\0');
+    attribute("compression", "compression", std::string(1, '\0'));
+    attribute("dataWindow", "box2i", pack({0, 0, 3, 3}));
+    attribute("displayWindow", "box2i", pack({0, 0, 3, 3}));
+    attribute("lineOrder", "lineOrder", std::string(1, '\0'));
+    const float one = 1.0f;
+    attribute("pixelAspectRatio", "float", std::string(reinterpret_cast<const char*>(&one), 4));
+    attribute("screenWindowCenter", "v2f", std::string(8, '\0'));
+    attribute("screenWindowWidth", "float", std::string(reinterpret_cast<const char*>(&one), 4));
+    attribute("tiles", "tiledesc", pack({2, 2}) + std::string(1, '\0'));  // 2x2, one level, rounding down
+    bytes += '\0';
+    const std::size_t table = bytes.size();
+    bytes.append(4 * 8, '\0');
+    tiles_at.clear();
+    for (std::int32_t ty = 0; ty < 2; ++ty)
+        for (std::int32_t tx = 0; tx < 2; ++tx) {
+            tiles_at.push_back(bytes.size());
+            std::memcpy(&bytes[table + 8 * (tiles_at.size() - 1)], &tiles_at.back(), 8);
+            bytes += pack({tx, ty, 0, 0, 2 * 3 * 2 * 4});
+            for (int y = 2 * ty; y < 2 * ty + 2; ++y)
+                for (int c = 0; c < 3; ++c)  // B, G, R
+                    for (int x = 2 * tx; x < 2 * tx + 2; ++x) put(c == 0 ? one : c == 1 ? float(y) : float(x));
+        }
+    return bytes;
+}
+
+// tinyexr places a tile where the file says, negative coordinates too, and
+// aborts on some header values instead of failing: a tile outside the image
+// (it was written outside the pixels, a crash), two tiles at one place
+// (the other's pixels were left black), a tiles attribute of the wrong size
+// or an unknown level mode (aborts) are each an InputError naming the file.
+TEST_F(ImageFiles, TiledExrTilesMustCoverTheImageOnce) {
+    std::vector<std::uint64_t> tiles_at;
+    const std::string good = tiled_exr(tiles_at);
+    const auto write = [&](const std::string& name, const std::string& bytes) {
+        const fs::path file = dir_ / name;
+        std::ofstream(file, std::ios::binary) << bytes;
+        return file;
+    };
+    const lc::Image read = lc::read_exr(write("good.exr", good));
+    ASSERT_EQ(read.width, 4u);
+    for (std::uint32_t y = 0; y < 4; ++y)
+        for (std::uint32_t x = 0; x < 4; ++x) EXPECT_EQ(read.at(x, y), glm::vec3(float(x), float(y), 1.0f));
+
+    const auto refused = [&](const std::string& name, const std::string& bytes, const std::string& why) {
+        const fs::path file = write(name, bytes);
+        try {
+            lc::read_exr(file);
+        } catch (const lc::InputError& e) {
+            const std::string message = e.what();
+            EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+            EXPECT_NE(message.find(why), std::string::npos) << message;
+            return;
+        }
+        ADD_FAILURE() << name << " was read";
+    };
+    const auto with_tile_x = [&](std::size_t tile, std::int32_t x, std::int32_t y) {
+        std::string bytes = good;
+        std::memcpy(&bytes[tiles_at[tile]], &x, 4);
+        std::memcpy(&bytes[tiles_at[tile] + 4], &y, 4);
+        return bytes;
+    };
+    refused("far_left.exr", with_tile_x(1, -16777216, 0), "outside the image");
+    refused("left.exr", with_tile_x(1, -1, 0), "outside the image");
+    refused("twice.exr", with_tile_x(3, 0, 0), "overlaps another tile");
+    const auto with_tiles_attribute = [&](std::uint32_t x, std::uint32_t y, unsigned char mode) {
+        std::string bytes = good;
+        const std::string attribute = std::string("tiles") + '\0' + "tiledesc" + '\0';
+        const std::size_t at = bytes.find(attribute) + attribute.size() + 4;
+        std::memcpy(&bytes[at], &x, 4);
+        std::memcpy(&bytes[at + 4], &y, 4);
+        bytes[at + 8] = char(mode);
+        return bytes;
+    };
+    refused("mode3.exr", with_tiles_attribute(2, 2, 3), "level or rounding mode");
+    refused("huge_tiles.exr", with_tiles_attribute(0x7fffffff, 2, 0), "tile size");
+    std::string ten = good;
+    const std::string attribute = std::string("tiles") + '\0' + "tiledesc" + '\0';
+    const std::size_t size_at = ten.find(attribute) + attribute.size();
+    const std::uint32_t size10 = 10;
+    std::memcpy(&ten[size_at], &size10, 4);
+    ten.insert(size_at + 4 + 9, 1, '\0');
+    refused("tiles10.exr", ten, "not 9");
 }
 
 // A file cut short in its header or in its pixels is an InputError naming

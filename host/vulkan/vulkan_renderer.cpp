@@ -6,12 +6,18 @@
 #include "vulkan_renderer.h"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <thread>
 
+#include "lightcuts/error.h"
 #include "render_setup.h"
 #include "tile_scheduler.h"
 
@@ -191,55 +197,111 @@ RenderSetup::RenderSetup(const Context& context, const PreparedScene& prepared,
 
 RenderSetup::~RenderSetup() { ctx.fn().vkDeviceWaitIdle(ctx.device().get()); }
 
+namespace {
+
+// The LC_VK_* variables are developers' switches (docs/vulkan.md). A value
+// that a switch does not know is refused, so that a misspelling does not
+// quietly measure the default. Unset or empty, a switch keeps its default.
+const char* variable(const char* name) {
+    const char* v = std::getenv(name);
+    return v != nullptr && *v != '\0' ? v : nullptr;
+}
+
+[[noreturn]] void refuse(const char* name, const std::string& value, const std::string& expected) {
+    throw InputError("environment", name, "'" + value + "' is not " + expected);
+}
+
+std::uint64_t count_variable(const char* name, const char* v) {
+    std::uint64_t n = 0;
+    const char* end = v + std::strlen(v);
+    const auto [last, ec] = std::from_chars(v, end, n);
+    if (ec != std::errc() || last != end) refuse(name, v, "a whole number");
+    return n;
+}
+
+std::uint32_t count32_variable(const char* name, const char* v) {
+    const std::uint64_t n = count_variable(name, v);
+    if (n > std::numeric_limits<std::uint32_t>::max()) refuse(name, v, "a whole number below 2^32");
+    return std::uint32_t(n);
+}
+
+bool flag_variable(const char* name, const char* v) {
+    const std::string value = v;
+    if (value != "0" && value != "1") refuse(name, value, "0 or 1");
+    return value == "1";
+}
+
+// One of a switch's two forcing words, or "auto" for its default.
+template <class Mode>
+Mode mode_variable(const char* name, const char* v, const char* first, Mode first_mode, const char* second,
+                   Mode second_mode) {
+    const std::string value = v;
+    if (value == first) return first_mode;
+    if (value == second) return second_mode;
+    if (value == "auto") return Mode::kAuto;
+    refuse(name, value, std::string(first) + ", " + second + " or auto");
+}
+
+}  // namespace
+
 Tuning Tuning::from_environment() {
     Tuning tuning;
-    if (const char* v = std::getenv("LC_VK_FORCE_FEATURES")) {
-        const std::string features = v;
-        const bool all = features.find("all") != std::string::npos;
-        tuning.force_ggx = all || features.find("ggx") != std::string::npos;
-        tuning.force_shadows = all || features.find("shadows") != std::string::npos;
-        tuning.force_oriented = all || features.find("oriented") != std::string::npos;
-        tuning.force_textures = all || features.find("textures") != std::string::npos;
-        tuning.force_disney = all || features.find("disney") != std::string::npos;
-        tuning.force_sheen = all || features.find("sheen") != std::string::npos;
-        tuning.force_clearcoat = all || features.find("clearcoat") != std::string::npos;
+    if (const char* v = variable("LC_VK_FORCE_FEATURES")) {
+        // Comma-separated names; "all" forces every feature, "none" none.
+        std::string_view rest = v;
+        while (!rest.empty()) {
+            const std::size_t comma = rest.find(',');
+            const std::string name(rest.substr(0, comma));
+            rest = comma == std::string_view::npos ? std::string_view() : rest.substr(comma + 1);
+            const bool all = name == "all";
+            bool known = all || name == "none";
+            const auto force = [&](const char* feature, bool& field) {
+                if (all || name == feature) field = known = true;
+            };
+            force("ggx", tuning.force_ggx);
+            force("shadows", tuning.force_shadows);
+            force("oriented", tuning.force_oriented);
+            force("textures", tuning.force_textures);
+            force("disney", tuning.force_disney);
+            force("sheen", tuning.force_sheen);
+            force("clearcoat", tuning.force_clearcoat);
+            if (!known)
+                refuse("LC_VK_FORCE_FEATURES", name,
+                       "a feature (ggx, shadows, oriented, textures, disney, sheen, clearcoat, all, none)");
+        }
     }
-    if (const char* v = std::getenv("LC_VK_MAX_TILE_PIXELS"))
-        tuning.max_tile_pixels = std::uint32_t(std::strtoul(v, nullptr, 10));
-    if (const char* v = std::getenv("LC_VK_LIGHTS_PER_DISPATCH"))
-        tuning.lights_per_dispatch = std::uint32_t(std::strtoul(v, nullptr, 10));
-    if (const char* v = std::getenv("LC_VK_REFINEMENTS_PER_DISPATCH"))
-        tuning.refinements_per_dispatch = std::uint32_t(std::strtoul(v, nullptr, 10));
-    if (const char* v = std::getenv("LC_VK_SPLIT_BYTES"))
-        tuning.split_bytes = std::strtoull(v, nullptr, 10);
-    if (const char* v = std::getenv("LC_VK_CHUNK_BUFFERS")) tuning.chunk_buffers = std::string(v) == "1";
-    if (const char* v = std::getenv("LC_VK_HOST_IMPORT")) tuning.host_import = std::string(v) != "0";
-    if (const char* v = std::getenv("LC_VK_SPREAD_GROUPS")) tuning.spread_groups_on_cpu = std::string(v) != "0";
-    if (const char* v = std::getenv("LC_VK_TEXEL_READS")) {
-        const std::string mode = v;
-        if (mode == "on") tuning.texel_reads = Tuning::TexelReads::kOn;
-        if (mode == "off") tuning.texel_reads = Tuning::TexelReads::kOff;
-    }
-    if (const char* v = std::getenv("LC_VK_SPECIALIZE_ON_HOST")) {
-        const std::string mode = v;
-        if (mode == "on") tuning.specialize_on_host = Tuning::HostSpecialization::kOn;
-        if (mode == "off") tuning.specialize_on_host = Tuning::HostSpecialization::kOff;
-    }
-    if (const char* v = std::getenv("LC_VK_HEAP_MEMORY")) {
-        const std::string mode = v;
-        if (mode == "shared") tuning.heap_memory = Tuning::HeapMemory::kShared;
-        if (mode == "private") tuning.heap_memory = Tuning::HeapMemory::kPrivate;
-    }
-    if (const char* v = std::getenv("LC_VK_MIN_TILE_PIXELS"))
-        tuning.min_tile_pixels = std::uint32_t(std::strtoul(v, nullptr, 10));
-    if (const char* v = std::getenv("LC_VK_SPLIT_SLOW_TILES")) {
-        const std::string mode = v;
-        if (mode == "on") tuning.split_slow_tiles = Tuning::SplitSlowTiles::kOn;
-        if (mode == "off") tuning.split_slow_tiles = Tuning::SplitSlowTiles::kOff;
-    }
-    if (const char* v = std::getenv("LC_VK_TARGET_MS")) {
-        const double ms = std::strtod(v, nullptr);
-        if (ms > 0.0) tuning.target_dispatch_ms = ms;
+    if (const char* v = variable("LC_VK_MAX_TILE_PIXELS"))
+        tuning.max_tile_pixels = count32_variable("LC_VK_MAX_TILE_PIXELS", v);
+    if (const char* v = variable("LC_VK_LIGHTS_PER_DISPATCH"))
+        tuning.lights_per_dispatch = count32_variable("LC_VK_LIGHTS_PER_DISPATCH", v);
+    if (const char* v = variable("LC_VK_REFINEMENTS_PER_DISPATCH"))
+        tuning.refinements_per_dispatch = count32_variable("LC_VK_REFINEMENTS_PER_DISPATCH", v);
+    if (const char* v = variable("LC_VK_SPLIT_BYTES")) tuning.split_bytes = count_variable("LC_VK_SPLIT_BYTES", v);
+    if (const char* v = variable("LC_VK_CHUNK_BUFFERS"))
+        tuning.chunk_buffers = flag_variable("LC_VK_CHUNK_BUFFERS", v);
+    if (const char* v = variable("LC_VK_HOST_IMPORT")) tuning.host_import = flag_variable("LC_VK_HOST_IMPORT", v);
+    if (const char* v = variable("LC_VK_SPREAD_GROUPS"))
+        tuning.spread_groups_on_cpu = flag_variable("LC_VK_SPREAD_GROUPS", v);
+    if (const char* v = variable("LC_VK_TEXEL_READS"))
+        tuning.texel_reads = mode_variable("LC_VK_TEXEL_READS", v, "on", Tuning::TexelReads::kOn, "off",
+                                           Tuning::TexelReads::kOff);
+    if (const char* v = variable("LC_VK_SPECIALIZE_ON_HOST"))
+        tuning.specialize_on_host = mode_variable("LC_VK_SPECIALIZE_ON_HOST", v, "on", Tuning::HostSpecialization::kOn,
+                                                  "off", Tuning::HostSpecialization::kOff);
+    if (const char* v = variable("LC_VK_HEAP_MEMORY"))
+        tuning.heap_memory = mode_variable("LC_VK_HEAP_MEMORY", v, "shared", Tuning::HeapMemory::kShared, "private",
+                                           Tuning::HeapMemory::kPrivate);
+    if (const char* v = variable("LC_VK_MIN_TILE_PIXELS"))
+        tuning.min_tile_pixels = count32_variable("LC_VK_MIN_TILE_PIXELS", v);
+    if (const char* v = variable("LC_VK_SPLIT_SLOW_TILES"))
+        tuning.split_slow_tiles = mode_variable("LC_VK_SPLIT_SLOW_TILES", v, "on", Tuning::SplitSlowTiles::kOn, "off",
+                                                Tuning::SplitSlowTiles::kOff);
+    if (const char* v = variable("LC_VK_TARGET_MS")) {
+        char* end = nullptr;
+        const double ms = std::strtod(v, &end);
+        if (*end != '\0' || !(ms > 0.0) || !std::isfinite(ms))
+            refuse("LC_VK_TARGET_MS", v, "a positive number of milliseconds");
+        tuning.target_dispatch_ms = ms;
     }
     return tuning;
 }

@@ -499,6 +499,39 @@ float lc_box_distance2(vec3 box_min, vec3 box_max, vec3 x) {
     return dot(d, d);
 }
 
+// The bounds below work with the cosines and sines of angles, never the
+// angles: a sine from its cosine, sqrt(1 - cos^2), is off by up to ~3.5e-4
+// rad near 0 and pi, where the cosine's own rounding is amplified (as an
+// angle from acos would be), so they take each angle kAngleSlack wider.
+LC_KCONST float kAngleSlack = 1e-3f;
+LC_KCONST float kAngleSlackCos = 0.9999995f;     // cos(kAngleSlack)
+LC_KCONST float kAngleSlackSin = 9.9999983e-4f;  // sin(kAngleSlack)
+
+// A point counts as outside a bounding sphere only when it is this much
+// farther from the centre than the radius. Nearer, float rounding cannot
+// tell inside from outside, and from a point within rounding of the sphere
+// a light on it close by can lie well outside the cone computed for it:
+// 0.47 degrees outside, for a point 7e-8 inside the sphere that the floats
+// put outside and a light 10^-5 from it, where GGX at the alpha floor was
+// 9.4 times its bound (a helper's search, docs/disney-bounds.md). Past the
+// margin sin(theta_c) <= 1 / 1.0001, so cos(theta_c) >= 0.014, and the
+// few ulps of rounding in the radius and the distance move theta_c by at
+// most ~3e-5 rad, inside kAngleSlack.
+LC_KCONST float kOutsideSphere = 1.0001f;
+
+// The cone of directions from x towards the box, from the box's bounding
+// sphere: unit axis a (xyz) and the sine of its half-angle theta_c (w); w < 0
+// when x is inside the sphere (or within kOutsideSphere of it), where the
+// directions can be any. The sine, not the angle: the bounds below work
+// with sines and cosines, without asin, acos or cos on the way.
+vec4 lc_box_cone(vec3 box_min, vec3 box_max, vec3 x) {
+    vec3 c = 0.5f * ((box_min - x) + (box_max - x));  // see lc_cosine_bound
+    float radius = 0.5f * length(box_max - box_min);
+    float dist = length(c);
+    if (!(dist > radius * kOutsideSphere)) return vec4(0.0f, 0.0f, 1.0f, -1.0f);
+    return vec4(c / dist, min(radius / dist, 1.0f));
+}
+
 // Upper bound of the GGX term D * G1(wi) * G1(wo) / (4 cos_o) over all
 // directions wi towards the box (relative to x). G1(wi) <= 1. D grows with
 // cos(theta_h), so it is bounded by D at the smallest possible angle between
@@ -506,32 +539,24 @@ float lc_box_distance2(vec3 box_min, vec3 box_max, vec3 x) {
 // half-angle theta_c, from the box's bounding sphere). For fixed wo the map
 // h -> wi = reflect(-wo, h) is 2-Lipschitz in angle and sends n to the mirror
 // direction wr, so angle(h, n) >= max(0, angle(wr, a) - theta_c) / 2.
-// The cone of directions from x towards the box, from the box's bounding
-// sphere: unit axis a (xyz) and the sine of its half-angle theta_c (w); w < 0
-// when x is inside the sphere, where the directions can be any. The sine,
-// not the angle: the bounds below work with sines and cosines, without
-// asin, acos or cos on the way.
-vec4 lc_box_cone(vec3 box_min, vec3 box_max, vec3 x) {
-    vec3 c = 0.5f * ((box_min - x) + (box_max - x));  // see lc_cosine_bound
-    float radius = 0.5f * length(box_max - box_min);
-    float dist = length(c);
-    if (!(dist > radius)) return vec4(0.0f, 0.0f, 1.0f, -1.0f);
-    return vec4(c / dist, min(radius / dist, 1.0f));
-}
-
 // The largest cos(theta_h) of any wi in the cone, for the view wo
 // (cos_o = n.wo > 0); the argument is lc_ggx_bound's. With delta =
 // angle(wr, a) - theta_c: cos(delta) = cos_r cos_c + sin_r sin_c, and
-// cos(delta / 2) = sqrt((1 + cos(delta)) / 2). sin_r comes from the cross
-// product, accurate for small angles where sqrt(1 - cos^2) is not; the sum
-// is widened by kCosineAbsSlack for the rounding of the products.
+// cos(delta / 2) = sqrt((1 + cos(delta)) / 2). theta_c is taken
+// kAngleSlack wider, as lc_cos_d_range takes it, for the rounding of its
+// cosine from its sine (near a sharp GGX peak D changes by several times
+// over 10^-4 rad); sin_r comes from the cross product, accurate for small
+// angles where sqrt(1 - cos^2) is not; the sum is widened by
+// kCosineAbsSlack for the rounding of the products.
 float lc_cos_h_max(vec4 cone, vec3 n, vec3 wo, float cos_o) {
     if (cone.w < 0.0f) return 1.0f;
     vec3 wr = 2.0f * cos_o * n - wo;
     vec3 a = vec3(cone);
     float cos_r = dot(wr, a);
-    float sin_c = cone.w;
-    float cos_c = sqrt(max(1.0f - sin_c * sin_c, 0.0f));
+    float sin_c0 = cone.w;
+    float cos_c0 = sqrt(max(1.0f - sin_c0 * sin_c0, 0.0f));
+    float cos_c = cos_c0 * kAngleSlackCos - sin_c0 * kAngleSlackSin;
+    float sin_c = sin_c0 * kAngleSlackCos + cos_c0 * kAngleSlackSin;
     if (cos_r >= cos_c) return 1.0f;  // the mirror direction lies in the cone
     float sin_r = length(cross(wr, a));
     float cos_delta = min(cos_r * cos_c + sin_r * sin_c + kCosineAbsSlack, 1.0f);
@@ -548,13 +573,6 @@ float lc_ggx_bound(LC_IN(Material) m, vec3 box_min, vec3 box_max, vec3 x, vec3 n
 
 uint lc_node_type(LC_IN(LightNode) node) { return (node.flags >> kNodeTypeShift) & kNodeTypeMask; }
 
-// The bounds below work with the cosines and sines of angles, never the
-// angles: a sine from its cosine, sqrt(1 - cos^2), is off by up to ~3.5e-4
-// rad near 0 and pi, where the cosine's own rounding is amplified (as an
-// angle from acos would be), so they take each angle kAngleSlack wider.
-LC_KCONST float kAngleSlack = 1e-3f;
-LC_KCONST float kAngleSlackCos = 0.9999995f;     // cos(kAngleSlack)
-LC_KCONST float kAngleSlackSin = 9.9999983e-4f;  // sin(kAngleSlack)
 
 // sin of an angle in [0, pi] from its cosine.
 float lc_sin_of(float cos_a) { return sqrt(max(1.0f - cos_a * cos_a, 0.0f)); }
@@ -589,7 +607,7 @@ float lc_emission_bound(LC_IN(LightNode) node, vec3 x) {
     vec3 to_centre = 0.5f * (lo + hi);
     float radius = 0.5f * length(hi - lo);
     float d = length(to_centre);
-    if (!(d > radius)) return 1.0f;  // x inside the bounding sphere: any direction
+    if (!(d > radius * kOutsideSphere)) return 1.0f;  // x inside the bounding sphere: any direction
     float cos_w = clamp(-dot(lc_decode_axis(node.axis_oct), to_centre) / d, -1.0f, 1.0f);
     if ((node.flags & kNodeTwoSided) != 0u) cos_w = abs(cos_w);
     // cos theta', 1 where theta' <= 0: theta_w at most the sum s = theta_o +

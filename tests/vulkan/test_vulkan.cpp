@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include "cpu_kernel.h"
+#include "lightcuts/error.h"
 #include "scene/materials.h"
 #include "scene/textures.h"
 #include "test_util.h"
@@ -144,6 +145,49 @@ TEST(DeviceChoiceAuto, ProbesTheDriversUnlessNoGpuCouldAnswer) {
     ::unsetenv("VK_DRIVER_FILES");
     EXPECT_FALSE(pointed.skipped);
     EXPECT_EQ(pointed.devices.names, list_vulkan_devices());
+}
+
+// The LC_VK_* switches take the values docs/vulkan.md names and refuse
+// any other, naming the variable: a misspelt switch must not quietly time
+// the default (bench/spec_switches.sh once printed rows for "shadow" that
+// forced nothing).
+TEST(TuningFromEnvironment, TakesTheNamedValuesAndRefusesOthers) {
+    const auto with = [](const char* name, const char* value) {
+        ::setenv(name, value, 1);
+        struct Unset {
+            const char* name;
+            ~Unset() { ::unsetenv(name); }
+        } unset{name};
+        return vk::Tuning::from_environment();
+    };
+    const auto refused = [&](const char* name, const char* value) {
+        try {
+            with(name, value);
+        } catch (const InputError& e) {
+            return std::string(e.what()).find(name) != std::string::npos;
+        }
+        return false;
+    };
+    const vk::Tuning forced = with("LC_VK_FORCE_FEATURES", "ggx,disney");
+    EXPECT_TRUE(forced.force_ggx && forced.force_disney);
+    EXPECT_FALSE(forced.force_shadows || forced.force_sheen);
+    const vk::Tuning all = with("LC_VK_FORCE_FEATURES", "all");
+    EXPECT_TRUE(all.force_shadows && all.force_oriented && all.force_textures && all.force_clearcoat);
+    EXPECT_FALSE(with("LC_VK_FORCE_FEATURES", "none").force_ggx);
+    EXPECT_EQ(with("LC_VK_HEAP_MEMORY", "shared").heap_memory, vk::Tuning::HeapMemory::kShared);
+    EXPECT_EQ(with("LC_VK_SPLIT_SLOW_TILES", "auto").split_slow_tiles, vk::Tuning::SplitSlowTiles::kAuto);
+    EXPECT_EQ(with("LC_VK_MAX_TILE_PIXELS", "4096").max_tile_pixels, 4096u);
+    EXPECT_FALSE(with("LC_VK_HOST_IMPORT", "0").host_import);
+    EXPECT_DOUBLE_EQ(with("LC_VK_TARGET_MS", "200").target_dispatch_ms, 200.0);
+    EXPECT_TRUE(refused("LC_VK_FORCE_FEATURES", "shadow"));
+    EXPECT_TRUE(refused("LC_VK_HEAP_MEMORY", "on"));
+    EXPECT_TRUE(refused("LC_VK_TEXEL_READS", "yes"));
+    EXPECT_TRUE(refused("LC_VK_MAX_TILE_PIXELS", "12x"));
+    EXPECT_TRUE(refused("LC_VK_MIN_TILE_PIXELS", "-1"));
+    EXPECT_TRUE(refused("LC_VK_SPLIT_BYTES", "1e6"));
+    EXPECT_TRUE(refused("LC_VK_HOST_IMPORT", "yes"));
+    EXPECT_TRUE(refused("LC_VK_TARGET_MS", "0"));
+    EXPECT_TRUE(refused("LC_VK_TARGET_MS", "inf"));
 }
 
 // --- Analytic truth (pbrt-v4 style): a point light of intensity pi * h^2 at
