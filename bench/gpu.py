@@ -189,8 +189,8 @@ def main():
         for label, extra, env_add in variants:
             try:
                 _, s = timed(ROOM_1E5, "heap", w, h, extra=extra, env_add=env_add)
-            except RuntimeError as e:
-                say(f"| {label} | refused: {str(e).splitlines()[-1]} |")
+            except RuntimeError as e:  # refused (a heap too large for shared memory), or failed
+                say(f"| {label} | did not render: {str(e).splitlines()[-1]} |")
                 continue
             results["heap"][label] = figures(s)
             say(row(label, results["heap"][label]))
@@ -212,6 +212,9 @@ def main():
                 continue
             _, l = timed(scene, name + "_lightcuts", bw, bh)
             fb, fl = figures(b), figures(l)
+            if min(fb["shadow_rays"], fl["shadow_rays"], fb["gpu_s"], fl["gpu_s"]) <= 0:
+                say(f"| {name} | no shadow rays or no GPU time to divide by |")
+                continue
             nb, nl = 1e9 * fb["shading_s"] / fb["shadow_rays"], 1e9 * fl["shading_s"] / fl["shadow_rays"]
             results["brute"][name] = {"brute": fb, "lightcuts": fl, "ratio": nl / nb,
                                       "speedup": fb["gpu_s"] / fl["gpu_s"]}

@@ -12,11 +12,13 @@
 #   bench/heap_pauses.sh [BINARY]
 set -uo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
-exe="${1:-$root/build/host/lightcuts}"
+exe="$(realpath "${1:-$root/build/host/lightcuts}")"  # before the cd below
+[ -x "$exe" ] || { echo "heap_pauses: no renderer at $exe" >&2; exit 1; }
 export VK_DRIVER_FILES="${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 cd "$root"
+failed=0
 echo "| scene | size | split | shading s | failed passes | heaps paused in global memory | images differ by |"
 echo "|---|---|---|---|---|---|---|"
 for f in scenes/*/*.json scenes/*/*.gltf; do
@@ -26,6 +28,7 @@ for f in scenes/*/*.json scenes/*/*.gltf; do
     if ! "$exe" render "$f" --method lightcuts --device vulkan -o "$tmp/$split.exr" --no-png \
         --stats "$tmp/$split.json" >"$tmp/log" 2>&1; then
       echo "| $f | | $split | failed: $(tail -1 "$tmp/log") | | | |"
+      failed=1
       continue 2
     fi
   done
@@ -42,3 +45,5 @@ print(f"| {sys.argv[2]} | {d['width']}x{d['height']} | {sys.argv[3]} | {d['secon
 PY
   done
 done
+# A failed render is in the table; the exit status says so too.
+exit "$failed"

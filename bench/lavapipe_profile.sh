@@ -30,10 +30,11 @@
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 exe="$root/build/host/lightcuts"
+[ $# -ge 1 ] || { echo "usage: bench/lavapipe_profile.sh SCENE [render options...]" >&2; exit 2; }
 scene="$1"
 shift
 tmp="$(mktemp -d)"
-trap 'rm -rf "$tmp"' EXIT
+trap 'kill "${perf_pid:-}" 2>/dev/null; rm -rf "$tmp"' EXIT
 export VK_DRIVER_FILES="${VK_DRIVER_FILES:-/usr/share/vulkan/icd.d/lvp_icd.x86_64.json}"
 
 perf record -F 499 -o "$tmp/perf.data" "$exe" render "$scene" "$@" --device vulkan \
@@ -44,7 +45,8 @@ perf_pid=$!
 # LC_PROFILE_DELAY: seconds to wait first (a render shorter than it leaves
 # nothing to copy).
 sleep "${LC_PROFILE_DELAY:-1}"
-pid="$(pgrep -n -x lightcuts || true)"
+# The renderer is perf's child (not any other lightcuts running).
+pid="$(pgrep -P "$perf_pid" -x lightcuts || true)"
 if [ -z "$pid" ]; then
   wait "$perf_pid" || true
   echo "lavapipe_profile: the render ended within ${LC_PROFILE_DELAY:-1} s, before its kernels could be copied;" \

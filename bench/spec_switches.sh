@@ -25,8 +25,13 @@ for method in $methods; do
   for force in $features; do
     times=()
     for run in 0 1 2 3 4 5; do
-      LC_VK_FORCE_FEATURES="$force" "$exe" render "$scene" -o "$tmp/x.exr" --device vulkan --method "$method" \
-        --width "$size" --height "$size" --no-png --stats "$tmp/s.json" >/dev/null 2>&1
+      # A render that fails (a feature name the renderer does not know, say)
+      # stops the script with the renderer's message.
+      if ! LC_VK_FORCE_FEATURES="$force" "$exe" render "$scene" -o "$tmp/x.exr" --device vulkan --method "$method" \
+        --width "$size" --height "$size" --no-png --stats "$tmp/s.json" >"$tmp/log" 2>&1; then
+        echo "spec_switches: $method with LC_VK_FORCE_FEATURES=$force failed: $(tail -1 "$tmp/log")" >&2
+        exit 1
+      fi
       [ "$run" -eq 0 ] && continue  # warm-up
       times+=("$(python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['seconds']['shading'])" "$tmp/s.json")")
     done

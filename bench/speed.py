@@ -117,7 +117,15 @@ def main():
         a.brute_runs = 1 if a.quick else 3
     size = 32 if a.quick else a.size
     scenes = SCENES[:1] + SCENES[3:4] if a.quick else SCENES
-    heaps = [int(k) for k in a.heaps.split(",")]
+    try:
+        heaps = [int(k) for k in a.heaps.split(",")]
+    except ValueError:
+        sys.exit("speed: --heaps takes comma-separated whole numbers, not '%s'" % a.heaps)
+    # The K table and the speed rows compare against the default heap.
+    if 64 not in heaps or min(heaps) < 1:
+        sys.exit("speed: --heaps must hold 64 (the default, which the tables compare against) and no K below 1")
+    if not os.access(EXE, os.X_OK):
+        sys.exit("speed: no renderer at %s (build it, or name it with --exe)" % EXE)
     os.makedirs(a.out, exist_ok=True)
     results = {"size": size, "speed": [], "heaps": [], "vulkan": []}
     lines = [f"# Speed and the bounded heap ({size}x{size}, CPU path unless said)", "",
