@@ -421,6 +421,30 @@ TEST(SceneLoader, MtllibReadsEveryLibraryOfItsLine) {
     EXPECT_NEAR(loaded.materials.at(loaded.triangles[1].material).kd_r, 0.9f, 1e-6f);
 }
 
+// Libraries apart by tabs, a line that ends in a space or a tab, and a
+// library named on two lines, with another after it on the second: each
+// library is read (tinyobjloader splits at spaces only, so a tab stayed in
+// the name and a trailing space named the OBJ's folder; and the second
+// line's other library was never read).
+TEST(SceneLoader, MtllibLinesSplitAtAnyBlankAndRepeatNames) {
+    TempDir dir;
+    dir.write("a.mtl", "newmtl red\nKd 0.9 0.1 0.1\n");
+    dir.write("b.mtl", "newmtl blue\nKd 0.1 0.1 0.9\n");
+    dir.write("c.mtl", "newmtl green\nKd 0.1 0.9 0.1\n");
+    const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
+ "meshes": [{"obj": "m.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");
+    for (const char* libraries : {"mtllib a.mtl\tb.mtl \nmtllib c.mtl\t\n", "mtllib a.mtl b.mtl\nmtllib b.mtl c.mtl\n",
+                                  "mtllib a.mtl \r\nmtllib b.mtl\tc.mtl\r\n"}) {
+        dir.write("m.obj", std::string(libraries) + "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n"
+                                                      "usemtl blue\nf 1 2 3\nusemtl green\nf 1 2 3\n");
+        const Scene loaded = load_scene(scene);
+        ASSERT_EQ(loaded.triangles.size(), 3u) << libraries;
+        EXPECT_NEAR(loaded.materials.at(loaded.triangles[0].material).kd_r, 0.9f, 1e-6f) << libraries;
+        EXPECT_NEAR(loaded.materials.at(loaded.triangles[1].material).kd_b, 0.9f, 1e-6f) << libraries;
+        EXPECT_NEAR(loaded.materials.at(loaded.triangles[2].material).kd_g, 0.9f, 1e-6f) << libraries;
+    }
+}
+
 // A usemtl in an OBJ without any mtllib line says so (it said "not found in
 // .mtl", naming a file that was never asked for).
 TEST(SceneLoader, UsemtlWithoutMtllibSaysSo) {

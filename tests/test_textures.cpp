@@ -496,6 +496,28 @@ TEST(ObjTextures, MapKdLoadsAndVtTurnsToGrowDownwards) {
     EXPECT_EQ(m.normal_texture, gpu::kInvalidIndex);
 }
 
+// A texture path in an MTL is relative to the MTL (in a folder of its own
+// here), and an image that two meshes name, or one OBJ listed twice, is
+// stored once in the scene (it was read again for every mesh: nine copies
+// of a 4096 x 4096 image passed the texel limit).
+TEST(ObjTextures, PathsAreTheMtlsAndEachImageIsStoredOnce) {
+    TempDir dir;
+    std::filesystem::create_directories(dir.path() / "materials");
+    write_png(dir.path() / "materials" / "paint.png", 2, 1, {rgba(255, 0, 0), rgba(0, 0, 255)});
+    dir.write("materials/quad.mtl", "newmtl paint\nKd 1 1 1\nmap_Kd paint.png\n");
+    std::string obj = kTexturedObj;
+    obj.replace(obj.find("mtllib quad.mtl"), 15, "mtllib materials/quad.mtl");
+    dir.write("quad.obj", obj);
+    std::string json = quad_scene_json();
+    json.replace(json.find(R"({"obj": "quad.obj"})"), 19,
+                 R"({"obj": "quad.obj"}, {"obj": "quad.obj", "transform": {"translate": [0, -1, 0]}})");
+    const Scene s = load_scene(dir.write("scene.json", json));
+    ASSERT_EQ(s.textures.size(), 1u);
+    EXPECT_EQ(s.texels.size(), 2u);
+    ASSERT_EQ(s.triangles.size(), 4u);
+    for (const auto& t : s.triangles) EXPECT_EQ(s.materials[t.material].base_color_texture, 0u);
+}
+
 // What an MTL asks for that is not done gets a note: a map's options but
 // -s, -o and -clamp, and maps the renderer has no use for (tinyobjloader
 // reads them all).
@@ -542,6 +564,22 @@ TEST(ObjTextures, MapWhoseOptionsTookItsFileNameIsRefused) {
                                                  ": names no texture file (its -s and -o options take three numbers"),
                       std::string::npos)
                 << e.what();
+        }
+    }
+}
+
+// The numbers of -s and -o must be numbers: tinyobjloader read "nan" as
+// the option's default and "inf" and "0,5" as 0, silently.
+TEST(ObjTextures, MapOptionsThatAreNoNumbersAreRefused) {
+    TexturedQuad quad;
+    for (const char* map : {"map_Kd -s nan 1 1 paint.png", "map_Ke -o 0 inf 0 paint.png", "norm -s 0,5 1 1 paint.png"}) {
+        const std::string key = std::string(map).substr(0, std::string(map).find(' '));
+        try {
+            quad.load(std::string("newmtl paint\nKd 1 1 1\n") + map + "\n");
+            ADD_FAILURE() << map << " loaded";
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find("quad.mtl: line 3 (" + key + "): -"), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("takes three numbers"), std::string::npos) << e.what();
         }
     }
 }

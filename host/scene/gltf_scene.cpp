@@ -44,7 +44,7 @@ Scene load_gltf_scene(const std::filesystem::path& file, const std::string& came
     // brute force, which sums every light, the 65536 area-light samples of
     // any emissive surface included, at every pixel.
     scene.render.method = "lightcuts";
-    MeshTarget target{scene, {}, {}};
+    MeshTarget target{scene, {}, {}, {}};
     const GltfContents contents = load_gltf(file, MeshTransform{}, target);
 
     LightLimits limits(target.geometry);

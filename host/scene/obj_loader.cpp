@@ -36,6 +36,9 @@ struct ObjData {
     tinyobj::attrib_t attrib;
     std::vector<tinyobj::shape_t> shapes;
     std::vector<tinyobj::material_t> materials;
+    // The folder of the MTL file each material came from, which its
+    // texture paths are relative to.
+    std::vector<std::filesystem::path> material_folders;
     std::size_t short_faces = 0;  // of one or two corners, which tinyobj skips with a warning
 };
 
@@ -67,27 +70,41 @@ public:
 // error where the materials are used.
 class MtlLibraries : public tinyobj::MaterialReader {
 public:
-    MtlLibraries(std::filesystem::path folder, const std::string& obj_name, bool uses_mtl, std::string_view obj)
-        : folder_(std::move(folder)), obj_name_(obj_name), uses_mtl_(uses_mtl) {
+    MtlLibraries(std::filesystem::path folder, const std::string& obj_name, bool uses_mtl, std::string_view obj,
+                 std::vector<std::filesystem::path>& material_folders)
+        : folder_(std::move(folder)), obj_name_(obj_name), uses_mtl_(uses_mtl), material_folders_(material_folders) {
         for_each_line(obj, [&](const Line& line) {
             if (line.words[0] == "mtllib") lines_.emplace_back(line.words.begin() + 1, line.words.end());
         });
     }
 
-    bool operator()(const std::string& library, std::vector<tinyobj::material_t>* materials,
+    bool operator()(const std::string& given, std::vector<tinyobj::material_t>* materials,
                     std::map<std::string, int>* material_map, std::string* warn, std::string* err) override {
         if (problem_) return false;
         try {
+            // tinyobjloader splits a mtllib line at spaces only: a line that
+            // ends in a space gives an empty last name, a tab stays in the
+            // name. The first of its words is the name (the line's words,
+            // lines_, give the rest).
+            std::string library;
+            for_each_line(given, [&](const Line& line) {
+                if (library.empty()) library = line.words[0];
+            });
+            if (library.empty()) return false;
             if (!read(library, materials, material_map, warn, err)) {
                 if (missing_.empty()) missing_ = library;
                 return false;  // tinyobjloader tries the line's next file name
             }
             missing_.clear();  // (see missing_)
-            // The names after this one on its line.
-            for (const std::vector<std::string>& names : lines_) {
+            // The names after this one on its line: the first line from the
+            // last one read on that names it (tinyobjloader reads the
+            // lines in order, one call for each until a name is found).
+            for (; next_line_ < lines_.size(); ++next_line_) {
+                const std::vector<std::string>& names = lines_[next_line_];
                 const auto self = std::find(names.begin(), names.end(), library);
                 if (self == names.end()) continue;
                 for (auto next = self + 1; next != names.end(); ++next) read(*next, materials, material_map, warn, err);
+                ++next_line_;
                 break;
             }
             return true;
@@ -119,6 +136,8 @@ private:
         const std::string problem = input_file_problem(file);
         if (problem == kFileNotFound) return false;
         if (!problem.empty()) throw InputError(obj_name_, "mtllib", "'" + name + "' " + problem);
+        // A library named again (on two mtllib lines) is read once.
+        if (!read_.insert(file.lexically_normal()).second) return true;
         const std::string text = read_input_file(file);
         const std::string_view mtl = without_bom(text);
         if (uses_mtl_) check_mtl_numbers(mtl, display(file));
@@ -146,6 +165,7 @@ private:
         TextBuffer buffer(mtl);
         std::istream in(&buffer);
         tinyobj::LoadMtl(material_map, materials, &in, warn, err);
+        material_folders_.resize(materials->size(), file.parent_path());
         if (materials->size() - first != blocks.size()) return true;
         for (std::size_t k = 0; k < blocks.size(); ++k) {
             tinyobj::material_t& m = (*materials)[first + k];
@@ -172,12 +192,15 @@ private:
     const std::string& obj_name_;
     bool uses_mtl_;
     std::vector<std::vector<std::string>> lines_;  // the names of each mtllib line
+    std::size_t next_line_ = 0;                    // of lines_, the first not yet read
+    std::set<std::filesystem::path> read_;         // the libraries read so far
     // The first of the names not found since the last one found: where the
     // OBJ's last `mtllib` line found none of its files, that line's first.
     // (Where an earlier line found none, a later line's found name clears
     // it, and the message names no file rather than a wrong one.)
     std::string missing_;
     std::exception_ptr problem_;
+    std::vector<std::filesystem::path>& material_folders_;
 };
 
 // tinyobj treats an unknown usemtl name as a warning and falls back to "no
@@ -202,7 +225,7 @@ void read_obj(const std::filesystem::path& file, const std::string& obj_name, bo
     const std::vector<std::size_t> non_finite_normals = check_obj_numbers(text, obj_name);
     TextBuffer buffer(text);
     std::istream in(&buffer);
-    MtlLibraries libraries(file.parent_path(), obj_name, uses_mtl, text);
+    MtlLibraries libraries(file.parent_path(), obj_name, uses_mtl, text, obj.material_folders);
     std::string warning, err;
     const bool ok = tinyobj::LoadObj(&obj.attrib, &obj.shapes, &obj.materials, &warning, &err, &in, &libraries,
                                      /*triangulate=*/false, /*default_vcols_fallback=*/false);
@@ -244,10 +267,10 @@ public:
             target_.scene.materials.push_back(*override_material);
             return;
         }
-        std::map<std::string, std::uint32_t> loaded;  // texture file -> index
-        for (const tinyobj::material_t& m : obj.materials) {
+        for (std::size_t i = 0; i < obj.materials.size(); ++i) {
+            const tinyobj::material_t& m = obj.materials[i];
             gpu::Material material = convert_mtl(m, obj_name_);
-            add_textures(material, m, file.parent_path(), loaded);
+            add_textures(material, m, i < obj.material_folders.size() ? obj.material_folders[i] : file.parent_path());
             target_.scene.materials.push_back(material);
         }
     }
@@ -293,13 +316,13 @@ private:
     // The MTL's texture maps (docs/scene-format.md): map_Kd scales the
     // albedo (base colour), map_Ke the emission (black or absent Ke counts
     // as 1 where there is a map_Ke), norm is a tangent-space normal map.
-    // Paths are relative to the OBJ's folder; each file is loaded once. A
+    // Paths are relative to the MTL's folder; each file is loaded once in a
+    // scene (MeshTarget::textures). A
     // map's -s and -o scale and move its texture coordinates and -clamp on
     // clamps them (sampled_texture); its other options (-t, -imfchan, -bm,
     // -mm, -boost, -blendu, -blendv, -type, -texres, -colorspace) and the
     // maps the renderer has no use for are read but not used, with a note.
-    void add_textures(gpu::Material& m, const tinyobj::material_t& mtl, const std::filesystem::path& folder,
-                      std::map<std::string, std::uint32_t>& loaded) {
+    void add_textures(gpu::Material& m, const tinyobj::material_t& mtl, const std::filesystem::path& folder) {
         const std::string where = obj_name_ + ": material '" + mtl.name + "'.";
         const auto note = [&](const std::string& line) {
             if (noted_.insert(line).second) target_.scene.load_notes.push_back(line);
@@ -328,8 +351,16 @@ private:
             sampling.uv_transform = {float(o.scale[0]), 0.0f, float(o.origin_offset[0]),
                                      0.0f, float(o.scale[1]), float(1.0 - double(o.scale[1]) - o.origin_offset[1])};
             if (o.clamp) sampling.wrap_u = sampling.wrap_v = gpu::kTextureWrapClamp;
-            const auto [at, added] = loaded.try_emplace(name, 0u);
-            if (added) at->second = load_texture(target_.scene, folder / name, obj_name_, field);
+            const std::filesystem::path path = std::filesystem::absolute(folder / name).lexically_normal();
+            const auto [at, added] = target_.textures.try_emplace(path, 0u);
+            if (added) {
+                try {
+                    at->second = load_texture(target_.scene, folder / name, obj_name_, field);
+                } catch (...) {
+                    target_.textures.erase(at);
+                    throw;
+                }
+            }
             set_texture(m, slot, sampled_texture(target_.scene, at->second, sampling));
         };
         if (!mtl.bump_texname.empty()) note(where + "map_Bump is not used (a normal map is read from norm)");

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
@@ -39,6 +40,10 @@ struct MeshTarget {
     Scene& scene;
     Box geometry;  // around every triangle kept so far, in double
     std::optional<std::uint32_t> default_material;  // index, added on first use
+    // Texture files loaded so far (their normalised absolute paths) and
+    // their scene.textures index: an image that several meshes' MTLs name,
+    // or one OBJ listed several times, is decoded and stored once.
+    std::map<std::filesystem::path, std::uint32_t> textures;
 };
 
 // Appends the OBJ's triangles (transformed; degenerate ones dropped and

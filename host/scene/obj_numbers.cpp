@@ -163,6 +163,18 @@ void check_mtl_numbers(std::string_view text, const std::string& name) {
             check_numbers(line, 3, name);
         } else if (key == "Ns" || key == "Pr" || key == "Pm" || key == "Ps" || key == "Pc" || key == "Pcr") {
             check_numbers(line, 1, name);
+        } else if (key == "map_Kd" || key == "map_Ke" || key == "norm") {
+            // The map options the loader applies, -s and -o, take three
+            // numbers before the file name; tinyobjloader reads "nan" as
+            // the option's default, "inf" and "0,5" as 0.
+            for (std::size_t k = 1; k + 1 < line.words.size(); ++k) {
+                if (line.words[k] != "-s" && line.words[k] != "-o") continue;
+                for (std::size_t j = k + 1; j < std::min(k + 4, line.words.size() - 1); ++j)
+                    if (!is_number(line.words[j]))
+                        throw InputError(name, "line " + std::to_string(line.number) + " (" + std::string(key) + ")",
+                                         std::string(line.words[k]) + " takes three numbers: '" +
+                                             std::string(line.words[j]) + "' is not one");
+            }
         }
     });
 }

@@ -71,7 +71,7 @@ private:
     JsonReader in_;
     unsigned threads_;  // SceneOptions::threads
     Scene scene_;
-    MeshTarget meshes_{scene_, {}, {}};
+    MeshTarget meshes_{scene_, {}, {}, {}};
     LightLimits limits_;
     // The lights of the glTF meshes, with the file each came from; they
     // join the scene's lights before the "lights" list.
