@@ -45,8 +45,11 @@ void create_empty(const fs::path& file, const std::string& label) {
     ::close(fd);
 }
 
-// Moves a file already at `file` aside, then `temporary` onto `file`, each
-// step in the journal before it is taken. Returns the problem, or "" on
+// Keeps a file already at `file` under a backup name, then renames
+// `temporary` onto `file`, each step in the journal before it is taken.
+// The backup is a hard link where the file system makes one, so that the
+// rename replaces `file` in one step and a reader never finds it missing;
+// elsewhere the file is moved aside first. Returns the problem, or "" on
 // success.
 std::string place(const fs::path& temporary, const fs::path& file, Placement& step, ReplacementJournal& journal) {
     std::error_code ec;
@@ -55,7 +58,11 @@ std::string place(const fs::path& temporary, const fs::path& file, Placement& st
     if (fs::exists(status) && !fs::is_directory(status)) {
         const fs::path backup = temporary_path_for(file);
         journal.begin(file, backup);
-        fs::rename(file, backup, ec);
+        fs::create_hard_link(file, backup, ec);
+        if (ec) {
+            ec.clear();
+            fs::rename(file, backup, ec);
+        }
         if (ec) return "cannot move the existing file aside: " + ec.message();
         step.backup = backup;
     } else {
@@ -72,7 +79,11 @@ void roll_back(const std::vector<fs::path>& files, const std::vector<Placement>&
     for (std::size_t i = end; i-- > 0;) {
         std::error_code ec;
         if (steps[i].placed) fs::remove(files[i], ec);
-        if (!steps[i].backup.empty()) fs::rename(steps[i].backup, files[i], ec);
+        if (!steps[i].backup.empty()) {
+            fs::rename(steps[i].backup, files[i], ec);
+            // A hard link renamed onto its own file stays where it is.
+            fs::remove(steps[i].backup, ec);
+        }
     }
 }
 

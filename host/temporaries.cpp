@@ -45,8 +45,9 @@ char* copy_of(const std::string& name) noexcept {
 
 // Undone or kept whatever the step had done: renaming the backup onto the
 // file restores it whether the new file is in place (replaced) or not (the
-// file was moved aside only); where the backup was never made the rename
-// fails and the file is as it was. A step without a backup had no file to
+// backup, a hard link to the file or the file moved aside, made only);
+// where the backup was never made the rename fails and the file is as it
+// was. A step without a backup had no file to
 // keep: removing the file removes the new one, if placed. Only unlink and
 // rename: both async-signal-safe.
 void undo_or_keep_steps() {
@@ -60,6 +61,7 @@ void undo_or_keep_steps() {
             if (backup != nullptr) ::unlink(backup);
         } else if (backup != nullptr) {
             ::rename(backup, file);
+            ::unlink(backup);  // a hard link to the file itself: the rename left it
         } else {
             ::unlink(file);
         }

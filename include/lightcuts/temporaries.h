@@ -29,12 +29,13 @@ void untrack_temporary(int handle) noexcept;
 // The steps of a commit that replaces several files one rename at a time
 // (OutputSet::commit), for remove_temporaries_on_signal: a signal before
 // finish() puts every file begun back as it was (the file it replaced,
-// moved aside to its backup, renamed back onto it; a file that was not
-// there removed), and one after finish() keeps the new files and removes
-// the backups. Each step holds whatever a signal interrupts: before, during
-// or after its renames. One journal at a time per process: a second one,
-// while the first lives, records nothing (active() is false). At most 64
-// steps are recorded; more are not undone by a signal.
+// kept under its backup name, a hard link or the file moved aside, renamed
+// back onto it; a file that was not there removed), and one after finish()
+// keeps the new files and removes the backups. Each step holds whatever a
+// signal interrupts: before, during or after its renames. One journal at a
+// time per process: a second one, while the first lives, records nothing
+// (active() is false). At most 64 steps are recorded; more are not undone
+// by a signal.
 class ReplacementJournal {
 public:
     ReplacementJournal() noexcept;
