@@ -3,6 +3,7 @@
 #include "lightcuts/report.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <numeric>
@@ -12,6 +13,17 @@
 namespace lc {
 
 namespace {
+
+// A setting held as float, as the double that prints as the float does
+// (0.02, not 0.019999999552965164): the shortest decimal that reads back as
+// the same float.
+double as_written(float v) {
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof(text), v).ptr;
+    double d = 0.0;
+    std::from_chars(text, end, d);
+    return d;
+}
 
 using nlohmann::json;
 
@@ -118,7 +130,7 @@ std::string lightcuts_text(const RenderReport& r, const LightcutsReport& l) {
 // heap_memory: where a GPU's kernels keep the heap; the CPU path's heaps
 // are each worker thread's own ("cpu").
 json lightcuts_json(const LightcutsReport& l, bool on_cpu) {
-    return {{"relative_error", l.relative_error},
+    return {{"relative_error", as_written(l.relative_error)},
             {"max_cut", l.max_cut},
             {"tree_nodes", l.tree_nodes},
             {"tree_bytes", l.tree_bytes},
@@ -312,7 +324,7 @@ std::string report_json(const RenderReport& r) {
         j["indirect"] = {{"vpls", r.indirect->vpls},
                          {"paths", r.indirect->paths},
                          {"max_bounces", r.indirect->max_bounces},
-                         {"clamp", r.indirect->clamp}};
+                         {"clamp", as_written(r.indirect->clamp)}};
     if (r.sampling) {
         j["sampling"] = {{"light_samples", r.sampling->light_samples}};
         if (!r.sampling->light_pick.empty()) j["sampling"]["light_pick"] = r.sampling->light_pick;

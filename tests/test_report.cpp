@@ -54,6 +54,10 @@ TEST(Report, JsonHasEveryKeyScriptsReadAndTheBlackLights) {
     EXPECT_EQ(named_lights, 1);
     EXPECT_THAT(json, HasSubstr("\"g-buffer\": 99"));
     EXPECT_THAT(json, HasSubstr("\"load\": 0.25"));
+    // A float setting prints as it was written (it printed the float's
+    // double, 0.019999999552965164).
+    ASSERT_EQ(o.relative_error, 0.02f);
+    EXPECT_THAT(json, HasSubstr("\"relative_error\": 0.02,"));
     EXPECT_THAT(report_text(report), HasSubstr("lights 20 (and 3 black, left out of the tree)"));
     EXPECT_THAT(report_text(report), HasSubstr("cut size mean"));
     EXPECT_THAT(json, HasSubstr("\"bounce_rays\": 0,"));

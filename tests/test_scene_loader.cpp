@@ -302,6 +302,13 @@ TEST(SceneLoader, ObjAndMtlByteOrderMarksAreSkipped) {
     dir.write("m.obj", "\xEF\xBB\xBF" "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n");
     const std::string message = input_error_of([&] { load_scene(scene); });
     EXPECT_NE(message.find("m.obj: line 2 (v): 'nan' is not a number"), std::string::npos) << message;
+    // A UTF-16 OBJ or MTL is refused as such (the OBJ read as having no
+    // usable triangles).
+    dir.write("m.obj", std::string("\xFF\xFE") + "v\0 \0" "0\0");
+    EXPECT_NE(input_error_of([&] { load_scene(scene); }).find("m.obj: is UTF-16 text"), std::string::npos);
+    dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nmtllib m.mtl\nusemtl red\nf 1 2 3\n");
+    dir.write("m.mtl", std::string("\xFE\xFF") + "\0n\0e\0w");
+    EXPECT_NE(input_error_of([&] { load_scene(scene); }).find("m.mtl: is UTF-16 text"), std::string::npos);
 }
 
 // Polygons are cut into triangles inside them, each keeping the face's

@@ -226,8 +226,7 @@ std::vector<gpu::Light> read_csv(const Format& format, const std::filesystem::pa
                                  unsigned threads, std::size_t chunk_bytes) {
     const std::string name = display(file);
     const std::string text = read_input_file(file);
-    if (text.starts_with("\xFF\xFE") || text.starts_with("\xFE\xFF"))
-        throw InputError(name, "", "is UTF-16 text (it starts with a UTF-16 byte-order mark); save it as UTF-8 or ASCII");
+    refuse_utf16(text, name);
     std::string_view all = without_bom(text);  // spreadsheets write one
 
     // A header is only the first content line, and only if nothing in it is

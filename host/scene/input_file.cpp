@@ -33,6 +33,11 @@ std::string_view without_bom(std::string_view text) {
     return text.substr(0, 3) == "\xEF\xBB\xBF" ? text.substr(3) : text;
 }
 
+void refuse_utf16(std::string_view text, const std::string& name) {
+    if (text.starts_with("\xFF\xFE") || text.starts_with("\xFE\xFF"))
+        throw InputError(name, "", "is UTF-16 text (it starts with a UTF-16 byte-order mark); save it as UTF-8 or ASCII");
+}
+
 std::string input_file_problem(const fs::path& path) {
     std::error_code ec;
     const fs::file_status status = fs::status(path, ec);

@@ -30,6 +30,11 @@ std::string read_input_file(const std::filesystem::path& path);
 // of the first keyword and dropped the line).
 std::string_view without_bom(std::string_view text);
 
+// Throws InputError naming `name` where `text` starts with a UTF-16
+// byte-order mark (the loaders read UTF-8 or ASCII; such a file otherwise
+// reads as text without a single usable line).
+void refuse_utf16(std::string_view text, const std::string& name);
+
 // While an InputFileLog lives, every file read_input_file reads, and every
 // file given to note_input_file (those read by other means: an EXR through
 // tinyexr, a glTF's buffers through tinygltf), is appended to its list once;

@@ -139,6 +139,7 @@ private:
         // A library named again (on two mtllib lines) is read once.
         if (!read_.insert(file.lexically_normal()).second) return true;
         const std::string text = read_input_file(file);
+        if (uses_mtl_) refuse_utf16(text, display(file));
         const std::string_view mtl = without_bom(text);
         if (uses_mtl_) check_mtl_numbers(mtl, display(file));
         // Each named material's block: whether it has a Kd, and which of
@@ -221,6 +222,7 @@ void read_obj(const std::filesystem::path& file, const std::string& obj_name, bo
     // reads a byte order mark as part of the first line's keyword, losing
     // that line (and shifting every later vertex index): skipped here.
     const std::string bytes = read_input_file(file);
+    refuse_utf16(bytes, obj_name);
     const std::string_view text = without_bom(bytes);
     const std::vector<std::size_t> non_finite_normals = check_obj_numbers(text, obj_name);
     TextBuffer buffer(text);
