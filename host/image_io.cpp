@@ -257,7 +257,7 @@ void check_exr_attributes(std::string_view bytes, const EXRVersion& version, con
 
 }  // namespace
 
-Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
+Image read_exr(const fs::path& file, std::uint64_t max_pixels, glm::ivec2* origin) {
     const std::string name = file.string();
     // The file is read once and decoded from memory. tinyexr's file calls
     // open it at each step (version, header, pixels), so a file changed in
@@ -290,6 +290,7 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels) {
     const std::int64_t width = std::int64_t(window.max_x) - window.min_x + 1;
     const std::int64_t height = std::int64_t(window.max_y) - window.min_y + 1;
     if (width <= 0 || height <= 0) throw InputError(name, "", "image is empty");
+    if (origin != nullptr) *origin = glm::ivec2(window.min_x, window.min_y);
     if (std::uint64_t(width) * std::uint64_t(height) > max_pixels)
         throw InputError(name, "", "is " + std::to_string(width) + " x " + std::to_string(height) +
                                        " pixels, more than the " + std::to_string(max_pixels) + " it may hold");

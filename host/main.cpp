@@ -209,12 +209,20 @@ int run_compare(const std::string& image, const std::string& reference, const st
         outputs.add_input(reference, "reference");
         outputs.add(heatmap, "heatmap");
     }
-    lc::Image a = lc::read_exr(image);
-    lc::Image r = lc::read_exr(reference);
+    glm::ivec2 a_origin, r_origin;
+    lc::Image a = lc::read_exr(image, lc::kMaxExrPixels, &a_origin);
+    lc::Image r = lc::read_exr(reference, lc::kMaxExrPixels, &r_origin);
     if (a.width != r.width || a.height != r.height)
         throw lc::InputError(image, "", "size " + std::to_string(a.width) + "x" + std::to_string(a.height) +
                                             " differs from the reference's " + std::to_string(r.width) + "x" +
                                             std::to_string(r.height));
+    // Pixels are compared where they lie: two data windows of one size that
+    // start apart hold different places of the image.
+    if (a_origin != r_origin)
+        throw lc::InputError(image, "", "pixels start at (" + std::to_string(a_origin.x) + ", " +
+                                            std::to_string(a_origin.y) + "), the reference's at (" +
+                                            std::to_string(r_origin.x) + ", " + std::to_string(r_origin.y) +
+                                            ") (the OpenEXR data windows)");
     // A NaN or infinite pixel makes every metric NaN or infinite: refused,
     // naming the first such pixel, rather than reported as a number.
     for (const auto& [img, file] : {std::pair<const lc::Image&, const std::string&>{a, image}, {r, reference}}) {

@@ -106,6 +106,22 @@ TEST_F(ImageFiles, ExrLineOrderDoesNotFlipTheImage) {
     EXPECT_EQ(back.rgb, image.rgb);
 }
 
+// A data window that starts away from (0, 0) reads the same pixels and
+// says where they start (compare refuses two images that start apart).
+TEST_F(ImageFiles, ExrDataWindowOriginIsReported) {
+    lc::Image image(3, 2);
+    image.set(2, 1, glm::vec3(1.0f, 2.0f, 3.0f));
+    const fs::path file = dir_ / "moved.exr";
+    lc::write_exr(file, image);
+    glm::ivec2 origin(-1);
+    EXPECT_EQ(lc::read_exr(file, lc::kMaxExrPixels, &origin).rgb, image.rgb);
+    EXPECT_EQ(origin, glm::ivec2(0, 0));
+    const std::int32_t window[4] = {10, 0, 12, 1};  // the scanline blocks keep their y
+    lc::test::patch_exr_attribute(file, "dataWindow", "box2i", window, sizeof(window));
+    EXPECT_EQ(lc::read_exr(file, lc::kMaxExrPixels, &origin).rgb, image.rgb);
+    EXPECT_EQ(origin, glm::ivec2(10, 0));
+}
+
 TEST_F(ImageFiles, ExrStoresFloatChannelsSortedByName) {
     lc::Image image(2, 1);
     image.set(0, 0, {1.0f, 2.0f, 3.0f});

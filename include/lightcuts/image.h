@@ -45,7 +45,11 @@ void write_exr(const std::filesystem::path& file, const Image& image);   // RGB 
 // allocates what a header declares). The default is the largest image the
 // renderer writes, 16384 x 16384.
 inline constexpr std::uint64_t kMaxExrPixels = std::uint64_t(16384) * 16384;
-Image read_exr(const std::filesystem::path& file, std::uint64_t max_pixels = kMaxExrPixels);
+// `origin`, where given, gets the data window's first pixel (x, y): an
+// image's pixels start there in the file's coordinates (0, 0 as this
+// renderer writes them).
+Image read_exr(const std::filesystem::path& file, std::uint64_t max_pixels = kMaxExrPixels,
+               glm::ivec2* origin = nullptr);
 void write_png_rgb8(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
                     const std::vector<std::uint8_t>& rgb8);
 // Tone-mapped sRGB preview: exposure * value, clamped to [0,1], sRGB-encoded.
