@@ -1034,6 +1034,10 @@ const BadInput kBadInputs[] = {
     {"bad_mtl_kd.json", "bad_kd.obj", "material 'hot'.Kd: ", "[0, 1]"},
     {"bad_scale_zero.json", "bad_scale_zero.json", "meshes[0].transform.scale[1]: ", "zero"},
     {"bad_scale_tiny.json", "bad_scale_tiny.json", "meshes[0].transform: ", "every triangle of"},
+    // A transform past float's range made the corners infinite, read as
+    // a degenerate triangle and dropped with a warning.
+    {"bad_translate_overflow.json", "bad_translate_overflow.json", "meshes[0].transform: ",
+     "takes triangle 1 of "},
     {"bad_roughness.json", "bad_roughness.json", "meshes[0].material.roughness: ", "(0, 1]"},
     {"bad_kd_override.json", "bad_kd_override.json", "meshes[0].material.kd[1]: ", "at most 1"},
     // Render block.

@@ -470,6 +470,13 @@ private:
         const Corners idx = transform_.file_winding(face_corners);
         const std::array<glm::vec3, 3> v{position(idx[0].vertex_index), position(idx[1].vertex_index),
                                          position(idx[2].vertex_index)};
+        // A transform that takes a corner past float's range makes it
+        // infinite (or NaN); the triangle would read as degenerate.
+        for (int c = 0; c < 3; ++c)
+            if (!fits_float(glm::dvec3(v[std::size_t(c)])) && !transform_.field.empty() &&
+                fits_float(glm::dvec3(raw_position(idx[std::size_t(c)].vertex_index))))
+                throw InputError(transform_.scene_file, transform_.field,
+                                 "takes " + face_name(f, shape) + " of " + obj_name_ + " past float's range");
         glm::vec3 face;
         const TriangleShape shape_of = triangle_shape(v, face);
         if (shape_of == TriangleShape::too_large) throw InputError(obj_name_, face_name(f, shape), kTriangleTooLarge);
