@@ -368,6 +368,19 @@ TEST_F(ImageFiles, TonemappedPngAppliesExposureAndSrgb) {
     // Auto exposure maps the 99th percentile luminance to white.
     lc::write_png_tonemapped(file, gray(10, 10, 40.0f));
     EXPECT_EQ(read_png(file).at(3, 3)[1], 255);
+    // Of the lit pixels only, and their 99th percentile, not the largest:
+    // 100 black pixels, 99 of luminance 1 to 99, one of 1e6. The 99th
+    // percentile of the 100 lit ones is 99, so 98 maps to 254 and 99 to 255
+    // (counting the black ones would give 98 and 255 for both; the largest
+    // would leave both black).
+    lc::Image lit(20, 10);
+    for (std::uint32_t i = 0; i < 99; ++i) lit.set((100 + i) % 20, (100 + i) / 20, glm::vec3(float(i + 1)));
+    lit.set(19, 9, glm::vec3(1e6f));
+    lc::write_png_tonemapped(file, lit);
+    const Png ramp = read_png(file);
+    EXPECT_EQ(ramp.at((100 + 97) % 20, (100 + 97) / 20)[1], 254);  // luminance 98: sRGB(98 / 99) = 0.9957
+    EXPECT_EQ(ramp.at((100 + 98) % 20, (100 + 98) / 20)[1], 255);  // luminance 99
+    EXPECT_EQ(ramp.at(0, 0)[1], 0);
     lc::write_png_tonemapped(file, gray(3, 3, 0.0f));  // all black: exposure 1, no crash
     EXPECT_EQ(read_png(file).at(1, 1)[0], 0);
     EXPECT_EQ(entries(), std::set<std::string>{"tone.png"});

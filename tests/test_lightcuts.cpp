@@ -767,8 +767,10 @@ INSTANTIATE_TEST_SUITE_P(Lightcuts, ShippedScenes,
                                            // Measured 0.0013, 5.7%, 0.12% (4096 samples).
                                            ShippedCase{"scenes/panels/panels.json", 0.002, 0.086, 0.002, 0.002},
                                            // Measured 0.040, 53%, 17%: sharp spots whose
-                                           // representative misses the point (docs/lightcuts.md).
-                                           ShippedCase{"scenes/gallery/gallery.json", 0.06, 0.8, 0.25, 0.16},
+                                           // representative misses the point (docs/lightcuts.md);
+                                           // above 5% the octets measure 24.1% (quads 23.2%), so
+                                           // that limit is 1.5 times the octets'.
+                                           ShippedCase{"scenes/gallery/gallery.json", 0.06, 0.8, 0.36, 0.16},
                                            // Measured 0.012, 9.1%, 0.24%.
                                            ShippedCase{"scenes/sky/sky.json", 0.018, 0.14, 0.004, 0.018},
                                            // Disney spheres: measured 0.0106, 8.2%, 0.17%.

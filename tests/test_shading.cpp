@@ -133,9 +133,11 @@ TEST(PixelSamples, EverySppCoversThePixel) {
             }
         const double n = double(seeds) * spp;
         EXPECT_EQ(std::count(hits.begin(), hits.end(), 0), 0) << "spp " << spp;
-        // Uniform positions: standard error sqrt(1/12 / n) <= 0.0023; 5 of them.
-        EXPECT_NEAR(mx / n, 0.5, 0.012) << "spp " << spp;
-        EXPECT_NEAR(my / n, 0.5, 0.012) << "spp " << spp;
+        // Uniform positions: standard error sqrt(1/12 / n), 0.0032 at spp 2
+        // to 0.0008 at spp 17; four of them (stratified samples err less).
+        const double se = std::sqrt(1.0 / 12.0 / n);
+        EXPECT_NEAR(mx / n, 0.5, 4.0 * se) << "spp " << spp;
+        EXPECT_NEAR(my / n, 0.5, 4.0 * se) << "spp " << spp;
     }
 }
 
