@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include "fuzz_input.h"
@@ -40,7 +42,7 @@ void replay(const fs::path& input, bool gltf) {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     std::string name = std::string(info->test_suite_name()) + "_" + info->name();
     std::replace(name.begin(), name.end(), '/', '_');
-    const fs::path dir = fs::temp_directory_path() / ("lc_fuzz_replay_" + name);
+    const fs::path dir = fs::temp_directory_path() / ("lc_fuzz_replay_" + std::to_string(::getpid()) + "_" + name);
     const fs::path scene_file = gltf ? fuzz::write_gltf_file(data, dir) : fuzz::write_scene_files(data, dir);
     try {
         const Scene scene = load_scene(scene_file);
@@ -77,7 +79,7 @@ INSTANTIATE_TEST_SUITE_P(Fuzz, FuzzGltfInput,
 // depth (over 2 GB for 400 KB of '['). Replaying them proves no crash; this
 // proves the cap that fixed it, which a replay of a small file cannot.
 TEST(FuzzRegression, DeepNestingIsRejectedByDepth) {
-    const fs::path dir = fs::temp_directory_path() / "lc_fuzz_replay_deep_nesting";
+    const fs::path dir = fs::temp_directory_path() / ("lc_fuzz_replay_deep_nesting_" + std::to_string(::getpid()));
     const fs::path scene_file =
         fuzz::write_scene_files("{\"camera\": " + std::string(100, '[') + std::string(100, ']') + "}", dir);
     try {
@@ -94,7 +96,7 @@ TEST(FuzzRegression, DeepNestingIsRejectedByDepth) {
 // tinygltf turns `extras` into its own values recursively: a file of nested
 // brackets must be refused before it runs the stack out.
 TEST(FuzzRegression, DeeplyNestedGltfIsRejectedByDepth) {
-    const fs::path dir = fs::temp_directory_path() / "lc_fuzz_replay_deep_gltf";
+    const fs::path dir = fs::temp_directory_path() / ("lc_fuzz_replay_deep_gltf_" + std::to_string(::getpid()));
     const fs::path file = fuzz::write_gltf_file(
         "{\"asset\": {\"version\": \"2.0\"}, \"extras\": " + std::string(100000, '[') + "}", dir);
     try {
