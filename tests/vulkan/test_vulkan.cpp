@@ -106,6 +106,35 @@ TEST(DeviceChoiceAuto, DecidesFromTheDevicesFoundEarly) {
     }
 }
 
+// Told of a hardware GPU, device "auto" renders through Vulkan (here on
+// whatever device this machine has, which the answer claims is one); cuts
+// shared by octets, which the kernels do not make, fall back to the CPU
+// with a note that names the setting.
+TEST_F(Vulkan, AutoRendersOnAHardwareGpuAndFallsBackForOctets) {
+    PreparedScene p = prepare_scene(random_scene(6, 4, 0, 8, 8), 1);
+    const auto told_of_a_gpu = [] {
+        std::promise<GpuProbe> answer;
+        answer.set_value(GpuProbe{VulkanDevices{list_vulkan_devices(), true}, false});
+        DeviceChoice choice;
+        choice.devices = answer.get_future().share();
+        return choice;
+    };
+    DeviceChoice choice = told_of_a_gpu();
+    std::string said;
+    choice.note = [&](const std::string& line) { said = line; };
+    const RenderResult pixel = render(p, options("lightcuts", 8, 8), choice);
+    const std::vector<std::string> names = list_vulkan_devices();
+    EXPECT_NE(std::find(names.begin(), names.end(), pixel.stats.device), names.end()) << pixel.stats.device;
+    EXPECT_EQ(said, "");
+    RenderOptions octets = options("lightcuts", 8, 8);
+    octets.cut_sharing = "octet";
+    choice = told_of_a_gpu();
+    choice.note = [&](const std::string& line) { said = line; };
+    EXPECT_EQ(render(p, octets, choice).stats.device, "cpu");
+    EXPECT_NE(said.find("cut_sharing \"octet\""), std::string::npos) << said;
+    EXPECT_NE(said.find("rendering on the CPU"), std::string::npos) << said;
+}
+
 // The device files a GPU's driver would use, found under a /dev of our
 // making: render nodes under dri/ (not card nodes), NVIDIA's, WSL's, and
 // none of the rest.
