@@ -11,6 +11,7 @@
 
 #include "cpu_kernel.h"
 #include "run_on_threads.h"
+#include "scene/float_limits.h"
 #include "scene/huge_pages.h"
 #include "scene/light_records.h"
 #include "shared/color.h"
@@ -49,9 +50,14 @@ void sample_triangle(const TriangleEmission& source, std::size_t index, const gp
                      const gpu::Material& m, std::uint32_t samples, float share, std::uint32_t hash,
                      gpu::Light* out) {
     const glm::vec3 a = vertex(t, 0), b = vertex(t, 1), c = vertex(t, 2);
-    const glm::vec3 cross = glm::cross(b - a, c - a);
-    const float area = 0.5f * glm::length(cross);
-    const glm::vec3 normal = glm::normalize(cross);
+    // In double: for a tiny triangle (edges below about 1e-10) the float
+    // cross product's squared length underflows, which shortened the area
+    // and gave the samples an axis up to 1.5 long, past the cluster bounds'
+    // cone (an audit's search).
+    const glm::dvec3 cross = glm::cross(glm::dvec3(b) - glm::dvec3(a), glm::dvec3(c) - glm::dvec3(a));
+    const float area = float(0.5 * glm::length(cross));
+    glm::vec3 normal(0.0f, 0.0f, 1.0f);
+    loader::unit_vector(cross, normal);  // the loader keeps no triangle without a normal
     const bool textured = has_emissive_texture(m);
     const glm::vec3 constant = emission(m) * (area / share);
     // A random shift of the whole pattern (Cranley-Patterson rotation).

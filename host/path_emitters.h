@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 
 #include "lightcuts/scene.h"
+#include "scene/float_limits.h"
 #include "shared/types.h"
 
 namespace lc::path {
@@ -121,10 +122,13 @@ double light_power(const gpu::Light& light, double radius);
 // map) may lean past it, but an opaque surface reflects nothing through
 // itself (Veach 1997, section 5.3; pbrt's BSDF::f tests the same side).
 inline glm::vec3 facing_normal(const gpu::Triangle& tri, glm::vec3 ray_dir, glm::vec3 fallback) {
-    const glm::vec3 v0(tri.v0_x, tri.v0_y, tri.v0_z);
-    glm::vec3 n = glm::cross(glm::vec3(tri.v1_x, tri.v1_y, tri.v1_z) - v0, glm::vec3(tri.v2_x, tri.v2_y, tri.v2_z) - v0);
-    const float length = glm::length(n);
-    n = length > 0.0f ? n / length : fallback;
+    // In double: a tiny triangle's float cross product has a squared length
+    // that underflows, and divided by it a normal (a VPL's axis) came out
+    // up to 1.5 long.
+    glm::vec3 n = fallback;
+    loader::face_normal({glm::vec3(tri.v0_x, tri.v0_y, tri.v0_z), glm::vec3(tri.v1_x, tri.v1_y, tri.v1_z),
+                         glm::vec3(tri.v2_x, tri.v2_y, tri.v2_z)},
+                        n);
     return glm::dot(n, ray_dir) > 0.0f ? -n : n;
 }
 

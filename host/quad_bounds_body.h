@@ -342,15 +342,18 @@ LC_ALWAYS_INLINE inline void disney_values(const QuadLanes& q, V wi_x, V wi_y, V
     r = v_mul(q.kd_r, diffuse);
     g = v_mul(q.kd_g, diffuse);
     b = v_mul(q.kd_b, diffuse);
-    // The specular lobe (lc_microfacet_cos; lc_smith_g1 at cos_i).
-    const V specular =
-        v_div(v_mul(v_mul(ggx_d<Kernel>(q, cos_h, sin2_h), smith_g1(cos_i, q.a2)), q.g1), q.four_cos_o);
+    // The specular and clearcoat lobes (lc_microfacet_cos; lc_smith_g1 at
+    // cos_i), where the facets reflect towards the viewer
+    // (lc_facets_reflect: wo . h > 0); 0, which adds nothing, elsewhere.
+    const V facets = v_cmpgt(dot4(q.wox, q.woy, q.woz, h_x, h_y, h_z), zero);
+    const V specular = v_and(
+        v_div(v_mul(v_mul(ggx_d<Kernel>(q, cos_h, sin2_h), smith_g1(cos_i, q.a2)), q.g1), q.four_cos_o), facets);
     add_disney_lobes<Kernel>(
         q, w, specular, cos_i,
         [&] {
             const V g1_coat_i =
                 smith_g1(cos_i, v_set1(Kernel::kClearcoatSmithAlpha * Kernel::kClearcoatSmithAlpha));
-            return v_div(v_mul(v_mul(gtr1_d(q, cos_h, sin2_h), g1_coat_i), q.coat_g1), q.four_cos_o);
+            return v_and(v_div(v_mul(v_mul(gtr1_d(q, cos_h, sin2_h), g1_coat_i), q.coat_g1), q.four_cos_o), facets);
         },
         r, g, b);
     const V seen = v_cmpgt(q.cos_o, zero);  // lc_disney_brdf_cos: 0 where !(cos_o > 0)
@@ -536,13 +539,17 @@ LC_ALWAYS_INLINE inline V light_values(const QuadLanes& q, const LightLanes& l, 
         // lc_brdf_cos's GGX lobe where cos_o > 0: h = normalize(wi + wo)
         // (glm's: v * (1 / sqrt(dot(v, v)))), then D G1(cos_i) G1(cos_o) /
         // (4 cos_o), the point's terms from set_ggx_terms.
-        const V hx = v_add(wi_x, q.wox), hy = v_add(wi_y, q.woy), hz = v_add(wi_z, q.woz);
-        const V inverse = v_div(one, v_sqrt(dot4(hx, hy, hz, hx, hy, hz)));
+        const V sx = v_add(wi_x, q.wox), sy = v_add(wi_y, q.woy), sz = v_add(wi_z, q.woz);
+        const V inverse = v_div(one, v_sqrt(dot4(sx, sy, sz, sx, sy, sz)));
+        const V hx = v_mul(sx, inverse), hy = v_mul(sy, inverse), hz = v_mul(sz, inverse);
         V cos_h, sin2_h;
-        half_angle<Kernel>(q, v_mul(hx, inverse), v_mul(hy, inverse), v_mul(hz, inverse), cos_h, sin2_h);
+        half_angle<Kernel>(q, hx, hy, hz, cos_h, sin2_h);
         const V spec =
             v_div(v_mul(v_mul(ggx_d<Kernel>(q, cos_h, sin2_h), smith_g1(cos_i, q.a2)), q.g1), q.four_cos_o);
-        const V lobe = v_and(q.specular_lanes, v_cmpgt(q.cos_o, zero));
+        // Where cos_o > 0 and the facets reflect towards the viewer
+        // (lc_facets_reflect).
+        const V facets = v_cmpgt(dot4(q.wox, q.woy, q.woz, hx, hy, hz), zero);
+        const V lobe = v_and(v_and(q.specular_lanes, v_cmpgt(q.cos_o, zero)), facets);
         r = v_select(lobe, v_add(r, v_mul(q.ks_r, spec)), r);
         g = v_select(lobe, v_add(g, v_mul(q.ks_g, spec)), g);
         b = v_select(lobe, v_add(b, v_mul(q.ks_b, spec)), b);

@@ -153,10 +153,12 @@ struct CutState {
     uint cut_size;
     uint shadow_rays;
     uint flags;                    // kCut* bits
-    float fixed_r, fixed_g, fixed_b;  // single lights and frozen clusters
+    // Single lights and frozen clusters; stochastic, once kCutSelected: the
+    // sum of the draws [0, draw) of heap slot `shaded`.
+    float fixed_r, fixed_g, fixed_b;
     // While the cut is refined: the running sum of the heap's estimates.
-    // Stochastic, once kCutSelected: fixed_sum plus the fresh estimates of
-    // heap slots [0, shaded) and of draws [0, draw) of slot `shaded`.
+    // Stochastic, once kCutSelected: the selection's fixed_sum plus the
+    // fresh estimates of heap slots [0, shaded).
     float heap_r, heap_g, heap_b;
     uint shaded;
     uint draw;

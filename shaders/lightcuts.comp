@@ -44,8 +44,11 @@ void main() {
     bool selected = false;  // stochastic: the cut is final; heap_sum is the fresh sum
     uint shaded = 0u;       // stochastic: heap slots shaded afresh so far
     uint draw = 0u;         // ... and draws of slot `shaded` (frame.light_samples per slot)
+    uint stream = kStochastic ? lc_sample_stream(frame.seed, lc_tile_x(i), lc_tile_y(i), push.sample_index) : 0u;
+    // Stochastic: the clusters that freeze are shaded afresh as they freeze.
+    uint fresh_draws = kStochastic ? frame.light_samples : 0u;
     if ((push.cut_flags & kCutFirstDispatch) != 0u) {
-        lc_cut_start(sp, m, frame, heap_size, fixed_sum, heap_sum, stats);
+        lc_cut_start(sp, m, frame, heap_size, fixed_sum, heap_sum, stats, stream, fresh_draws);
     } else {
         CutState s = cut_states[i];
         if ((s.flags & kCutDone) != 0u) return;
@@ -63,24 +66,29 @@ void main() {
         lc_heap_restore(heap_size);
     }
 
-    uint stream = kStochastic ? lc_sample_stream(frame.seed, lc_tile_x(i), lc_tile_y(i), push.sample_index) : 0u;
     bool done = false;
     for (uint r = 0u; r < push.refine_budget && !done; ++r) {
         if (!selected) {
-            if (lc_cut_refine(sp, m, frame, heap_size, fixed_sum, heap_sum, stats)) continue;
+            if (lc_cut_refine(sp, m, frame, heap_size, fixed_sum, heap_sum, stats, stream, fresh_draws)) continue;
             selected = true;
-            heap_sum = fixed_sum;  // the fresh sum starts from the single lights and frozen clusters
+            if (kStochastic) {
+                heap_sum = fixed_sum;    // the fresh sum starts from the single lights and frozen clusters
+                fixed_sum = vec3(0.0f);  // from here the sum of slot `shaded`'s draws so far
+            }
             done = !kStochastic;
         } else if (kStochastic && shaded < heap_size) {
             // kStochastic written into the condition lets the host's
             // specialization drop this branch, and the ray and light
             // sampling code under it, from Lightcuts' kernel: the loop state
             // alone does not show the compiler that it is dead there.
-            heap_sum += lc_shade_cluster_stochastic(sp, lc_entry_node(LC_HEAP_LOAD(shaded)), frame.min_distance2, stream,
-                                                    draw, stats) *
-                        (1.0f / float(frame.light_samples));
+            // A cluster's draws are summed apart and then scaled, as
+            // lc_cluster_fresh_estimate sums them on the CPU.
+            fixed_sum += lc_shade_cluster_stochastic(sp, lc_entry_node(LC_HEAP_LOAD(shaded)), frame.min_distance2,
+                                                     stream, draw, stats);
             draw += 1u;
             if (draw == frame.light_samples) {
+                heap_sum += fixed_sum * (1.0f / float(frame.light_samples));
+                fixed_sum = vec3(0.0f);
                 draw = 0u;
                 shaded += 1u;
             }

@@ -259,7 +259,7 @@ TEST(LightcutsBounds, GgxBoundIsTighterThanThePeak) {
 void push_entry(Kernel& k, std::uint32_t& size, std::uint32_t node, float error, Kernel::ShadeStats& ss) {
     glm::vec3 fixed_sum(0.0f), heap_sum(0.0f);
     k.lc_heap_push(Kernel::SurfacePoint{}, 0.0f, size, cpu::HeapEntry{node, error, glm::vec3(0.0f)}, glm::vec3(0.0f), fixed_sum,
-                   heap_sum, ss);
+                   heap_sum, ss, 0u, 0u);
 }
 
 // lc_cos_h_max works with the cone's sine and cosines (no acos or cos): for

@@ -420,6 +420,30 @@ TEST(AreaLight, MoreTrianglesThanSamplesKeepTheirPower) {
     EXPECT_NEAR(sum / seeds, expected, 0.02 * expected);
 }
 
+// A triangle with edges of 1e-11 (kept by the loader: its normal is taken
+// in double) gives samples whose axis is of unit length and whose power is
+// its emission times its area: in float the cross product's squared length
+// underflows, and the axis came out up to 1.5 long, past the cluster
+// bounds' emission cone (an audit's search, ratio 1.51).
+TEST(AreaLight, TinyTrianglesGiveUnitAxes) {
+    std::vector<gpu::Material> materials = {test::lambert(glm::vec3(0.0f))};
+    materials[0].emission_r = materials[0].emission_g = materials[0].emission_b = 2.0f;
+    materials[0].flags |= gpu::kMaterialEmissive;
+    const glm::vec3 a(8.94575108e-11f, 9.97217794e-11f, 4.75157275e-11f), b(8.90358759e-11f, 9.47505546e-11f, 5.587137e-11f),
+        c(9.47667916e-11f, 1.00431434e-10f, 5.05735592e-11f);
+    const std::vector<gpu::Triangle> triangles = {
+        gpu::Triangle{a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, 0u, 0u, 0u}};
+    const double area = 0.5 * glm::length(glm::cross(glm::dvec3(b) - glm::dvec3(a), glm::dvec3(c) - glm::dvec3(a)));
+    const auto sampled = sample_area_lights(TriangleEmission(triangles, materials), triangles, materials, 16, 1);
+    ASSERT_EQ(sampled.size(), 16u);
+    double power = 0.0;
+    for (const gpu::Light& l : sampled) {
+        EXPECT_NEAR(glm::length(glm::dvec3(l.axis_x, l.axis_y, l.axis_z)), 1.0, 1e-6);
+        power += l.r;
+    }
+    EXPECT_NEAR(power, 2.0 * area, 1e-5 * 2.0 * area);
+}
+
 // Each triangle's samples depend on it alone, so the threads that make
 // them do not change them: the same bytes from one thread as from three
 // (whose ranges of samples start and end inside triangles' shares) and as

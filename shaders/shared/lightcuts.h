@@ -152,6 +152,20 @@ uint lc_heap_smallest(uint from, uint to, float bound) {
 #endif
 }
 
+// Stochastic Lightcuts' estimate of one cluster: the mean of `draws` fresh
+// representatives (lc_shade_cluster_stochastic), summed apart from
+// everything else and then scaled (added one by one into the pixel's sum,
+// 65,536 draws of each of a hundred clusters lost 0.9% to rounding). Two
+// nested loops of at most 256 trips: llvmpipe stops a loop after 65,535.
+vec3 lc_cluster_fresh_estimate(LC_IN(SurfacePoint) sp, uint node_index, float min_distance2, uint stream, uint draws,
+                               LC_INOUT(ShadeStats) stats) {
+    vec3 sum = vec3(0.0f);
+    for (uint first = 0u; first < draws; first += 256u)
+        for (uint d = first; d < min(draws, first + 256u); ++d)
+            sum += lc_shade_cluster_stochastic(sp, node_index, min_distance2, stream, d, stats);
+    return sum * (1.0f / float(draws));
+}
+
 // The bounded heap: at most LC_HEAP_CAPACITY entries. A push into a full
 // heap freezes the entry with the smallest bound, the new one included (the
 // new one on a tie): it stays in the cut with its current estimate, which
@@ -160,8 +174,16 @@ uint lc_heap_smallest(uint from, uint to, float bound) {
 // slots size/2 and up; the new entry takes its slot and rises.
 // One sift for both cases, after them: llvmpipe runs every branch for all
 // the lanes of a SIMD group, so a sift in each would be two loops a push.
+//
+// fresh_draws > 0 (Stochastic Lightcuts): a frozen cluster is shaded with
+// that many fresh representatives from `stream` as it freezes, since it
+// will not be in the heap when the cut's clusters are shaded afresh; the
+// fresh estimate goes into fixed_sum and the difference from the fixed one
+// into heap_sum, so that the criterion's sum (fixed_sum + heap_sum), and
+// with it the cut, stays what the fixed representatives make it.
 void lc_heap_push(LC_IN(SurfacePoint) sp, float min_distance2, LC_INOUT(uint) size, HeapEntry e, vec3 estimate,
-                  LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
+                  LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats, uint stream,
+                  uint fresh_draws) {
     uint slot = size;  // where e rises from; kInvalidIndex where e is frozen
     if (size < uint(LC_HEAP_CAPACITY)) {
         size += 1u;
@@ -169,16 +191,22 @@ void lc_heap_push(LC_IN(SurfacePoint) sp, float min_distance2, LC_INOUT(uint) si
     } else {
         stats.frozen += 1u;
         slot = lc_heap_smallest(size / 2u, size, e.error);
+        HeapEntry leaving = e;
+        vec3 frozen = estimate;
         if (slot == kInvalidIndex) {
             stats.frozen_error += e.error;
-            fixed_sum += estimate;
         } else {
-            HeapEntry leaving = LC_HEAP_LOAD(slot);
+            leaving = LC_HEAP_LOAD(slot);
             stats.frozen_error += leaving.error;
-            vec3 frozen = lc_entry_estimate(sp, leaving, min_distance2);
-            fixed_sum += frozen;
+            frozen = lc_entry_estimate(sp, leaving, min_distance2);
             heap_sum += estimate - frozen;
         }
+        if (fresh_draws > 0u) {
+            vec3 fresh = lc_cluster_fresh_estimate(sp, lc_entry_node(leaving), min_distance2, stream, fresh_draws, stats);
+            heap_sum += frozen - fresh;
+            frozen = fresh;
+        }
+        fixed_sum += frozen;
     }
     if (slot != kInvalidIndex) lc_heap_sift_up(slot, e);
 }
@@ -242,14 +270,14 @@ bool lc_cluster_entry(uint node_index, LC_IN(LightNode) node, float error, vec3 
 // be refined.
 void lc_add_cluster(LC_IN(SurfacePoint) sp, uint node_index, LC_IN(LightNode) node, float error, float min_distance2,
                     LC_INOUT(uint) heap_size, LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum,
-                    LC_INOUT(ShadeStats) stats) {
+                    LC_INOUT(ShadeStats) stats, uint stream, uint fresh_draws) {
     HeapEntry e;
     vec3 estimate;
     bool visible = false;
     vec3 unit = vec3(0.0f);
     if (lc_cluster_needs_unit(node, error)) unit = lc_rep_unit(sp, node.rep_light, min_distance2, visible, stats);
     if (lc_cluster_entry(node_index, node, error, unit, visible, e, estimate, fixed_sum))
-        lc_heap_push(sp, min_distance2, heap_size, e, estimate, fixed_sum, heap_sum, stats);
+        lc_heap_push(sp, min_distance2, heap_size, e, estimate, fixed_sum, heap_sum, stats, stream, fresh_draws);
 }
 
 // Walter 2005, section 4: start from the roots, repeatedly replace the
@@ -260,9 +288,11 @@ void lc_add_cluster(LC_IN(SurfacePoint) sp, uint node_index, LC_IN(LightNode) no
 // In three steps (start, one refinement, result) so that the GPU can spread
 // a long refinement over several dispatches; lc_shade_lightcuts runs them
 // back to back. fixed_sum holds the estimates that are final (leaves and
-// frozen clusters), heap_sum the running sum of the heap's.
+// frozen clusters), heap_sum the running sum of the heap's. `stream` and
+// `fresh_draws`: lc_heap_push's (Stochastic Lightcuts; 0 draws otherwise).
 void lc_cut_start(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_size,
-                  LC_OUT(vec3) fixed_sum, LC_OUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
+                  LC_OUT(vec3) fixed_sum, LC_OUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats, uint stream,
+                  uint fresh_draws) {
     heap_size = 0u;
     fixed_sum = vec3(0.0f);
     heap_sum = vec3(0.0f);
@@ -272,7 +302,7 @@ void lc_cut_start(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_
         if (f.roots[type] == kInvalidIndex) continue;
         LightNode root = LC_LIGHT_NODE(f.roots[type]);
         lc_add_cluster(sp, f.roots[type], root, lc_cluster_error(sp, m, root, f.min_distance2), f.min_distance2,
-                       heap_size, fixed_sum, heap_sum, stats);
+                       heap_size, fixed_sum, heap_sum, stats, stream, fresh_draws);
         root_count += 1u;
     }
     stats.cut_size = root_count;
@@ -284,7 +314,8 @@ void lc_cut_start(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_
 // Refines the cluster with the largest bound; false (cut unchanged) once the
 // cut is final.
 bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) heap_size,
-                   LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats) {
+                   LC_INOUT(vec3) fixed_sum, LC_INOUT(vec3) heap_sum, LC_INOUT(ShadeStats) stats, uint stream,
+                   uint fresh_draws) {
     if (heap_size == 0u) return false;
     HeapEntry top = LC_HEAP_LOAD(0u);
     float estimate = lc_luminance(fixed_sum + heap_sum);
@@ -351,7 +382,8 @@ bool lc_cut_refine(SurfacePoint sp, Material m, FrameParams f, LC_INOUT(uint) he
         a = LC_HEAP_LOAD(heap_size);
     }
     if (heap_size > 0u) lc_heap_replace_top(heap_size, a);
-    if (has_b) lc_heap_push(sp, f.min_distance2, heap_size, b, estimate_b, fixed_sum, heap_sum, stats);
+    if (has_b)
+        lc_heap_push(sp, f.min_distance2, heap_size, b, estimate_b, fixed_sum, heap_sum, stats, stream, fresh_draws);
     stats.cut_size += 1u;
     if (lc_node_type(node) == kLightVpl) stats.cut_indirect += 1u;
     return true;
@@ -367,10 +399,10 @@ vec3 lc_cut_result(SurfacePoint sp, float min_distance2, uint heap_size, vec3 fi
 
 // Runs the cut selection from the roots to the final cut.
 void lc_select_cut(SurfacePoint sp, Material m, FrameParams f, LC_OUT(uint) heap_size, LC_OUT(vec3) fixed_sum,
-                   LC_INOUT(ShadeStats) stats) {
+                   LC_INOUT(ShadeStats) stats, uint stream, uint fresh_draws) {
     vec3 heap_sum = vec3(0.0f);
-    lc_cut_start(sp, m, f, heap_size, fixed_sum, heap_sum, stats);
-    while (lc_cut_refine(sp, m, f, heap_size, fixed_sum, heap_sum, stats)) {
+    lc_cut_start(sp, m, f, heap_size, fixed_sum, heap_sum, stats, stream, fresh_draws);
+    while (lc_cut_refine(sp, m, f, heap_size, fixed_sum, heap_sum, stats, stream, fresh_draws)) {
     }
 }
 
@@ -378,30 +410,26 @@ vec3 lc_shade_lightcuts(SurfacePoint sp, FrameParams f, LC_INOUT(ShadeStats) sta
     Material m = sp.mat;
     uint heap_size = 0u;
     vec3 fixed_sum = vec3(0.0f);
-    lc_select_cut(sp, m, f, heap_size, fixed_sum, stats);
+    lc_select_cut(sp, m, f, heap_size, fixed_sum, stats, 0u, 0u);
     return lc_cut_result(sp, f.min_distance2, heap_size, fixed_sum);
 }
 
 // Stochastic Lightcuts (Yuksel 2019): the cut is selected exactly as above,
 // with the fixed representatives, so it depends on the shaded point only;
 // then every cluster of the cut that is not a single light is shaded again
-// with a representative drawn afresh from the sample's `stream`
-// (lc_shade_cluster_stochastic, f.light_samples draws of one shadow ray
-// each, averaged). Single lights are exact already. Each cluster's estimate
-// is unbiased given the cut, so the pixel is, and the mean over samples
-// converges to the exact image; except for clusters frozen out of a full
-// heap (lc_heap_push), which keep their fixed representative's estimate in
-// fixed_sum: a bias within their error bounds, absent where no cut fills
-// the heap (the stats count the frozen clusters).
+// with representatives drawn afresh from the sample's `stream`
+// (lc_cluster_fresh_estimate, f.light_samples draws of one shadow ray
+// each, averaged): the clusters left in the heap here, the clusters frozen
+// out of a full heap as they freeze (lc_heap_push). Single lights are exact
+// already. Each cluster's estimate is unbiased given the cut, so the pixel
+// is, and the mean over samples converges to the exact image.
 vec3 lc_shade_stochastic(SurfacePoint sp, FrameParams f, uint stream, LC_INOUT(ShadeStats) stats) {
     Material m = sp.mat;
     uint heap_size = 0u;
     vec3 result = vec3(0.0f);  // the cut's fixed_sum: single lights and frozen clusters
-    lc_select_cut(sp, m, f, heap_size, result, stats);
-    float weight = 1.0f / float(f.light_samples);
+    lc_select_cut(sp, m, f, heap_size, result, stats, stream, f.light_samples);
     for (uint i = 0u; i < heap_size; ++i)
-        for (uint d = 0u; d < f.light_samples; ++d)
-            result += lc_shade_cluster_stochastic(sp, lc_entry_node(LC_HEAP_LOAD(i)), f.min_distance2, stream, d, stats) *
-                      weight;
+        result += lc_cluster_fresh_estimate(sp, lc_entry_node(LC_HEAP_LOAD(i)), f.min_distance2, stream,
+                                            f.light_samples, stats);
     return result;
 }

@@ -217,8 +217,8 @@ void expect_cut_guarantee(const PreparedScene& p, const RenderOptions& o,
         Kernel::ShadeStats stats{};
         std::uint32_t heap_size = 0;
         glm::vec3 fixed_sum, heap_sum;
-        k.lc_cut_start(s.sp, m, f, heap_size, fixed_sum, heap_sum, stats);
-        while (k.lc_cut_refine(s.sp, m, f, heap_size, fixed_sum, heap_sum, stats)) {
+        k.lc_cut_start(s.sp, m, f, heap_size, fixed_sum, heap_sum, stats, 0u, 0u);
+        while (k.lc_cut_refine(s.sp, m, f, heap_size, fixed_sum, heap_sum, stats, 0u, 0u)) {
         }
         const double a = luminance(k.lc_cut_result(s.sp, f.min_distance2, heap_size, fixed_sum));
         double bounds = double(stats.frozen_error);
