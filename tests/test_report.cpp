@@ -207,11 +207,12 @@ TEST(Report, BufferTableListsTheKernelsArraysAndTheirTotal) {
     }
     EXPECT_EQ(buffers[7].bytes, 20u * sizeof(gpu::Light)) << "the 20 lights the tree keeps, not the 3 black ones";
     EXPECT_GT(buffers[8].bytes, 0u);
-    const std::string table = buffer_table({{"a", 512}, {"b", 2048}, {"c", 3u << 20}});
+    const std::string table = buffer_table({{"a", 512}, {"b", 2048}, {"c", 3u << 20}, {"d", 5ull << 29}});
     EXPECT_THAT(table, HasSubstr("a                  512 B\n"));
     EXPECT_THAT(table, HasSubstr("b                  2.0 KiB\n"));
     EXPECT_THAT(table, HasSubstr("c                  3.0 MiB\n"));
-    EXPECT_THAT(table, HasSubstr("total              3.0 MiB\n"));
+    EXPECT_THAT(table, HasSubstr("d                  2.50 GiB\n"));
+    EXPECT_THAT(table, HasSubstr("total              2.50 GiB\n"));
     EXPECT_GT(total, 0u);
 }
 

@@ -519,15 +519,16 @@ TEST(ObjTextures, PathsAreTheMtlsAndEachImageIsStoredOnce) {
 }
 
 // What an MTL asks for that is not done gets a note: a map's options but
-// -s, -o and -clamp, and maps the renderer has no use for (tinyobjloader
-// reads them all).
+// -s, -o and -clamp, maps the renderer has no use for (tinyobjloader reads
+// them all), and transparency (d below 1).
 TEST(ObjTextures, UnusedMapsAndOptionsAreNoted) {
     TexturedQuad quad;
     const Scene scene = quad.load("newmtl paint\nKd 1 1 1\nmap_Kd -colorspace linear paint.png\nmap_Bump paint.png\n"
-                                  "map_Ks paint.png\n");
+                                  "map_Ks paint.png\nd 0.5\n");
     const std::string obj = quad.obj();
     EXPECT_EQ(scene.load_notes,
-              (std::vector<std::string>{obj + ": material 'paint'.map_Bump is not used (a normal map is read from norm)",
+              (std::vector<std::string>{obj + ": material 'paint'.d (or Tr): transparency is not rendered, the surface is opaque",
+                                        obj + ": material 'paint'.map_Bump is not used (a normal map is read from norm)",
                                         obj + ": material 'paint'.map_Ks is not used",
                                         obj + ": material 'paint'.map_Kd: options other than -s, -o and -clamp are "
                                               "not applied (sRGB, bilinear)"}));

@@ -365,6 +365,9 @@ private:
             }
             set_texture(m, slot, sampled_texture(target_.scene, at->second, sampling));
         };
+        // tinyobjloader holds d, or 1 - Tr, as dissolve.
+        if (mtl.dissolve < 1.0)
+            note(where + "d (or Tr): transparency is not rendered, the surface is opaque");
         if (!mtl.bump_texname.empty()) note(where + "map_Bump is not used (a normal map is read from norm)");
         for (const auto& [name, key] : {std::pair{&mtl.specular_texname, "map_Ks"}, {&mtl.ambient_texname, "map_Ka"},
                                         {&mtl.specular_highlight_texname, "map_Ns"},
