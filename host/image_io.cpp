@@ -344,7 +344,7 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels, glm::ivec2* origi
         // coordinates the file gives (tinyexr takes any, negative ones too),
         // so each tile must lie on the grid inside the image and every pixel
         // must come from exactly one tile.
-        std::vector<std::uint8_t> covered(std::size_t(exr.width) * std::size_t(exr.height), 0);
+        std::vector<bool> covered(std::size_t(exr.width) * std::size_t(exr.height), false);
         std::uint64_t placed = 0;
         for (int t = 0; t < exr.num_tiles; ++t) {
             const EXRTile& tile = exr.tiles[t];
@@ -358,8 +358,9 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels, glm::ivec2* origi
             for (int y = 0; y < h; ++y) {
                 for (int x = 0; x < w; ++x) {
                     const std::size_t pixel = std::size_t(y0 + y) * image.width + std::size_t(x0 + x);
-                    if (covered[pixel]++ != 0)
+                    if (covered[pixel])
                         throw InputError(name, "tiles", "tile " + std::to_string(t) + " overlaps another tile");
+                    covered[pixel] = true;
                     ++placed;
                     const std::size_t from = std::size_t(y) * std::size_t(header.tile_size_x) + std::size_t(x);
                     for (int slot = 0; slot < 3; ++slot)

@@ -346,12 +346,7 @@ TEST(DisneyBounds, MirrorDirectionAtTheAlphaFloor) {
     std::vector<gpu::Material> materials(1);
     Kernel k;
     k.materials = materials.data();
-    loader::DisneyParams p;
-    p.base_color = glm::vec3(1.0f);
-    p.metallic = 1.0f;
-    p.roughness = 0.0f;
-    p.clearcoat = 1.0f;
-    p.clearcoat_gloss = 1.0f;
+    const loader::DisneyParams p = test::polished_metal();
     int checked = 0;
     for (int trial = 0; trial < 200000; ++trial) {
         materials[0] = loader::make_disney_material(p);

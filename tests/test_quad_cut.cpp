@@ -338,13 +338,7 @@ TEST(QuadCut, LightUnitsKeepOnlyFacetsFacingTheViewer) {
 #if defined(__SSE2__)
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    loader::DisneyParams metal;
-    metal.base_color = glm::vec3(1.0f);
-    metal.metallic = 1.0f;
-    metal.roughness = 0.0f;
-    metal.clearcoat = 1.0f;
-    metal.clearcoat_gloss = 1.0f;
-    const gpu::Material materials[2] = {loader::make_disney_material(metal),
+    const gpu::Material materials[2] = {loader::make_disney_material(test::polished_metal()),
                                         test::glossy(glm::vec3(0.2f), glm::vec3(1.0f), gpu::kMinGgxAlpha)};
     Kernel k;
     k.materials = materials;

@@ -170,7 +170,6 @@ inline gpu::Light oriented_light(glm::vec3 p, glm::vec3 normal, glm::vec3 intens
     return l;
 }
 
-// Adds a triangle with its face normal (or the given vertex normals).
 // Random Disney parameters; each lobe is switched off entirely in about a
 // quarter of the cases, so every combination of lobes occurs.
 inline loader::DisneyParams random_disney_params(std::mt19937& rng) {
@@ -187,6 +186,35 @@ inline loader::DisneyParams random_disney_params(std::mt19937& rng) {
     p.clearcoat = maybe(u(rng));
     p.clearcoat_gloss = u(rng);
     return p;
+}
+
+// The sharpest Disney material: white polished metal (roughness 0, the
+// GGX alpha floor) under a clearcoat of gloss 1, where the microfacet
+// peaks are highest.
+inline loader::DisneyParams polished_metal() {
+    loader::DisneyParams p;
+    p.base_color = glm::vec3(1.0f);
+    p.metallic = 1.0f;
+    p.roughness = 0.0f;
+    p.clearcoat = 1.0f;
+    p.clearcoat_gloss = 1.0f;
+    return p;
+}
+
+// Eight bright point lights at the corners of a box below room_scene's
+// ceiling and 65,536 dim ones inside it, each about 2^-27 of the bright
+// ones' sum at a point of the floor, below half a float step of a running
+// sum: a plain float sum rounds them away (5e-4 of the light).
+inline std::vector<gpu::Light> many_dim_lights() {
+    std::vector<gpu::Light> lights;
+    for (int c = 0; c < 8; ++c)
+        lights.push_back(point_light({c & 1 ? -0.3f : -0.7f, c & 2 ? 1.6f : 1.2f, c & 4 ? 0.9f : 0.5f}, glm::vec3(0.5f)));
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (int i = 0; i < 65536; ++i)
+        lights.push_back(
+            point_light({-0.7f + 0.4f * u(rng), 1.2f + 0.4f * u(rng), 0.5f + 0.4f * u(rng)}, glm::vec3(1.6e-8f)));
+    return lights;
 }
 
 // A uniformly distributed unit vector.

@@ -319,11 +319,11 @@ private:
     // albedo (base colour), map_Ke the emission (black or absent Ke counts
     // as 1 where there is a map_Ke), norm is a tangent-space normal map.
     // Paths are relative to the MTL's folder; each file is loaded once in a
-    // scene (MeshTarget::textures). A
-    // map's -s and -o scale and move its texture coordinates and -clamp on
-    // clamps them (sampled_texture); its other options (-t, -imfchan, -bm,
-    // -mm, -boost, -blendu, -blendv, -type, -texres, -colorspace) and the
-    // maps the renderer has no use for are read but not used, with a note.
+    // scene (MeshTarget::textures). A map's -s and -o scale and move its
+    // texture coordinates and -clamp on clamps them (sampled_texture); its
+    // other options (-t, -imfchan, -bm, -mm, -boost, -blendu, -blendv,
+    // -type, -texres, -colorspace) and the maps the renderer has no use for
+    // are read but not used, with a note.
     void add_textures(gpu::Material& m, const tinyobj::material_t& mtl, const std::filesystem::path& folder) {
         const std::string where = obj_name_ + ": material '" + mtl.name + "'.";
         const auto note = [&](const std::string& line) {

@@ -298,16 +298,7 @@ TEST_F(Vulkan, BruteMatchesCpuOnRandomScenes) {
 // (BruteForce.ManyDimLightsBesideBrightOnesAllCount) to the tolerance of
 // a sum the loop limit splits into ranges.
 TEST_F(Vulkan, BruteForceKeepsManyDimLightsBesideBrightOnes) {
-    std::vector<gpu::Light> lights;
-    for (int c = 0; c < 8; ++c)
-        lights.push_back(test::point_light({c & 1 ? -0.3f : -0.7f, c & 2 ? 1.6f : 1.2f, c & 4 ? 0.9f : 0.5f},
-                                           glm::vec3(0.5f)));
-    std::mt19937 rng(5);
-    std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    for (int i = 0; i < 65536; ++i)
-        lights.push_back(test::point_light({-0.7f + 0.4f * u(rng), 1.2f + 0.4f * u(rng), 0.5f + 0.4f * u(rng)},
-                                           glm::vec3(1.6e-8f)));
-    const PreparedScene p = prepare_scene(test::room_scene(std::move(lights), 4), 1);
+    const PreparedScene p = prepare_scene(test::room_scene(test::many_dim_lights(), 4), 1);
     const RenderOptions o = options("brute", 4, 4);
     expect_brute_matches(p, o, gpu(p, o), vulkan_test::kBruteSplitRelative);
 }
