@@ -60,3 +60,6 @@ PY
     done
   done
 done
+# The device the Vulkan renders ran on (VK_DRIVER_FILES picks it; lavapipe
+# unless the caller set another).
+python3 -c "import json, sys; print('Vulkan device:', json.load(open(sys.argv[1]))['device'])" "$tmp/vulkan.json"
