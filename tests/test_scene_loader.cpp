@@ -453,7 +453,8 @@ TEST(SceneLoader, MtllibLinesSplitAtAnyBlankAndRepeatNames) {
 }
 
 // A usemtl in an OBJ without any mtllib line says so (it said "not found in
-// .mtl", naming a file that was never asked for).
+// .mtl", naming a file that was never asked for), as does one before the
+// OBJ's first mtllib line.
 TEST(SceneLoader, UsemtlWithoutMtllibSaysSo) {
     TempDir dir;
     dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl foo\nf 1 2 3\n");
@@ -462,6 +463,13 @@ TEST(SceneLoader, UsemtlWithoutMtllibSaysSo) {
     EXPECT_EQ(input_error_of([&] { load_scene(scene); }),
               (dir.path() / "m.obj").lexically_normal().string() +
                   ": usemtl: tinyobjloader: material [ 'foo' ] not found: the OBJ has no mtllib line");
+    // ... and one before the mtllib line that would define it says that.
+    dir.write("m.mtl", "newmtl foo\nKd 0.5 0.5 0.5\n");
+    dir.write("m.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl foo\nf 1 2 3\nmtllib m.mtl\n");
+    EXPECT_EQ(input_error_of([&] { load_scene(scene); }),
+              (dir.path() / "m.obj").lexically_normal().string() +
+                  ": usemtl: tinyobjloader: material [ 'foo' ] not found in .mtl (line 4's usemtl comes before "
+                  "line 6's mtllib, which reads the library)");
 }
 
 // A `mtllib` line needs one of its files to exist (the others are read

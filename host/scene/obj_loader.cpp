@@ -206,14 +206,26 @@ private:
 
 // tinyobj treats an unknown usemtl name as a warning and falls back to "no
 // material"; silently grey walls are worse than an error. `libraries`:
-// whether the OBJ has a mtllib line at all.
-void check_usemtl_warnings(const std::string& warning, const std::string& obj_name, bool libraries) {
+// whether the OBJ has a mtllib line at all; `obj`, its text, says whether
+// a usemtl line comes before the first of them (tinyobjloader reads a
+// library where its line is, so a material named earlier is not found).
+void check_usemtl_warnings(const std::string& warning, const std::string& obj_name, bool libraries,
+                           std::string_view obj) {
     if (const auto at = warning.find("not found in .mtl"); at != std::string::npos) {
         const auto begin = warning.rfind('\n', at);
         const auto from = begin == std::string::npos ? 0 : begin + 1;
+        std::size_t first_usemtl = 0, first_mtllib = 0;
+        for_each_line(obj, [&](const Line& line) {
+            if (line.words[0] == "usemtl" && first_usemtl == 0) first_usemtl = line.number;
+            if (line.words[0] == "mtllib" && first_mtllib == 0) first_mtllib = line.number;
+        });
+        const std::string order = first_usemtl != 0 && first_usemtl < first_mtllib
+                                      ? " (line " + std::to_string(first_usemtl) + "'s usemtl comes before line " +
+                                            std::to_string(first_mtllib) + "'s mtllib, which reads the library)"
+                                      : "";
         throw InputError(obj_name, "usemtl",
                          "tinyobjloader: " + warning.substr(from, at - from) +
-                             (libraries ? "not found in .mtl" : "not found: the OBJ has no mtllib line"));
+                             (libraries ? "not found in .mtl" + order : "not found: the OBJ has no mtllib line"));
     }
 }
 
@@ -236,7 +248,7 @@ void read_obj(const std::filesystem::path& file, const std::string& obj_name, bo
         while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
         throw InputError(obj_name, "", "tinyobjloader: " + (err.empty() ? "parse failed" : err));
     }
-    if (uses_mtl) check_usemtl_warnings(warning, obj_name, libraries.any());
+    if (uses_mtl) check_usemtl_warnings(warning, obj_name, libraries.any(), text);
     for (std::size_t at = warning.find("Degenerated face found"); at != std::string::npos;
          at = warning.find("Degenerated face found", at + 1))
         ++obj.short_faces;
