@@ -30,7 +30,7 @@
    have no octets.
 
 Writes DIR/speed.md and DIR/speed.json (default out/speed). Nothing here
-passes or fails. --quick: 32x32, two scenes (CI's bench label runs it);
+passes or fails. --quick: 32x32 (unless --size says otherwise), two scenes (CI's bench label runs it);
 --vulkan-only: part 3 alone.
 """
 import argparse
@@ -103,7 +103,7 @@ def main():
     global EXE
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "speed"))
-    ap.add_argument("--size", type=int, default=128)
+    ap.add_argument("--size", type=int, default=None, help="image width and height (default 128; 32 with --quick)")
     ap.add_argument("--heaps", default="8,16,32,64")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--no-vulkan", action="store_true")
@@ -115,7 +115,11 @@ def main():
     EXE = a.exe
     if a.brute_runs is None:
         a.brute_runs = 1 if a.quick else 3
-    size = 32 if a.quick else a.size
+    if a.size is None:
+        a.size = 32 if a.quick else 128
+    if a.size < 1:
+        sys.exit("speed: --size takes a positive whole number, not %d" % a.size)
+    size = a.size
     scenes = SCENES[:1] + SCENES[3:4] if a.quick else SCENES
     try:
         heaps = [int(k) for k in a.heaps.split(",")]

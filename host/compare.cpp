@@ -23,9 +23,9 @@ double luminance_d(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.07
 //    all zero but the image is not, 0 when both are all zero.
 //  - A pixel whose error is NaN counts as above every threshold, and then
 //    max_relative_error is NaN as well.
-//  - The per-pixel denominator floor is 1e-3 * mean Y(r); when that mean is
-//    not a positive finite number (an all-black or non-finite reference) the
-//    floor is 1e-30, so black reference pixels give huge errors, not NaN.
+//  - The per-pixel denominator floor is 1e-3 * |mean Y(r)|; when that mean
+//    is zero or not finite (an all-black or non-finite reference) the floor
+//    is 1e-30, so black reference pixels give huge errors, not NaN.
 CompareResult compare_images(const Image& image, const Image& reference) {
     if (image.width != reference.width || image.height != reference.height)
         throw std::invalid_argument("compare_images: sizes differ (" + std::to_string(image.width) + "x" +
@@ -52,7 +52,10 @@ CompareResult compare_images(const Image& image, const Image& reference) {
         result.relative_rmse = std::sqrt(sum_diff2 / sum_ref2);
 
     const double mean_lum = pixels ? sum_ref_lum / double(pixels) : 0.0;
-    const double lum_floor = (mean_lum > 0.0 && std::isfinite(mean_lum)) ? 1e-3 * mean_lum : 1e-30;
+    // The magnitude: a negative reference (an EXR from elsewhere) floors
+    // its pixels at its own scale, not at 1e-30.
+    const double lum_floor =
+        (mean_lum != 0.0 && std::isfinite(mean_lum)) ? 1e-3 * std::abs(mean_lum) : 1e-30;
 
     result.per_pixel.resize(pixels);
     double sum_image_lum = 0.0;

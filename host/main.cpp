@@ -92,35 +92,46 @@ lc::RenderOptions render_options(const RenderArgs& a, const lc::Scene& scene) {
     return o;
 }
 
-// The options given on the command line that the method does not use, as
-// one note ("" if none): a render that ignores what it was told says so.
+// The options given on the command line that the render does not use, as
+// one note ("" if none): a render that ignores what it was told says so,
+// and why: the method, or (the VPLs' settings) that it makes no VPLs.
 std::string unused_options_note(const RenderArgs& a, const std::string& method, bool vpls) {
     const bool cuts = method == "lightcuts" || method == "stochastic";
+    const bool path = method == "path";
     const struct {
-        bool given, used;
+        bool given, used_by_method;
         const char* name;
+        bool needs_vpls;
     } options[] = {
-        {a.relative_error.has_value(), cuts, "--error"},
-        {a.max_cut.has_value(), cuts, "--max-cut"},
-        {a.cut_heap.has_value(), cuts, "--cut-heap"},
-        {!a.cut_sharing.empty(), method == "lightcuts", "--cut-sharing"},
-        {a.light_samples.has_value(), method == "sampled" || method == "stochastic" || method == "path",
-         "--light-samples"},
-        {!a.light_pick.empty(), method == "sampled", "--light-pick"},
-        {a.max_bounces.has_value(), method == "path", "--max-bounces"},
-        {a.time_limit.has_value(), method == "path", "--time-limit"},
-        {a.area_samples.has_value(), method != "path", "--area-samples"},
-        {a.vpls.has_value(), method != "path", "--vpls"},
-        {a.vpl_bounces.has_value(), method != "path" && vpls, "--vpl-bounces"},
-        {a.vpl_clamp.has_value(), method != "path" && vpls, "--vpl-clamp"},
+        {a.relative_error.has_value(), cuts, "--error", false},
+        {a.max_cut.has_value(), cuts, "--max-cut", false},
+        {a.cut_heap.has_value(), cuts, "--cut-heap", false},
+        {!a.cut_sharing.empty(), method == "lightcuts", "--cut-sharing", false},
+        {a.light_samples.has_value(), method == "sampled" || method == "stochastic" || path, "--light-samples",
+         false},
+        {!a.light_pick.empty(), method == "sampled", "--light-pick", false},
+        {a.max_bounces.has_value(), path, "--max-bounces", false},
+        {a.time_limit.has_value(), path, "--time-limit", false},
+        {a.area_samples.has_value(), !path, "--area-samples", false},
+        {a.vpls.has_value(), !path, "--vpls", false},
+        {a.vpl_bounces.has_value(), !path, "--vpl-bounces", true},
+        {a.vpl_clamp.has_value(), !path, "--vpl-clamp", true},
     };
-    std::string unused;
-    for (const auto& o : options)
-        if (o.given && !o.used) unused += std::string(unused.empty() ? "" : ", ") + o.name;
-    if (unused.empty()) return "";
-    if (method != "path" && !vpls && (a.vpl_bounces || a.vpl_clamp))
-        return "this render makes no VPLs (no --vpls, nor render.indirect.vpls): it does not use " + unused;
-    return "method " + method + " does not use " + unused;
+    std::string by_method, by_vpls;
+    const auto add = [](std::string& list, const char* name) { list += (list.empty() ? "" : ", ") + std::string(name); };
+    for (const auto& o : options) {
+        if (!o.given) continue;
+        if (!o.used_by_method)
+            add(by_method, o.name);
+        else if (o.needs_vpls && !vpls)
+            add(by_vpls, o.name);
+    }
+    std::string note;
+    if (!by_method.empty()) note = "method " + method + " does not use " + by_method;
+    if (!by_vpls.empty())
+        note += (note.empty() ? "" : "; ") + std::string("this render makes no VPLs (") +
+                (a.vpls ? "--vpls 0" : "no --vpls, nor render.indirect.vpls") + "): it does not use " + by_vpls;
+    return note;
 }
 
 // What the loader dropped or left out, on stderr before anything else.
@@ -171,13 +182,14 @@ int run_render(RenderArgs a) {
     if (a.vpl_clamp) scene.render.indirect.clamp = *a.vpl_clamp;
     drop_what_the_method_does_not_use(scene, options.method);
     lc::validate_render_options(options);
-    if (const std::string note = unused_options_note(a, options.method, scene.render.indirect.vpls > 0);
-        !note.empty())
-        std::fprintf(stderr, "note: %s\n", note.c_str());
     if (const std::string problem = lc::vulkan_options_problem(a.device, options.method); !problem.empty())
         throw std::invalid_argument(problem);
     // Every output is checked and reserved before the render; none is left if any fails.
     lc::OutputSet outputs = lc::reserve_render_outputs(a.outputs, a.scene, options.method, scene.input_files);
+    // After the checks, so that a refused command reads as one error.
+    if (const std::string note = unused_options_note(a, options.method, scene.render.indirect.vpls > 0);
+        !note.empty())
+        std::fprintf(stderr, "note: %s\n", note.c_str());
 
     const lc::PreparedScene prepared = lc::prepare_scene(std::move(scene), options.seed, options.threads);
     a.device.note = [](const std::string& line) { std::fprintf(stderr, "note: %s\n", line.c_str()); };
@@ -283,10 +295,20 @@ int run_info(const std::string& file, const lc::SceneOptions& options, const Inf
     const std::uint32_t seed = a.seed.value_or(scene.render.seed);
     const std::string method = a.method.empty() ? scene.render.method : a.method;
     drop_what_the_method_does_not_use(scene, method);
+    RenderArgs as_render;  // the note render would print for these options
+    as_render.area_samples = a.area_samples;
+    as_render.vpls = a.vpls;
+    as_render.vpl_bounces = a.vpl_bounces;
+    if (const std::string note = unused_options_note(as_render, method, scene.render.indirect.vpls > 0);
+        !note.empty())
+        std::fprintf(stderr, "note: %s\n", note.c_str());
+    std::size_t emissive = 0;
+    for (const lc::gpu::Triangle& t : scene.triangles)
+        emissive += (scene.materials[t.material].flags & lc::gpu::kMaterialEmissive) != 0;
     std::printf("%s\n", file.c_str());
     std::printf("  method             %s\n", method.c_str());
-    std::printf("  triangles          %zu (%zu degenerate dropped)\n", scene.triangles.size(),
-                scene.degenerate_triangles_dropped);
+    std::printf("  triangles          %zu (%zu emissive, %zu degenerate dropped)\n", scene.triangles.size(),
+                emissive, scene.degenerate_triangles_dropped);
     std::printf("  materials          %zu\n", scene.materials.size());
     std::printf("  textures           %zu (%zu texels)\n", scene.textures.size(), scene.texels.size());
     std::printf("  point lights       %zu\n", scene.count_lights(lc::gpu::kLightPoint));
@@ -379,7 +401,7 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
                        "path: surface interactions per path (1 = direct light only; 0 = unlimited, the default)")
         ->transform(setting(lc::kSettingMaxBounces));
     render->add_option("--time-limit", r.time_limit,
-                       "path: stop after the sample pass that ends past this many seconds (0 = none)")
+                       "path: end the render near this many seconds, with the samples done by then (0 = none)")
         ->transform(setting(lc::kSettingTimeLimit));
     render->add_option("--seed", r.seed, "Seed for pixel jitter, light-tree representatives and light samples")
         ->transform(setting(lc::kSettingSeed));
@@ -400,6 +422,11 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& r) {
 }
 
 }  // namespace
+
+// The exit status: 0 done, 1 an error in the input or the work (the
+// message names the file and the field), 2 a command line that does not
+// parse (CLI11's own codes, 105 to 114, told its kinds apart for nobody).
+constexpr int kUsageError = 2;
 
 int main(int argc, char** argv) {
     CLI::App app{"lightcuts: many-light rendering with Lightcuts on the CPU and Vulkan compute"};
@@ -445,7 +472,7 @@ int main(int argc, char** argv) {
             std::string names;
             for (const CLI::App* c : commands) names += (names.empty() ? "" : ", ") + c->get_name();
             std::fprintf(stderr, "error: unknown command '%s' (the commands are %s)\n", argv[1], names.c_str());
-            return 1;
+            return kUsageError;
         }
     }
     try {
@@ -461,26 +488,41 @@ int main(int argc, char** argv) {
         if (dynamic_cast<const CLI::RequiredError*>(&e) != nullptr ||
             dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr) {
             const CLI::App* command = nullptr;
+            // An option is a word of a dash and a letter or of two dashes;
+            // "-1" and "-.5" are (refused) values.
+            const auto is_option = [](const std::string& word) {
+                return word.size() > 1 && word[0] == '-' && word != "--" &&
+                       !(std::isdigit(static_cast<unsigned char>(word[1])) || word[1] == '.');
+            };
             for (int i = 1; i < argc; ++i) {
                 const std::string word = argv[i];
-                if (command == nullptr && word.rfind("--", 0) != 0) {
+                if (command == nullptr && !is_option(word)) {
                     for (const CLI::App* c : app.get_subcommands([](CLI::App*) { return true; }))
                         if (c->check_name(word)) command = c;
                     continue;
                 }
-                if (word.rfind("--", 0) != 0 || word == "--") continue;
+                if (!is_option(word)) continue;
                 const std::string name = word.substr(0, word.find('='));
                 const CLI::App* in = command != nullptr ? command : &app;
                 if (in->get_option_no_throw(name) == nullptr && app.get_option_no_throw(name) == nullptr) {
                     std::fprintf(stderr, "error: unknown option %s%s\nRun with --help for more information.\n",
                                  name.c_str(),
                                  command == nullptr ? " (a command comes first: render, compare or info)" : "");
-                    return e.get_exit_code();
+                    return kUsageError;
                 }
             }
         }
+        // An option given twice: CLI11 says "--spp: At Most 1 required but received 2".
+        if (dynamic_cast<const CLI::ArgumentMismatch*>(&e) != nullptr) {
+            const std::string what = e.what();
+            if (const std::size_t colon = what.find(": At Most 1 required"); colon != std::string::npos) {
+                std::fprintf(stderr, "error: %s is given more than once\nRun with --help for more information.\n",
+                             what.substr(0, colon).c_str());
+                return kUsageError;
+            }
+        }
         std::fprintf(stderr, "error: %s\nRun with --help for more information.\n", e.what());
-        return e.get_exit_code();
+        return kUsageError;
     }
     // Ctrl-C or a kill during a render leaves no temporary beside its outputs.
     lc::remove_temporaries_on_signal();

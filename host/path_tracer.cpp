@@ -356,6 +356,17 @@ glm::vec3 PathTracer::environment_sample(Kernel& k, const SurfacePoint& sp, glm:
     return f * sky * (weight / light_pdf);
 }
 
+std::uint32_t next_pass_samples(std::uint32_t done, std::uint32_t spp, double time_limit, double elapsed,
+                                double seconds_per_sample) {
+    if (done >= spp) return 0;
+    const std::uint32_t doubling = std::min(std::max(done, 1u), spp - done);
+    if (!(time_limit > 0.0) || done == 0) return doubling;
+    // NaN (no time left and no time measured) and negative counts stop too.
+    const double fits = (time_limit - elapsed) / seconds_per_sample;
+    if (!(fits >= 1.0)) return 0;
+    return fits >= double(doubling) ? doubling : std::uint32_t(fits);
+}
+
 }  // namespace lc::path
 
 // ---- render_path: the image in passes of samples ----
@@ -424,11 +435,14 @@ RenderResult render_path(const PreparedScene& prepared, const RenderOptions& opt
     const SampleOrder order(spp);
     Progress progress(options.progress);
 
-    // Passes of 1, 1, 2, 4, ... samples per pixel: each doubles what is
-    // done, so a time limit is overrun by at most the time taken so far.
+    // The passes end near a time limit instead of overrunning it by up to
+    // the time already taken, as doubling passes alone would.
     std::uint32_t done = 0;
-    while (done < spp) {
-        const std::uint32_t end = done + std::min(std::max(done, 1u), spp - done);
+    double seconds_per_sample = 0.0;  // a sample a pixel, measured on the last pass
+    while (const std::uint32_t take =
+               path::next_pass_samples(done, spp, options.time_limit, elapsed(), seconds_per_sample)) {
+        const std::uint32_t end = done + take;
+        const double pass_start = elapsed();
         std::atomic<std::uint32_t> tiles_done{0};
         for_each_tile(tile_count, workers, [&](std::uint32_t tile, Worker& w) {
             const std::uint32_t x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
@@ -446,8 +460,8 @@ RenderResult render_path(const PreparedScene& prepared, const RenderOptions& opt
             if (options.time_limit > 0.0) fraction = std::max(fraction, elapsed() / options.time_limit);
             progress.update(std::min(fraction, 1.0));
         });
+        seconds_per_sample = (elapsed() - pass_start) / double(take);
         done = end;
-        if (options.time_limit > 0.0 && elapsed() >= options.time_limit) break;
     }
     progress.finish();
 

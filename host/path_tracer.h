@@ -59,6 +59,15 @@ float bsdf_pdf(Kernel& k, const gpu::Material& m, const LobeWeights& lobes, glm:
 // weight of the technique with density `pdf` against the other's `other`.
 float power_heuristic(float pdf, float other);
 
+// Samples a pixel the next pass takes, `done` of `spp` done: passes of 1,
+// 1, 2, 4, ... (each doubling what is done), and under a time limit
+// (`time_limit` > 0 seconds, `elapsed` of them gone) no more than the time
+// left holds at `seconds_per_sample` (a sample a pixel, as the last pass
+// took). 0 means stop: all done, or not one more sample fits. The first
+// pass always takes one.
+std::uint32_t next_pass_samples(std::uint32_t done, std::uint32_t spp, double time_limit, double elapsed,
+                                double seconds_per_sample);
+
 // The rays a path tracer's samples cast: shadow rays (next-event
 // estimation) and the rays that continue paths after a bounce.
 struct PathRays {

@@ -236,6 +236,7 @@ std::string report_text(const RenderReport& r) {
         const std::string split =
             along <= 1                   ? std::string()
             : r.spp % camera_rays == 0u ? format(" (%u along each camera ray)", done)
+            : done == 0u                ? format(" (one along each of %u of the %u camera rays)", r.spp, camera_rays)
                                         : format(" (%u or %u along each of %u camera rays)", done, done + 1, camera_rays);
         text += format("  %u path(s) per pixel%s, %s\n", r.spp, split.c_str(),
                        r.max_bounces ? format("at most %u bounce(s)", r.max_bounces).c_str()

@@ -40,8 +40,16 @@ std::string setting_problem(std::string_view key, double value) {
     if (key == kSettingMaxBounces) return integer_problem(value, 0, kMaxBounces);
     if (key == kSettingThreads) return integer_problem(value, 0, kMaxThreads);
     if (key == kSettingTimeLimit || key == kSettingClamp) {
-        if (!(value >= 0.0 && value <= double(std::numeric_limits<float>::max())))
+        // Up to the largest float: the clamp is held as one. What rounds to
+        // it is taken (the stats JSON writes it as 3.4028235e+38, which
+        // reads back so), what rounds to infinity is not, nor a positive
+        // clamp that rounds to 0, which means "none".
+        constexpr double kLargest = double(std::numeric_limits<float>::max());
+        constexpr double kRoundsToInfinity = kLargest + 0x1p103;  // half the float step there
+        if (!(value >= 0.0 && value < kRoundsToInfinity))
             return "must be a number from 0 to 3.4e38 (the largest float)";
+        if (key == kSettingClamp && value > 0.0 && static_cast<float>(value) == 0.0f)
+            return "must be 0 (none) or at least 1.4e-45 (the smallest float)";
         return "";
     }
     if (key == kSettingRelativeError) {

@@ -260,7 +260,55 @@ grep -qx "note: method brute does not use --error, --light-pick, --time-limit" "
   --vpl-bounces 2 >/dev/null 2>"$tmp/unused.txt" || fail "unused VPL options: $(cat "$tmp/unused.txt")"
 grep -qx "note: this render makes no VPLs (no --vpls, nor render.indirect.vpls): it does not use --vpl-bounces" \
   "$tmp/unused.txt" || fail "unused VPL options said: $(cat "$tmp/unused.txt")"
-# The command line's own errors read as the others do.
+# Unused for the method and unused for want of VPLs are told apart; a
+# refused command prints its error alone, not the note before it.
+"$exe" render "$mini" -o "$tmp/unused.exr" --no-png --device cpu --width 2 --height 2 --method lightcuts \
+  --vpls 0 --vpl-bounces 2 --light-pick power >/dev/null 2>"$tmp/unused.txt" ||
+  fail "unused options: $(cat "$tmp/unused.txt")"
+grep -qx "note: method lightcuts does not use --light-pick; this render makes no VPLs (--vpls 0): it does not use --vpl-bounces" \
+  "$tmp/unused.txt" || fail "unused options for two reasons said: $(cat "$tmp/unused.txt")"
+"$exe" render "$mini" -o "$tmp/unused.exr" --method brute --error 0.1 --cut-heatmap "$tmp/unused_cuts.png" \
+  >/dev/null 2>"$tmp/unused.txt" && fail "--cut-heatmap with brute force was accepted"
+[ "$(wc -l <"$tmp/unused.txt")" = 1 ] && grep -q "^error: " "$tmp/unused.txt" ||
+  fail "a refused render with an unused option said: $(cat "$tmp/unused.txt")"
+# info names the options its method leaves unused, and the emissive
+# triangles the path tracer samples.
+"$exe" info "$gltf/emissive_only.gltf" --method path --vpls 100 >"$tmp/info_path.txt" 2>"$tmp/unused.txt" ||
+  fail "info --method path: $(cat "$tmp/unused.txt")"
+grep -qx "note: method path does not use --vpls" "$tmp/unused.txt" || fail "info's unused note: $(cat "$tmp/unused.txt")"
+grep -Eq "^  triangles +[0-9]+ \([1-9][0-9]* emissive," "$tmp/info_path.txt" ||
+  fail "info does not count the emissive triangles: $(grep triangles "$tmp/info_path.txt")"
+rm -f "$tmp"/unused* "$tmp/info_path.txt"
+# --no-png writes the image and no preview.
+"$exe" render "$mini" -o "$tmp/nopng.exr" --no-png --device cpu --width 2 --height 2 >/dev/null 2>&1 ||
+  fail "--no-png render failed"
+[ -s "$tmp/nopng.exr" ] && [ ! -e "$tmp/nopng.png" ] || fail "--no-png: $(ls "$tmp"/nopng*)"
+rm -f "$tmp"/nopng*
+# The path tracer under a time limit shorter than a pass: one path a pixel,
+# said in the report and in the stats.
+"$exe" render "$mini" -o "$tmp/tl.exr" --no-png --device cpu --width 4 --height 4 --method path --spp 64 \
+  --time-limit 1e-9 --stats "$tmp/tl.json" >"$tmp/tl.txt" 2>&1 || fail "path with a time limit: $(cat "$tmp/tl.txt")"
+grep -q "stopped at the time limit after 1 of 64 spp" "$tmp/tl.txt" && grep -Eq '"spp": 1,?$' "$tmp/tl.json" &&
+  grep -Eq '"spp_requested": 64,?$' "$tmp/tl.json" || fail "path stopped at its time limit: $(cat "$tmp/tl.txt")"
+rm -f "$tmp"/tl.*
+# compare refuses images of two sizes, naming both.
+"$exe" render "$mini" -o "$tmp/small.exr" --no-png --device cpu --width 2 --height 3 >/dev/null 2>&1 ||
+  fail "2x3 render failed"
+expect_error "small.exr: size 2x3 differs from the reference's 24x16" compare "$tmp/small.exr" "$tmp/a.exr"
+rm -f "$tmp/small.exr"
+# The command line's own errors read as the others do, and exit with 2
+# (an error in the input or the render exits with 1).
+status=0; "$exe" render "$mini" -o "$tmp/edge2.exr" --spp 2 --spp 3 >"$tmp/err.txt" 2>&1 || status=$?
+[ "$status" = 2 ] && grep -qx "error: --spp is given more than once" "$tmp/err.txt" ||
+  fail "an option given twice: status $status, $(cat "$tmp/err.txt")"
+status=0; "$exe" render "$mini" -o "$tmp/edge2.exr" -s 4 >"$tmp/err.txt" 2>&1 || status=$?
+[ "$status" = 2 ] && grep -qx "error: unknown option -s" "$tmp/err.txt" ||
+  fail "an unknown short option: status $status, $(cat "$tmp/err.txt")"
+status=0; "$exe" render "$mini" -o "$tmp/edge2.exr" --width 0 >/dev/null 2>&1 || status=$?
+[ "$status" = 2 ] || fail "a value out of range exited with $status, not 2"
+status=0; "$exe" render "$tmp/missing.json" -o "$tmp/edge2.exr" >/dev/null 2>&1 || status=$?
+[ "$status" = 1 ] || fail "a missing scene exited with $status, not 1"
+
 expect_error "error: unknown command 'frobnicate' (the commands are render, compare, info)" frobnicate "$mini"
 # An unknown option is named before a missing command or argument.
 expect_error "error: unknown option --bogus (a command comes first: render, compare or info)" --bogus

@@ -479,6 +479,9 @@ TEST(CompareImages, DarkReferencePixelsUseTheMeanFloor) {
     const lc::CompareResult r = lc::compare_images(image, reference);
     EXPECT_NEAR(r.per_pixel[3], 0.0015 / (1e-3 * 0.75), 1e-5);
     EXPECT_DOUBLE_EQ(r.fraction_above_5pct, 0.25);
+    // A negative reference floors at its magnitude (it was 1e-30: errors of 1e30).
+    const lc::Image negative = gray(2, 2, -1.0f);
+    EXPECT_NEAR(lc::compare_images(gray(2, 2, 1.0f), negative).max_relative_error, 2.0 / 1e-3, 1e-6);
 }
 
 TEST(CompareImages, ZeroAndNonFiniteImagesDoNotCrash) {

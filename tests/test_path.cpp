@@ -605,5 +605,29 @@ TEST(PathRender, TimeLimitStopsAfterAPass) {
     EXPECT_THROW(render_path(p, o), std::invalid_argument);
 }
 
+// The passes' sizes: doubling without a limit; under one, what the time
+// left holds at the last pass's rate, and none once one sample a pixel
+// does not fit (the doubling passes alone overran a limit by up to the
+// time taken before it: 1.48 s at a limit of 0.70).
+TEST(PathRender, PassesFitTheTimeLeft) {
+    using path::next_pass_samples;
+    EXPECT_EQ(next_pass_samples(0, 64, 0.0, 0.0, 0.0), 1u);
+    EXPECT_EQ(next_pass_samples(1, 64, 0.0, 5.0, 1.0), 1u);
+    EXPECT_EQ(next_pass_samples(16, 64, 0.0, 5.0, 1.0), 16u);
+    EXPECT_EQ(next_pass_samples(40, 64, 0.0, 5.0, 1.0), 24u);
+    EXPECT_EQ(next_pass_samples(64, 64, 0.0, 5.0, 1.0), 0u);
+    // The first sample a pixel is taken whatever the limit.
+    EXPECT_EQ(next_pass_samples(0, 64, 1e-9, 1.0, 0.0), 1u);
+    // 16 done at 0.1 s a sample, 1 s of a 2 s limit left: 10 more, not 16.
+    EXPECT_EQ(next_pass_samples(16, 64, 2.0, 1.0, 0.1), 10u);
+    EXPECT_EQ(next_pass_samples(16, 64, 2.0, 1.0, 0.01), 16u);
+    // Less than a sample's time left, none left, or past the limit: stop.
+    EXPECT_EQ(next_pass_samples(16, 64, 2.0, 1.95, 0.1), 0u);
+    EXPECT_EQ(next_pass_samples(16, 64, 2.0, 2.0, 0.0), 0u);
+    EXPECT_EQ(next_pass_samples(16, 64, 2.0, 3.0, 0.1), 0u);
+    // A pass too quick for the clock: the doubling pass.
+    EXPECT_EQ(next_pass_samples(16, 64, 2.0, 1.0, 0.0), 16u);
+}
+
 }  // namespace
 }  // namespace lc

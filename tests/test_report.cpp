@@ -140,6 +140,11 @@ TEST(Report, StochasticMethodsReportTheirSampling) {
     report.spp_requested = 8;  // two camera rays of 4 paths each, stopped after 5 paths
     report.spp = 5;
     EXPECT_THAT(report_text(report), HasSubstr("5 path(s) per pixel (2 or 3 along each of 2 camera rays)"));
+    // Stopped before every camera ray had a path (before: "0 or 1 along each").
+    report.spp_requested = 4096 * 16;  // 4096 camera rays of 16 paths
+    report.sampling->light_samples = 16;
+    report.spp = 1;
+    EXPECT_THAT(report_text(report), HasSubstr("1 path(s) per pixel (one along each of 1 of the 4096 camera rays)"));
 }
 
 TEST(Report, BruteForceHasNoLightcutsPart) {

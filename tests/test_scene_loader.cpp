@@ -1142,6 +1142,27 @@ TEST(SceneLoader, TimeLimitAndClampPastTheFloatRangeNameTheLimit) {
     }
 }
 
+// The largest float as the stats JSON spells it (3.4028235e+38, a little
+// above FLT_MAX as a double) reads back; a positive clamp that a float
+// rounds to 0, which would mean "none", is refused.
+TEST(SceneLoader, TimeLimitAndClampRoundTripTheirFloats) {
+    TempDir dir;
+    const Scene scene = load_scene(
+        scene_with_render(dir, R"({"time_limit": 3.4028235e+38, "indirect": {"clamp": 3.4028235e38}})"));
+    EXPECT_EQ(scene.render.time_limit, 3.4028235e38);
+    EXPECT_EQ(scene.render.indirect.clamp, std::numeric_limits<float>::max());
+    const fs::path file = scene_with_render(dir, R"({"indirect": {"clamp": 1e-46}})");
+    EXPECT_EQ(input_error_of([&] { load_scene(file); }),
+              file.lexically_normal().string() +
+                  ": render.indirect.clamp: must be 0 (none) or at least 1.4e-45 (the smallest float)");
+    // Halfway between the largest float and the next power of two rounds
+    // to infinity (ties to even); the double below it to the largest float.
+    const double halfway = double(std::numeric_limits<float>::max()) + 0x1p103;
+    EXPECT_EQ(static_cast<float>(std::nextafter(halfway, 0.0)), std::numeric_limits<float>::max());
+    EXPECT_EQ(setting_problem(kSettingClamp, std::nextafter(halfway, 0.0)), "");
+    EXPECT_NE(setting_problem(kSettingClamp, halfway), "");
+}
+
 TEST(SceneLoader, RenderSettingsAcceptTheFullRange) {
     TempDir dir;
     const Scene scene = load_scene(scene_with_render(

@@ -82,7 +82,7 @@ struct RenderOptions {
     std::uint32_t light_samples = 1;  // sampled: lights per camera sample; stochastic: draws per cluster
     std::string light_pick = "tree";  // sampled: "tree", "uniform" or "power"
     std::uint32_t max_bounces = 0;    // path: surface interactions per path; 0 = unlimited (roulette)
-    double time_limit = 0.0;          // path: stop after the sample pass that passes this many
+    double time_limit = 0.0;          // path: end near this many
                                       // seconds, with the samples done so far; 0 = no limit
     unsigned threads = 0;             // CPU: 0 = all cores
     bool progress = false;            // show percentage and ETA on stderr

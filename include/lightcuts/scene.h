@@ -47,7 +47,7 @@ struct RenderSettings {
     std::uint32_t area_light_samples = 65536;
     IndirectSettings indirect;
     std::uint32_t max_bounces = 0;  // path: surface interactions per path; 0: unlimited (roulette)
-    double time_limit = 0.0;        // path: seconds, then stop after the current sample pass; 0: none
+    double time_limit = 0.0;        // path: seconds, the sample passes sized to end near it; 0: none
 };
 
 // An environment: lat-long RGB radiance, +Y up (docs/scene-format.md). A
