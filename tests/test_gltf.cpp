@@ -12,6 +12,7 @@
 #include <sys/stat.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "gltf_room.h"
 #include "lightcuts/error.h"
@@ -293,6 +294,39 @@ TEST(Gltf, UnusedImagesAreNotDecoded) {
     EXPECT_EQ(s.textures.size(), 1u);
 }
 
+// materials.gltf with a WebP image its texture offers through
+// EXT_texture_webp, its PNG the fallback, as the extension's example does.
+nlohmann::json with_webp_offered(const fs::path& folder) {
+    std::ifstream in(kData / "materials.gltf", std::ios::binary);
+    nlohmann::json doc = nlohmann::json::parse(in);
+    for (const nlohmann::json& image : doc["images"])
+        if (image.contains("uri") && !image["uri"].get<std::string>().starts_with("data:"))
+            fs::copy_file(kData / image["uri"].get<std::string>(), folder / image["uri"].get<std::string>());
+    std::ofstream(folder / "t.webp", std::ios::binary) << "RIFF\x1a\0\0\0WEBPVP8 ";
+    doc["images"].push_back({{"uri", "t.webp"}});
+    doc["textures"][0]["extensions"]["EXT_texture_webp"] = {{"source", doc["images"].size() - 1}};
+    doc["extensionsUsed"].push_back("EXT_texture_webp");
+    return doc;
+}
+
+// An image no material reads need not be PNG or JPEG: a file offering WebP
+// with a PNG fallback loads, its texture the PNG's. Where the file requires
+// the extension, that is what the error names (it named the WebP image).
+TEST(Gltf, AnOfferedWebpImageFallsBackToItsPng) {
+    test::TempDir dir;
+    nlohmann::json doc = with_webp_offered(dir.path());
+    const fs::path used = dir.write("used.gltf", doc.dump());
+    const Scene s = load_scene(used);
+    EXPECT_EQ(s.textures.size(), load("materials.gltf").textures.size());
+    EXPECT_TRUE(has_note(s, "extensionsUsed: EXT_texture_webp is not supported"));
+    doc["extensionsRequired"] = {"EXT_texture_webp"};
+    const fs::path required = dir.write("required.gltf", doc.dump());
+    EXPECT_EQ(error_of(required.string()),
+              required.string() + ": extensionsRequired[0]: EXT_texture_webp is required by the file but not "
+                                  "supported (supported: KHR_lights_punctual, KHR_materials_emissive_strength, "
+                                  "KHR_materials_clearcoat, KHR_materials_sheen, KHR_texture_transform)");
+}
+
 // --camera takes the first camera node of its name, in node order, and
 // notes that there are others.
 TEST(Gltf, CameraOnTwoNodesIsTakenFromTheFirstWithANote) {
@@ -383,6 +417,75 @@ TEST(Gltf, FilePastFourGibibytesIsRefusedBeforeItIsRead) {
                                                        "4294967295 (GLB's lengths are 32-bit)");
 }
 
+// Without a `scene` the first of the scenes is drawn, as viewers do (every
+// root node was, the scenes' overlaid, and nodes of no scene too); a file
+// with no scenes draws its root nodes.
+TEST(Gltf, WithoutADefaultSceneTheFirstIsDrawn) {
+    test::TempDir dir;
+    std::ifstream in(kData / "triangle.gltf", std::ios::binary);
+    nlohmann::json doc = nlohmann::json::parse(in);
+    doc.erase("scene");
+    doc["nodes"].push_back({{"mesh", 0}, {"translation", {3.0, 0.0, 0.0}}});
+    doc["scenes"].push_back({{"nodes", {1, 2}}});
+    const fs::path file = dir.write("two.gltf", doc.dump());
+    const Scene first = load_scene(file);
+    EXPECT_EQ(first.triangles.size(), 1u);
+    EXPECT_TRUE(has_note(first, "scenes: the file names no default scene (`scene`); the first of its 2 scenes is drawn"));
+    doc["scene"] = 1;
+    const Scene second = load_scene(dir.write("second.gltf", doc.dump()));
+    ASSERT_EQ(second.triangles.size(), 1u);
+    EXPECT_EQ(second.triangles[0].v0_x, first.triangles[0].v0_x + 3.0f);
+    doc.erase("scene");
+    doc.erase("scenes");
+    EXPECT_EQ(load_scene(dir.write("none.gltf", doc.dump())).triangles.size(), 2u);
+}
+
+// --camera naming an orthographic camera says that it is one (it said the
+// file had no cameras).
+TEST(Gltf, CameraNamingAnOrthographicOneSaysSo) {
+    test::TempDir dir;
+    std::ifstream in(kData / "triangle.gltf", std::ios::binary);
+    nlohmann::json doc = nlohmann::json::parse(in);
+    doc["cameras"] = {{{"type", "orthographic"},
+                       {"name", "ortho"},
+                       {"orthographic", {{"xmag", 1.0}, {"ymag", 1.0}, {"znear", 0.1}, {"zfar", 10.0}}}}};
+    doc["nodes"].push_back({{"camera", 0}, {"translation", {0.0, 0.0, 3.0}}});
+    doc["scenes"][0]["nodes"].push_back(2);
+    const fs::path file = dir.write("ortho.gltf", doc.dump());
+    EXPECT_EQ(error_of(file.string(), "ortho"),
+              file.string() + ": --camera: 'ortho' is an orthographic camera; only perspective cameras are read");
+}
+
+// A buffer must hold its byteLength, in a file or a data URI: tinygltf
+// said "File size mismatch" naming no field, or "Failed to decode 'uri'"
+// with the whole data URI (1.4 MB of message for a 1 MiB buffer). And a
+// '+' in a URI, which tinygltf reads as a space, is pointed out where the
+// file with the '+' is there.
+TEST(Gltf, BuffersMustHoldTheirByteLength) {
+    test::TempDir dir;
+    std::ifstream in(kData / "triangle.gltf", std::ios::binary);
+    nlohmann::json doc = nlohmann::json::parse(in);
+    const std::string data = doc["buffers"][0]["uri"].get<std::string>();
+    ASSERT_TRUE(data.starts_with("data:"));
+    const std::uint64_t length = doc["buffers"][0]["byteLength"].get<std::uint64_t>();
+    doc["buffers"][0]["byteLength"] = length + 1;
+    fs::path file = dir.write("long.gltf", doc.dump());
+    EXPECT_EQ(error_of(file.string()), file.string() + ": buffers[0].byteLength: " + std::to_string(length + 1) +
+                                           ", but its data URI holds " + std::to_string(length) + " bytes");
+    // The same bytes in a file of their own, one byte short.
+    std::string bytes(length - 1, '\0');
+    std::ofstream(dir.path() / "a+b.bin", std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+    doc["buffers"][0] = {{"uri", "a%2Bb.bin"}, {"byteLength", length}};
+    file = dir.write("short.gltf", doc.dump());
+    EXPECT_EQ(error_of(file.string()), file.string() + ": buffers[0].byteLength: " + std::to_string(length) +
+                                           ", but 'a%2Bb.bin' holds " + std::to_string(length - 1) + " bytes");
+    doc["buffers"][0]["uri"] = "a+b.bin";
+    file = dir.write("plus.gltf", doc.dump());
+    EXPECT_EQ(error_of(file.string()),
+              file.string() + ": buffers[0].uri: 'a+b.bin' not found next to the glTF (the glTF loader, tinygltf, "
+                              "reads '+' in a URI as a space; write it as %2B)");
+}
+
 // A buffer read from a device or a pipe could go on for ever: such URIs are
 // refused before tinygltf opens them (it reads a pipe until its writer
 // closes it, which here is never).
@@ -425,7 +528,7 @@ TEST(Gltf, BufferAndImageUrisMustNameRegularFiles) {
         message = e.what();
     }
     fs::current_path(cwd);
-    EXPECT_NE(message.find("File not found : elsewhere.bin"), std::string::npos) << message;
+    EXPECT_EQ(message, file.string() + ": buffers[0].uri: 'elsewhere.bin' not found next to the glTF");
     // "%00" decodes to a NUL, which would cut the name short.
     const fs::path nul = with_buffer("missing.bin%00.txt");
     try {
@@ -476,10 +579,10 @@ INSTANTIATE_TEST_SUITE_P(
                 "accessors[0].count: is larger than 16777216 for an accessor without a bufferView"},
         BadCase{"bad_view_past_buffer.gltf", "bufferViews[0]: bytes 8 + 36 run past the end of buffer 0"},
         BadCase{"bad_nan_position.gltf", "meshes[0].primitives[0].attributes.POSITION: element 1 of accessors[0] is not a finite"},
-        BadCase{"bad_missing_buffer.gltf", "tinygltf: File not found : missing.bin"},
+        BadCase{"bad_missing_buffer.gltf", "buffers[0].uri: 'missing.bin' not found next to the glTF"},
         BadCase{"bad_buffer_folder.gltf", "buffers[0].uri: '.' is a folder, not a file"},
         BadCase{"bad_image_folder.gltf", "images[0].uri: '..' is a folder, not a file"},
-        BadCase{"bad_data_uri.gltf", "tinygltf: Failed to decode 'uri'"},
+        BadCase{"bad_data_uri.gltf", "buffers[0].uri: the data URI's base64 holds '@' at character 0 of its data"},
         BadCase{"bad_no_position.gltf", "meshes[0].primitives[0].attributes.POSITION: missing"},
         BadCase{"bad_no_light.gltf", "the scene has no light"},
         BadCase{"bad_node_cycle.gltf", "nodes[3].children[0]: nodes[2] is reached twice"},

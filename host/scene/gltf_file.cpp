@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <limits>
 #include <string_view>
 #include <system_error>
@@ -82,6 +83,50 @@ std::string decoded_uri(const std::string& uri) {
     return out;
 }
 
+// The bytes a base64 data URI decodes to (tinygltf decodes only base64).
+std::uint64_t data_uri_bytes(const std::string& uri) {
+    const std::size_t comma = uri.find(',');
+    if (comma == std::string::npos) return 0;
+    std::uint64_t digits = uri.size() - comma - 1;
+    std::size_t end = uri.size();
+    while (end > comma + 1 && uri[end - 1] == '=') --end, --digits;
+    return digits * 3 / 4;
+}
+
+// What makes a data URI's base64 undecodable ("" if nothing): a character
+// outside the alphabet, or a length not a multiple of 4.
+std::string base64_problem(const std::string& uri) {
+    const std::size_t comma = uri.find(',');
+    if (comma == std::string::npos) return "the data URI has no ',' before its data";
+    const std::size_t digits = uri.size() - comma - 1;
+    for (std::size_t i = comma + 1; i < uri.size(); ++i) {
+        const unsigned char c = static_cast<unsigned char>(uri[i]);
+        const bool padding = c == '=' && i + 2 >= uri.size() && (i + 1 == uri.size() || uri[i + 1] == '=');
+        if (!(std::isalnum(c) || c == '+' || c == '/' || padding))
+            return "the data URI's base64 holds " +
+                   (std::isprint(c) ? "'" + std::string(1, char(c)) + "'" : "byte " + std::to_string(int(c))) +
+                   " at character " + std::to_string(i - comma - 1) + " of its data";
+    }
+    if (digits % 4 != 0)
+        return "the data URI's base64 is " + std::to_string(digits) + " characters long, not a multiple of 4";
+    return "";
+}
+
+// tinygltf's messages quote a data URI whole (megabytes on one line):
+// each is cut to its start and its length.
+std::string shortened_data_uris(std::string text) {
+    constexpr std::size_t kKeep = 48;
+    for (std::size_t at = text.find("data:"); at != std::string::npos; at = text.find("data:", at + 1)) {
+        std::size_t end = at;
+        while (end < text.size() && !std::isspace(static_cast<unsigned char>(text[end])) && text[end] != '\'' &&
+               text[end] != '"')
+            ++end;
+        if (end - at > kKeep + 16)
+            text.replace(at + kKeep, end - at - kKeep, "... (" + std::to_string(end - at) + " characters)");
+    }
+    return text;
+}
+
 // A glTF's images as the JSON names them, before tinygltf decodes them.
 struct GltfImages {
     std::vector<std::string> uris;  // the file each names; "" for a data URI or a buffer view
@@ -99,17 +144,17 @@ fs::path uri_file(const std::string& base, const std::string& uri) {
 // seek to its end: a folder's "size" makes it ask for about 2^63 bytes
 // (std::bad_alloc), and a device or a pipe may never end. So every URI that
 // tinygltf would open must name a regular file, checked in the file's JSON
-// before tinygltf reads it. A missing buffer is left to tinygltf's "File
-// not found"; a missing image is refused here, used or not (tinygltf would
-// only warn, and a texture of it fail without naming the file). JSON that
+// before tinygltf reads it. A missing buffer or image is refused here, an
+// image used or not (tinygltf would only warn, and a texture of it fail
+// without naming the file), and a buffer whose file or data URI does not
+// hold its byteLength. JSON that
 // does not parse is left to tinygltf's message. Returns each image's uri
 // ("" for a data URI or a buffer view) and whether a material reads it, for
 // load_image_checked.
-GltfImages check_uri_files(std::string_view json, const std::string& base, const std::string& name) {
+GltfImages check_uri_files(const nlohmann::json& doc, const std::string& base, const std::string& name) {
     GltfImages out;
     std::vector<std::string>& image_uris = out.uris;
-    const nlohmann::json doc = nlohmann::json::parse(json.begin(), json.end(), nullptr, false);
-    if (doc.is_discarded() || !doc.is_object()) return out;
+    if (!doc.is_object()) return out;
     if (const auto images = doc.find("images"); images != doc.end() && images->is_array())
         for (const nlohmann::json& image : *images) {
             const auto uri = image.is_object() ? image.find("uri") : image.end();
@@ -145,22 +190,53 @@ GltfImages check_uri_files(std::string_view json, const std::string& base, const
     for (const char* list : {"buffers", "images"}) {
         const auto entries = doc.find(list);
         if (entries == doc.end() || !entries->is_array()) continue;
+        const bool buffers = list == std::string("buffers");
         for (std::size_t i = 0; i < entries->size(); ++i) {
             const nlohmann::json& entry = (*entries)[i];
             if (!entry.is_object()) continue;
             const auto uri = entry.find("uri");
             if (uri == entry.end() || !uri->is_string()) continue;
             const std::string& text = uri->get_ref<const std::string&>();
-            if (text.empty() || tinygltf::IsDataURI(text)) continue;
+            const std::string field = std::string(list) + "[" + std::to_string(i) + "]";
+            // tinygltf wants a buffer of exactly byteLength bytes, and says
+            // only "Failed to decode" with the whole data URI, or "File size
+            // mismatch", where it is not.
+            const auto length = entry.find("byteLength");
+            const bool has_length = buffers && length != entry.end() && length->is_number_unsigned();
+            if (text.empty()) continue;
+            if (tinygltf::IsDataURI(text)) {
+                if (const std::string problem = base64_problem(text); !problem.empty())
+                    throw InputError(name, field + ".uri", problem);
+                const std::uint64_t held = data_uri_bytes(text);
+                if (has_length && held != length->get<std::uint64_t>())
+                    throw InputError(name, field + ".byteLength",
+                                     std::to_string(length->get<std::uint64_t>()) + ", but its data URI holds " +
+                                         std::to_string(held) + " bytes");
+                continue;
+            }
             // "%00" decodes to a NUL, which would end the name where the
             // system reads it, and another file be opened.
             if (decoded_uri(text).find('\0') != std::string::npos)
-                throw InputError(name, std::string(list) + "[" + std::to_string(i) + "].uri",
-                                 "'" + text + "' decodes to a file name with a NUL character");
-            const std::string problem = input_file_problem(uri_file(base, text));
-            if (problem.empty() || (problem == kFileNotFound && list == std::string("buffers"))) continue;
-            throw InputError(name, std::string(list) + "[" + std::to_string(i) + "].uri",
-                             "'" + text + "' " + (problem == kFileNotFound ? "not found next to the glTF" : problem));
+                throw InputError(name, field + ".uri", "'" + text + "' decodes to a file name with a NUL character");
+            const fs::path file = uri_file(base, text);
+            const std::string problem = input_file_problem(file);
+            if (problem == kFileNotFound) {
+                // tinygltf 2.7 reads '+' as a space, as in a query string.
+                const bool plus_named = text.find('+') != std::string::npos &&
+                                        input_file_problem(fs::path(base + "/" + text)).empty();
+                throw InputError(name, field + ".uri",
+                                 "'" + text + "' not found next to the glTF" +
+                                     (plus_named ? " (the glTF loader, tinygltf, reads '+' in a URI as a space; "
+                                                   "write it as %2B)"
+                                                 : ""));
+            }
+            if (!problem.empty()) throw InputError(name, field + ".uri", "'" + text + "' " + problem);
+            std::error_code ec;
+            const std::uintmax_t bytes = fs::file_size(file, ec);
+            if (has_length && !ec && bytes != length->get<std::uint64_t>())
+                throw InputError(name, field + ".byteLength",
+                                 std::to_string(length->get<std::uint64_t>()) + ", but '" + text + "' holds " +
+                                     std::to_string(bytes) + " bytes");
         }
     }
     return out;
@@ -170,7 +246,7 @@ GltfImages check_uri_files(std::string_view json, const std::string& base, const
 // header: one larger than the scene's textures may hold, or one that would
 // take the images the materials read past that together, is refused before
 // its pixels are allocated (encoded_image_problem). An image no material
-// reads is not decoded. An image that stb_image cannot decode is named with
+// reads is not decoded, nor its format checked. An image that stb_image cannot decode is named with
 // stb's reason (tinygltf says "Unknown image format" for all of them);
 // `user_data` is check_uri_files' GltfImages.
 bool load_image_checked(tinygltf::Image* image, const int index, std::string* err, std::string* warn,
@@ -180,6 +256,10 @@ bool load_image_checked(tinygltf::Image* image, const int index, std::string* er
     const bool known = index >= 0 && std::size_t(index) < uris.size();
     const std::string uri = known && !uris[std::size_t(index)].empty() ? " ('" + uris[std::size_t(index)] + "')"
                                                                        : std::string();
+    // Not read, so neither decoded nor held to PNG or JPEG: a WebP or KTX2
+    // image whose texture falls back to a PNG (EXT_texture_webp,
+    // KHR_texture_basisu) is such an image.
+    if (known && !images.used[std::size_t(index)]) return true;
     const std::size_t size_bytes = std::size_t(std::max(size, 0));
     std::uint64_t texels = 0;
     const std::string problem = encoded_image_problem(bytes, size_bytes, &texels);
@@ -187,7 +267,6 @@ bool load_image_checked(tinygltf::Image* image, const int index, std::string* er
         if (err != nullptr) *err += "images[" + std::to_string(index) + "]" + uri + " " + problem + "\n";
         return false;
     }
-    if (known && !images.used[std::size_t(index)]) return true;
     images.texels += texels;
     if (images.texels > kMaxTexels) {
         if (err != nullptr)
@@ -261,10 +340,24 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
     }
     if (too_deep(json)) throw InputError(name, "", "JSON nested more than " + std::to_string(kMaxJsonDepth) + " levels deep");
     const std::string base = file.parent_path().empty() ? std::string(".") : file.parent_path().string();
-    GltfImages images = check_uri_files(json, base, name);
+    const nlohmann::json doc = nlohmann::json::parse(json.begin(), json.end(), nullptr, false);
+    GltfImages images = check_uri_files(doc, base, name);
     // Before tinygltf, whose messages for a value of the wrong JSON type
     // name neither the value nor where it is.
     check_gltf_types(json, name);
+    // Before tinygltf too: it would decode the images that an extension the
+    // loader lacks (EXT_texture_webp, say) provides, and fail on those.
+    if (const auto required = doc.is_object() ? doc.find("extensionsRequired") : doc.end();
+        required != doc.end() && required->is_array())
+        for (std::size_t i = 0; i < required->size(); ++i) {
+            const nlohmann::json& ext = (*required)[i];
+            if (ext.is_string() && !supported(ext.get<std::string>()))
+                throw InputError(name, "extensionsRequired[" + std::to_string(i) + "]",
+                                 ext.get<std::string>() +
+                                     " is required by the file but not supported (supported: KHR_lights_punctual, "
+                                     "KHR_materials_emissive_strength, KHR_materials_clearcoat, KHR_materials_sheen, "
+                                     "KHR_texture_transform)");
+        }
 
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(load_image_checked, &images);
@@ -282,20 +375,14 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
         err = e.what();
         ok = false;
     }
-    if (!ok) throw InputError(name, "", "tinygltf: " + (err.empty() ? std::string("cannot parse the file") : trimmed(err)));
+    if (!ok)
+        throw InputError(name, "", "tinygltf: " + (err.empty() ? std::string("cannot parse the file")
+                                                                : shortened_data_uris(trimmed(err))));
     warn = trimmed(warn);
     for (std::size_t from = 0; from < warn.size();) {
         const std::size_t end = std::min(warn.find('\n', from), warn.size());
-        if (end > from) notes.add("", "tinygltf: " + warn.substr(from, end - from));
+        if (end > from) notes.add("", "tinygltf: " + shortened_data_uris(warn.substr(from, end - from)));
         from = end + 1;
-    }
-    for (std::size_t i = 0; i < model.extensionsRequired.size(); ++i) {
-        const std::string& ext = model.extensionsRequired[i];
-        if (!supported(ext))
-            throw InputError(name, "extensionsRequired[" + std::to_string(i) + "]",
-                             ext + " is required by the file but not supported (supported: KHR_lights_punctual, "
-                                   "KHR_materials_emissive_strength, KHR_materials_clearcoat, KHR_materials_sheen, "
-                                   "KHR_texture_transform)");
     }
     for (const std::string& ext : model.extensionsUsed)
         if (!supported(ext)) notes.add("extensionsUsed", ext + " is not supported; what it adds is ignored");

@@ -98,13 +98,19 @@ public:
 
     GltfContents walk() {
         std::vector<int> roots;
-        if (model_.defaultScene >= 0) {
-            if (std::size_t(model_.defaultScene) >= model_.scenes.size())
-                fail("scene", "scene " + std::to_string(model_.defaultScene) + " out of range (" +
+        // The file's `scene`; without one the first of its scenes, as
+        // viewers take it (the spec leaves it to the reader).
+        const int scene = model_.defaultScene >= 0 ? model_.defaultScene : model_.scenes.empty() ? -1 : 0;
+        if (model_.defaultScene < 0 && model_.scenes.size() > 1)
+            notes_.add("scenes", "the file names no default scene (`scene`); the first of its " +
+                                     std::to_string(model_.scenes.size()) + " scenes is drawn");
+        if (scene >= 0) {
+            if (std::size_t(scene) >= model_.scenes.size())
+                fail("scene", "scene " + std::to_string(scene) + " out of range (" +
                                   std::to_string(model_.scenes.size()) + " scenes)");
-            roots = model_.scenes[std::size_t(model_.defaultScene)].nodes;
+            roots = model_.scenes[std::size_t(scene)].nodes;
         } else {
-            // No default scene: every node that is nobody's child.
+            // No scene at all: every node that is nobody's child.
             std::vector<bool> child(model_.nodes.size(), false);
             for (const tinygltf::Node& n : model_.nodes)
                 for (const int c : n.children)
@@ -115,8 +121,9 @@ public:
         visited_.assign(model_.nodes.size(), false);
         const glm::dmat4 base(transform_.position);
         for (std::size_t i = 0; i < roots.size(); ++i)
-            visit(roots[i], base, "scenes[" + std::to_string(std::max(model_.defaultScene, 0)) + "].nodes[" +
-                                      std::to_string(i) + "]");
+            visit(roots[i], base,
+                  scene >= 0 ? "scenes[" + std::to_string(scene) + "].nodes[" + std::to_string(i) + "]"
+                             : "nodes[" + std::to_string(roots[i]) + "]");
         if (kept_ == 0 && !flattened_.empty())
             fail(flattened_, "its transform makes every triangle of its mesh degenerate (a scale of 0, or one too "
                              "small for floats?), and no other triangle is left");
@@ -357,6 +364,7 @@ private:
         const tinygltf::Camera& cam = model_.cameras[std::size_t(index)];
         if (cam.type != "perspective") {
             notes_.add(name, "camera type \"" + cam.type + "\" is skipped (only perspective cameras are read)");
+            contents_.skipped_cameras.emplace_back(cam.name, cam.type);
             return;
         }
         // In degrees and as the float the camera keeps: a yfov just inside

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lightcuts/scene.h"
@@ -29,6 +30,9 @@ struct GltfCamera {
 struct GltfContents {
     std::vector<GltfLight> lights;    // in node order, not yet checked against the scene's totals
     std::vector<GltfCamera> cameras;  // in node order
+    // The cameras skipped for their type ("orthographic"), by name, so that
+    // --camera naming one says why it is not there.
+    std::vector<std::pair<std::string, std::string>> skipped_cameras;
 };
 
 // True for a path ending in .gltf or .glb (any case).

@@ -287,8 +287,12 @@ std::uint32_t GltfMaterials::texture(int index, int tex_coord, const tinygltf::E
     if (transform != extensions.end())
         read_transform(transform->second, field + ".extensions.KHR_texture_transform", tex_coord, sampling);
     if (tex_coord != 0) {
-        notes_.add(field + ".texCoord", "uses TEXCOORD_" + std::to_string(tex_coord) +
-                                            "; only TEXCOORD_0 is read, so the texture is left out");
+        // The set the transform's texCoord chose, where it gives one.
+        const bool overridden = transform != extensions.end() && transform->second.IsObject() &&
+                                transform->second.Has("texCoord");
+        notes_.add(field + (overridden ? ".extensions.KHR_texture_transform.texCoord" : ".texCoord"),
+                   "uses TEXCOORD_" + std::to_string(tex_coord) +
+                       "; only TEXCOORD_0 is read, so the texture is left out");
         return gpu::kInvalidIndex;
     }
     const std::string name = "textures[" + std::to_string(index) + "]";

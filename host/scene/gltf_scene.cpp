@@ -72,6 +72,10 @@ Scene load_gltf_scene(const std::filesystem::path& file, const std::string& came
                                            camera + "'; the first in node order is used");
             return scene;
         }
+        for (const auto& [skipped, type] : contents.skipped_cameras)
+            if (skipped == camera)
+                throw InputError(name, "--camera", "'" + camera + "' is an " + type +
+                                                       " camera; only perspective cameras are read");
         std::string names;
         for (const GltfCamera& c : contents.cameras) names += (names.empty() ? "" : ", ") + ("'" + c.name + "'");
         throw InputError(name, "--camera", "no perspective camera named '" + camera + "' (the file has " +
