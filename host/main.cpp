@@ -73,20 +73,20 @@ CLI::Validator setting(std::string_view key) {
 
 // The scene's render block and camera, overridden by what the command line gives.
 lc::RenderOptions render_options(const RenderArgs& a, const lc::Scene& scene) {
-    lc::RenderOptions o;
-    o.method = a.method.empty() ? scene.render.method : a.method;
-    o.spp = a.spp.value_or(scene.render.spp);
-    o.relative_error = a.relative_error.value_or(scene.render.relative_error);
-    o.max_cut = a.max_cut.value_or(scene.render.max_cut);
-    o.cut_heap = a.cut_heap.value_or(scene.render.cut_heap);
-    o.cut_sharing = a.cut_sharing.empty() ? scene.render.cut_sharing : a.cut_sharing;
-    o.seed = a.seed.value_or(scene.render.seed);
-    o.light_samples = a.light_samples.value_or(scene.render.light_samples);
-    o.light_pick = a.light_pick.empty() ? scene.render.light_pick : a.light_pick;
-    o.max_bounces = a.max_bounces.value_or(scene.render.max_bounces);
-    o.time_limit = a.time_limit.value_or(scene.render.time_limit);
-    o.width = a.width.value_or(scene.camera.width);
-    o.height = a.height.value_or(scene.camera.height);
+    lc::RenderOptions o = lc::scene_render_options(scene);
+    if (!a.method.empty()) o.method = a.method;
+    o.spp = a.spp.value_or(o.spp);
+    o.relative_error = a.relative_error.value_or(o.relative_error);
+    o.max_cut = a.max_cut.value_or(o.max_cut);
+    o.cut_heap = a.cut_heap.value_or(o.cut_heap);
+    if (!a.cut_sharing.empty()) o.cut_sharing = a.cut_sharing;
+    o.seed = a.seed.value_or(o.seed);
+    o.light_samples = a.light_samples.value_or(o.light_samples);
+    if (!a.light_pick.empty()) o.light_pick = a.light_pick;
+    o.max_bounces = a.max_bounces.value_or(o.max_bounces);
+    o.time_limit = a.time_limit.value_or(o.time_limit);
+    o.width = a.width.value_or(o.width);
+    o.height = a.height.value_or(o.height);
     o.threads = a.threads;
     o.progress = true;
     return o;

@@ -84,6 +84,25 @@ std::uint32_t cpu_cut_points(std::string_view method, std::string_view sharing) 
     return sharing == "quad" ? 4u : 1u;
 }
 
+RenderOptions scene_render_options(const Scene& scene) {
+    const RenderSettings& r = scene.render;
+    RenderOptions o;
+    o.method = r.method;
+    o.spp = r.spp;
+    o.relative_error = r.relative_error;
+    o.max_cut = r.max_cut;
+    o.cut_heap = r.cut_heap;
+    o.cut_sharing = r.cut_sharing;
+    o.seed = r.seed;
+    o.light_samples = r.light_samples;
+    o.light_pick = r.light_pick;
+    o.max_bounces = r.max_bounces;
+    o.time_limit = r.time_limit;
+    o.width = scene.camera.width;
+    o.height = scene.camera.height;
+    return o;
+}
+
 void validate_render_options(const RenderOptions& o) {
     std::string problem = method_problem(o.method);
     if (!problem.empty()) throw std::invalid_argument("method " + problem);

@@ -127,6 +127,11 @@ struct RenderResult {
     RenderStats stats;
 };
 
+// The options a scene asks for: its `render` block (method, spp, error,
+// cut limits, seed, sampling, path settings) and its camera's image size.
+// The command line starts from these and overrides what it is given.
+RenderOptions scene_render_options(const Scene& scene);
+
 // Throws std::invalid_argument naming the first option out of the ranges of
 // lightcuts/settings.h; both renderers call it on what they are given.
 void validate_render_options(const RenderOptions& options);
@@ -155,7 +160,7 @@ struct NoVulkanDevice : std::runtime_error {
 // Throws NoVulkanDevice when no Vulkan device exists, std::runtime_error on
 // other failures.
 RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& options,
-                           const VulkanOptions& vulkan);
+                           const VulkanOptions& vulkan = {});
 
 // The Vulkan devices present, found by one Vulkan instance: the loader
 // loads every installed driver for it (on a machine without a GPU, Mesa's
