@@ -208,7 +208,9 @@ std::vector<Buffer> GpuResources::upload_chunks(const SceneArray& array, std::ui
     VkDeviceSize limit = max_buffer_;
     if (split_bytes_ > 0) limit = std::min(limit, split_bytes_);
     std::uint32_t shift = 31;
-    if (binding < gpu::kSceneArrayCount && bytes > limit && element <= limit) {
+    // An element larger than the limit (only a forced split's can be) gets
+    // a chunk of its own.
+    if (binding < gpu::kSceneArrayCount && bytes > limit) {
         shift = 0;
         while (shift < 30 && (VkDeviceSize(2) << shift) * element <= limit) ++shift;
     }

@@ -1,6 +1,7 @@
 #include "vk_objects.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <stdexcept>
 
 #include "vk_check.h"
@@ -75,6 +76,24 @@ VkBufferHandle create_buffer(const Device& device, VkDeviceSize size, VkBufferUs
     return handle;
 }
 
+// vkAllocateMemory, where running out of memory says which buffer and how
+// large, and what would need less (VK_CHECK's message named only the call).
+VkDeviceMemory allocate_memory(const Device& device, const VkMemoryAllocateInfo& info, const std::string& name) {
+    VkDeviceMemory allocation = VK_NULL_HANDLE;
+    const VkResult result = device.fn().vkAllocateMemory(device.get(), &info, nullptr, &allocation);
+    if (result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY) {
+        char size[32];
+        std::snprintf(size, sizeof size, "%.1f MiB", double(info.allocationSize) / double(1 << 20));
+        throw std::runtime_error(
+            std::string("the Vulkan device ran out of ") +
+            (result == VK_ERROR_OUT_OF_DEVICE_MEMORY ? "device" : "host") + " memory for buffer '" + name + "' (" +
+            size + "); the image's size, the lights and area-light samples, --cut-heap and the tiles' size "
+            "(LC_VK_MAX_TILE_PIXELS) set what the buffers take, and --device cpu renders without them");
+    }
+    VK_CHECK(result);
+    return allocation;
+}
+
 }  // namespace
 
 Buffer::Buffer(const Device& device, const VkPhysicalDeviceMemoryProperties& memory,
@@ -108,8 +127,7 @@ Buffer::Buffer(const Device& device, const VkPhysicalDeviceMemoryProperties& mem
     auto flags_info = vk_struct<VkMemoryAllocateFlagsInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO);
     flags_info.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
     if ((usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) != 0) alloc_info.pNext = &flags_info;
-    VkDeviceMemory allocation = VK_NULL_HANDLE;
-    VK_CHECK(vkd.vkAllocateMemory(device.get(), &alloc_info, nullptr, &allocation));
+    const VkDeviceMemory allocation = allocate_memory(device, alloc_info, name);
     memory_ = own<DeviceMemory>(device, allocation, name + " memory");
     VK_CHECK(vkd.vkBindBufferMemory(device.get(), buffer, allocation, 0));
 
@@ -149,8 +167,7 @@ Buffer::Buffer(const Device& device, const VkPhysicalDeviceMemoryProperties& mem
     alloc_info.pNext = &import;
     alloc_info.allocationSize = bytes;
     alloc_info.memoryTypeIndex = type;
-    VkDeviceMemory allocation = VK_NULL_HANDLE;
-    VK_CHECK(vkd.vkAllocateMemory(device.get(), &alloc_info, nullptr, &allocation));
+    const VkDeviceMemory allocation = allocate_memory(device, alloc_info, name);
     memory_ = own<DeviceMemory>(device, allocation, name + " memory");
     VK_CHECK(vkd.vkBindBufferMemory(device.get(), buffer, allocation, 0));
 }

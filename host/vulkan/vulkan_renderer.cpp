@@ -117,14 +117,19 @@ bool share_cuts(const Context& ctx, const LightTree& tree, const RenderOptions& 
         const std::uint64_t slots = tree.cut_heap_slots(frame.max_cut, quad_cut_heap(options.cut_heap));
         const std::uint64_t bytes = slots * gpu::kWorkgroupSize * sizeof(gpu::QuadCutEntry);
         const std::uint32_t offered = ctx.properties().limits.maxComputeSharedMemorySize;
-        if (bytes > offered)
+        if (bytes > offered) {
+            // The largest cut_heap whose quad heap fits (the tree may cap the slots lower still).
+            const std::uint64_t fits = offered / (gpu::kWorkgroupSize * sizeof(gpu::QuadCutEntry)) / 4u;
             why = "a quad's heap of " + std::to_string(slots) + " slots needs " + std::to_string(bytes) +
-                  " bytes of shared memory per workgroup, the device offers " + std::to_string(offered);
+                  " bytes of shared memory per workgroup, the device offers " + std::to_string(offered) +
+                  (fits > 0 ? "; use cut_heap " + std::to_string(fits) + " or less," : ";");
+        }
     }
     if (why.empty()) return true;
     if (options.cut_sharing == "quad")
         throw std::invalid_argument("cut_sharing \"quad\" on " + ctx.device_name() + ": " + why +
-                                    "; use cut_sharing \"pixel\" or \"auto\", or --device cpu");
+                                    (why.back() == ',' ? " " : "; use ") +
+                                    "cut_sharing \"pixel\" or \"auto\", or --device cpu");
     return false;
 }
 

@@ -252,6 +252,20 @@ TEST_F(Vulkan, SceneArraysSplitIntoChunksMatchTheCpu) {
             if (std::string(method) == "lightcuts") expect_lightcuts_matches(p, o, chunked);
         }
     }
+    // A forced split smaller than an element (48-byte lights, 64-byte tree
+    // nodes at 40 bytes) gives each such element a chunk of its own (those
+    // arrays were left whole, so the switch tested less than it said).
+    vk::Tuning elements;
+    elements.split_bytes = 40;
+    check_setups(p, {elements}, [&](const vk::RenderSetup& setup) {
+        for (std::uint32_t b : {gpu::kBindingLights, gpu::kBindingLightNodes}) {
+            SCOPED_TRACE(b);
+            EXPECT_EQ(setup.resources.chunks().shift[b], 0u);
+            EXPECT_GT(setup.resources.chunk_count(b), 50u);
+        }
+    });
+    const RenderOptions o = options("lightcuts", 12, 10);
+    EXPECT_EQ(max_relative_difference(gpu(p, o, elements).image, gpu(p, o).image, "one element a chunk", 0.0), 0.0);
 }
 
 // On a CPU device that can import host memory (lavapipe), the large scene
