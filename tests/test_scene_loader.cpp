@@ -239,10 +239,15 @@ TEST(SceneLoader, ObjAndMtlNumbersThatAreNotNumbersAreRefused) {
                          Bad{kVertices, "newmtl m\nKd 0.5\n", "m.mtl", "line 2 (Kd): needs 3 numbers, has 1"},
                          Bad{kVertices, "newmtl m\nKd 0.5 0.5 0.5\nNs inf\n", "m.mtl", "line 3 (Ns): 'inf'"},
                          Bad{kVertices, "newmtl m\n\tPm 0.5x\n", "m.mtl", "line 2 (Pm): '0.5x'"},
-                         // Past float's range, which tinyobjloader reads as infinity; and a
+                         // Past float's range, which tinyobjloader reads as infinity (or, at
+                         // 1e99999, as 0: the triangle was dropped as degenerate); and a
                          // value too small for to_string's six decimals.
-                         Bad{kVertices, "newmtl m\nKd 1e39 0.5 0.5\n", "m.obj",
-                             "material 'm'.Kd: components must be in [0, 1], got a number beyond float's range"},
+                         Bad{kVertices, "newmtl m\nKd 1e39 0.5 0.5\n", "m.mtl",
+                             "line 2 (Kd): '1e39' is past the largest float (3.4e38)"},
+                         Bad{"v 1e99999 0 0\nv 1 0 0\nv 0 1 0\n", kMtl, "m.obj",
+                             "line 2 (v): '1e99999' is past the largest float (3.4e38)"},
+                         Bad{"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 -4e38 0\n", kMtl, "m.obj",
+                             "line 5 (vn): '-4e38' is past the largest float (3.4e38)"},
                          Bad{kVertices, "newmtl m\nKd -1e-7 0.5 0.5\n", "m.obj",
                              "material 'm'.Kd: components must be in [0, 1], got -1e-07"},
                          Bad{kVertices, "newmtl m\nKd 1.0000001 0.5 0.5\n", "m.obj",

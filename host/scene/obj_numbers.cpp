@@ -3,6 +3,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <string>
 #include <vector>
 
 #include "lightcuts/error.h"
@@ -46,13 +50,27 @@ bool is_non_finite(std::string_view w) {
     return starts("nan") || starts("inf");
 }
 
-// Words 1.. of `line` are `least` or more numbers (all of them numbers;
-// with `non_finite_ok`, NaN and infinity spelt out count as numbers).
+// A number past float's range ("1e99999", "4e38"), which tinyobjloader
+// reads as 0 or as infinity without a word (a vertex at 1e99999 made its
+// triangle degenerate, and the error said only that none were left).
+bool past_float_range(std::string_view w) {
+    const double value = std::strtod(std::string(w).c_str(), nullptr);
+    return !(std::abs(value) <= double(std::numeric_limits<float>::max()));
+}
+
+// Words 1.. of `line` are `least` or more numbers (all of them numbers
+// within float's range; with `non_finite_ok`, NaN and infinity spelt out
+// count as numbers).
 void check_numbers(const Line& line, std::size_t least, const std::string& name, bool non_finite_ok = false) {
     const std::string field = "line " + std::to_string(line.number) + " (" + std::string(line.words[0]) + ")";
-    for (std::size_t k = 1; k < line.words.size(); ++k)
-        if (!is_number(line.words[k]) && !(non_finite_ok && is_non_finite(line.words[k])))
+    for (std::size_t k = 1; k < line.words.size(); ++k) {
+        if (non_finite_ok && is_non_finite(line.words[k])) continue;
+        if (!is_number(line.words[k]))
             throw InputError(name, field, "'" + std::string(line.words[k]) + "' is not a number");
+        if (past_float_range(line.words[k]))
+            throw InputError(name, field,
+                             "'" + std::string(line.words[k]) + "' is past the largest float (3.4e38)");
+    }
     if (line.words.size() - 1 < least)
         throw InputError(name, field, "needs " + std::to_string(least) + " numbers, has " +
                                           std::to_string(line.words.size() - 1));
@@ -170,9 +188,9 @@ void check_mtl_numbers(std::string_view text, const std::string& name) {
             for (std::size_t k = 1; k + 1 < line.words.size(); ++k) {
                 if (line.words[k] != "-s" && line.words[k] != "-o") continue;
                 for (std::size_t j = k + 1; j < std::min(k + 4, line.words.size() - 1); ++j)
-                    if (!is_number(line.words[j]))
+                    if (!is_number(line.words[j]) || past_float_range(line.words[j]))
                         throw InputError(name, "line " + std::to_string(line.number) + " (" + std::string(key) + ")",
-                                         std::string(line.words[k]) + " takes three numbers: '" +
+                                         std::string(line.words[k]) + " takes three numbers within float's range: '" +
                                              std::string(line.words[j]) + "' is not one");
             }
         }
