@@ -80,6 +80,9 @@ struct Build {
     std::uint32_t seed = 0;
     // c^2 of the metric's cone term: 0 for lights that emit everywhere.
     double cone_weight = 0.0;
+    // Powers of two that the metric's positions and weights are scaled by
+    // (MetricKeys), 1 but where its float could overflow (metric_scales).
+    float position_scale = 1.0f, weight_scale = 1.0f;
 
     const ClusterCone& cone(std::uint32_t id) const { return cones.empty() ? everywhere : cones[id]; }
 };
@@ -247,9 +250,14 @@ struct MetricKeys {
     std::vector<float> lo_x, lo_y, lo_z, hi_x, hi_y, hi_z, weight;
     std::vector<float> axis_x, axis_y, axis_z, cos_half, sin_half, cos_beta;  // with cones only
     bool cones = false;
-    float cone_weight = 0.0f;  // Build::cone_weight
+    float cone_weight = 0.0f;  // Build::cone_weight, in the scaled positions' units
+    float position_scale = 1.0f, weight_scale = 1.0f;  // Build's
 
-    explicit MetricKeys(const Build& b) : cones(b.cone_weight > 0.0), cone_weight(float(b.cone_weight)) {}
+    explicit MetricKeys(const Build& b)
+        : cones(b.cone_weight > 0.0),
+          cone_weight(float(b.cone_weight * double(b.position_scale) * double(b.position_scale))),
+          position_scale(b.position_scale),
+          weight_scale(b.weight_scale) {}
     std::size_t size() const { return weight.size(); }
     void resize(std::size_t n) {
         auto fit = [n](std::vector<float>& v) {
@@ -263,9 +271,10 @@ struct MetricKeys {
     // Slot i takes build id `id`.
     void set(std::size_t i, const Build& b, std::uint32_t id) {
         const Cluster& c = b.all[id];
-        lo_x[i] = c.lo.x; lo_y[i] = c.lo.y; lo_z[i] = c.lo.z;
-        hi_x[i] = c.hi.x; hi_y[i] = c.hi.y; hi_z[i] = c.hi.z;
-        weight[i] = float(c.weight);
+        const glm::vec3 lo = c.lo * position_scale, hi = c.hi * position_scale;  // exact: powers of two
+        lo_x[i] = lo.x; lo_y[i] = lo.y; lo_z[i] = lo.z;
+        hi_x[i] = hi.x; hi_y[i] = hi.y; hi_z[i] = hi.z;
+        weight[i] = float(c.weight * double(weight_scale));
         if (!cones) return;
         const EmissionCone& cone = b.cone(id).cone;
         const ConeSpread spread = ConeSpread::of(cone);
@@ -471,6 +480,24 @@ void best_partners(const MetricKeys& k, std::uint32_t* best, std::size_t begin, 
     }
 }
 
+// The metric is computed in float, and its largest value, about the
+// tree's total weight times (12 r^2 + 4 c^2) for lights within r of the
+// origin, passes float's range inside the scenes the loader accepts (an
+// extent of 10^18, or 10^33 per light over 10^4 lights): costs became
+// infinite, ties broken by the Morton order alone, or NaN (infinity times
+// a zero cone term), and the tree a chain. Where it could pass 2^100, the
+// positions are scaled by 2^-e with 2^e >= r and the weights by 2^-f with
+// 2^f >= the total: exact, and every cost then below about 50. Elsewhere
+// the scales are 1, and the trees bit for bit what they were.
+void metric_scales(Build& build, glm::vec3 lo, glm::vec3 hi, double total_weight) {
+    const glm::dvec3 reach = glm::max(glm::abs(glm::dvec3(lo)), glm::abs(glm::dvec3(hi)));
+    const double r = std::max({reach.x, reach.y, reach.z});
+    const double largest = total_weight * (12.0 * r * r + 4.0 * build.cone_weight);
+    if (largest <= 0x1p100) return;
+    if (r > 1.0) build.position_scale = float(std::ldexp(1.0, -std::ilogb(r) - 1));
+    if (total_weight > 1.0) build.weight_scale = float(std::ldexp(1.0, -std::ilogb(total_weight) - 1));
+}
+
 // Locally-ordered clustering of leaves given in Morton order (leaf_key);
 // returns the root's build id.
 std::uint32_t cluster_fast(Build& build, std::vector<std::uint32_t> active) {
@@ -570,7 +597,10 @@ std::uint32_t cluster_exact(Build& build, std::vector<std::uint32_t> active) {
     std::vector<std::uint32_t> best(active.size());
     std::vector<float> best_cost(active.size(), inf);
     auto rescan = [&](std::size_t i) {
+        // A partner other than itself even where every cost is infinite or
+        // NaN (merging a cluster with itself wrote past the node array).
         best_cost[i] = inf;
+        best[i] = i == 0 ? 1u : 0u;
         for (std::size_t j = 0; j < active.size(); ++j) {
             if (j == i) continue;
             const float c = pair_cost(keys, active[i], active[j]);
@@ -816,10 +846,12 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
         std::vector<glm::vec3> range_lo(threads, glm::vec3(std::numeric_limits<float>::max()));
         std::vector<glm::vec3> range_hi(threads, glm::vec3(-std::numeric_limits<float>::max()));
         std::vector<std::size_t> range_black(threads, 0);
+        std::vector<double> range_weight(threads, 0.0);
         std::vector<char> range_cones(threads, 0);
         parallel_for_ranges(lights.size(), [&](std::size_t begin, std::size_t end, unsigned t) {
             glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
             std::size_t count = 0, black = 0;
+            double weight = 0.0;
             bool cones = false;
             for (std::size_t i = begin; i < end; ++i) {
                 if (!of_type(lights[i])) continue;
@@ -828,6 +860,7 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
                     continue;
                 }
                 ++count;
+                weight += leaf_weight(lights[i]);
                 const glm::vec3 p = tree_point(lights[i]);
                 lo = glm::min(lo, p);
                 hi = glm::max(hi, p);
@@ -835,15 +868,18 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
             }
             made[t + 1] = count;
             range_black[t] = black;
+            range_weight[t] = weight;
             range_lo[t] = lo;
             range_hi[t] = hi;
             range_cones[t] = cones ? 1 : 0;
         });
         glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
         bool has_cones = false;
+        double total_weight = 0.0;
         for (unsigned t = 0; t < threads; ++t) {
             made[t + 1] += made[t];
             tree.black_lights += range_black[t];
+            total_weight += range_weight[t];
             lo = glm::min(lo, range_lo[t]);
             hi = glm::max(hi, range_hi[t]);
             has_cones = has_cones || range_cones[t] != 0;
@@ -853,13 +889,22 @@ LightTree build_light_tree(std::span<const gpu::Light> lights, std::uint32_t see
         // Walter 2005 §4.1 sets c, which weighs directional against spatial
         // similarity, to the scene's diagonal; here the diagonal of this
         // tree's lights. Lights that emit everywhere have no cone term.
-        if (has_cones)
-            build.cone_weight = cone_scale * cone_scale * glm::dot(glm::dvec3(hi - lo), glm::dvec3(hi - lo));
+        if (has_cones) {
+            // The float difference, as always; in double where it overflows.
+            const glm::vec3 diagonal = hi - lo;
+            const glm::dvec3 d = glm::all(glm::lessThanEqual(glm::abs(diagonal), glm::vec3(std::numeric_limits<float>::max())))
+                                     ? glm::dvec3(diagonal)
+                                     : glm::dvec3(hi) - glm::dvec3(lo);
+            build.cone_weight = cone_scale * cone_scale * glm::dot(d, d);
+        }
+        metric_scales(build, lo, hi, total_weight);
         // Pass 2: the leaves' lights in light order, each with its Morton
         // key where the fast builder will sort them.
         const bool sorted = builder == TreeBuilder::kFast;
         const bool with_axis = build.cone_weight > 0.0;
-        const glm::vec3 extent = glm::max(hi - lo, glm::vec3(1e-30f));
+        // Finite where the box spans more than a float holds (a NaN key's
+        // conversion to an integer is undefined).
+        const glm::vec3 extent = glm::min(glm::max(hi - lo, glm::vec3(1e-30f)), glm::vec3(std::numeric_limits<float>::max()));
         std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
         reserve_huge(keyed, leaf_count);
         keyed.resize(leaf_count);

@@ -167,6 +167,69 @@ TEST(LightTree, InvariantsOnLargeDegenerateSets) {
     }
 }
 
+// The deepest leaf of the tree whose root is node 0.
+std::uint32_t tree_depth(const LightTree& tree) {
+    std::vector<std::uint32_t> depth(tree.nodes.size(), 0);
+    std::uint32_t deepest = 0;
+    for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
+        const gpu::LightNode& node = tree.nodes[i];
+        if (node.flags & gpu::kNodeLeaf) continue;
+        depth[node.left] = depth[node.left + 1] = depth[i] + 1;
+        deepest = std::max(deepest, depth[i] + 1);
+    }
+    return deepest;
+}
+
+// Scaling every position or every intensity by a power of two scales the
+// build's metric exactly, so the tree is the same, also where the metric's
+// floats would overflow inside what the loader accepts (positions at 2^60,
+// 1.2e18: 38,644 of 39,999 nodes differed, the tree 27% worse by its own
+// measure; intensities of 2^110 each, 20% worse); and oriented lights of
+// one axis spread over 1e20 no longer make a chain (infinity times a zero
+// cone term was NaN: depth 3999 for 4000 lights).
+TEST(LightTree, SameTreeWhereTheMetricsFloatsWouldOverflow) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f), w(0.5f, 1.0f);
+    std::vector<gpu::Light> lights;
+    for (int i = 0; i < 20000; ++i) lights.push_back(test::point_light({u(rng), u(rng), u(rng)}, {w(rng), w(rng), w(rng)}));
+    const LightTree reference = build_light_tree(lights, 1);
+    const auto same_shape = [&](const LightTree& t) {
+        ASSERT_EQ(t.nodes.size(), reference.nodes.size());
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < t.nodes.size(); ++i)
+            differ += t.nodes[i].left != reference.nodes[i].left || t.nodes[i].rep_light != reference.nodes[i].rep_light ||
+                      t.nodes[i].flags != reference.nodes[i].flags;
+        EXPECT_EQ(differ, 0u);
+    };
+    std::vector<gpu::Light> far = lights, bright = lights;
+    for (gpu::Light& l : far) l.x *= 0x1p60f, l.y *= 0x1p60f, l.z *= 0x1p60f;
+    for (gpu::Light& l : bright) l.r *= 0x1p110f, l.g *= 0x1p110f, l.b *= 0x1p110f;
+    {
+        SCOPED_TRACE("positions times 2^60");
+        same_shape(build_light_tree(far, 1));
+    }
+    {
+        SCOPED_TRACE("intensities times 2^110");
+        same_shape(build_light_tree(bright, 1));
+    }
+    std::vector<gpu::Light> spread;
+    for (int i = 0; i < 4000; ++i)
+        spread.push_back(test::oriented_light({u(rng) * 1e20f, u(rng) * 1e20f, u(rng) * 1e20f}, {0, 1, 0}, {1, 1, 1}));
+    const LightTree oriented = build_light_tree(spread, 1);
+    ASSERT_EQ(oriented.nodes.size(), 2u * spread.size() - 1u);
+    EXPECT_LE(tree_depth(oriented), 40u);  // log2(4000) = 12
+}
+
+// The exact builder's costs all infinite (six lights 9e18 apart, each of
+// 1e30): it merged a cluster with itself and wrote past the node array.
+TEST(LightTree, ExactBuilderWithInfiniteCosts) {
+    std::vector<gpu::Light> lights;
+    for (int i = 0; i < 6; ++i)
+        lights.push_back(test::point_light({float(i % 2) * 9e18f, float(i / 2 % 2) * 9e18f, float(i / 4) * 9e18f},
+                                           {1e30f, 1e30f, 1e30f}));
+    check_tree(build_light_tree(lights, 1, TreeBuilder::kExact), lights);
+}
+
 // Black lights stay out of the tree; lights 10^40 times dimmer than their
 // neighbours (denormal floats) stay in, and are picked as a cluster's
 // representative in proportion to intensity: never, where a bright light
