@@ -29,7 +29,8 @@
    quads, on both (cut_sharing "quad", shaders/quadcuts.comp); the kernels
    have no octets.
 
-Writes DIR/speed.md and DIR/speed.json (default out/speed). Nothing here
+Writes DIR/speed.md and DIR/speed.json (default out/speed), after each
+scene as well (marked incomplete until the run ends). Nothing here
 passes or fails. --quick: 32x32 (unless --size says otherwise), two scenes (CI's bench label runs it);
 --vulkan-only: part 3 alone.
 """
@@ -157,6 +158,18 @@ def main():
              "(the sky's background has no cut).", "",
              "| scene | cuts | K | relative RMSE | above 2% | mean cut | rays/px | samples that froze | time s |",
              "|---|---|---|---|---|---|---|---|---|"]
+    md_path, json_path = os.path.join(a.out, "speed.md"), os.path.join(a.out, "speed.json")
+
+    def save(partial):
+        """Writes speed.md and speed.json as they stand: after each scene
+        too, so that a run cut short keeps what it measured."""
+        body = lines + ([""] + table + ["", "(Incomplete: the run was still going when this was written.)"]
+                        if partial else [])
+        with open(md_path, "w") as f:
+            f.write("\n".join(body) + "\n")
+        with open(json_path, "w") as f:
+            json.dump({**results, "complete": not partial}, f, indent=1)
+
     for scene in [] if a.vulkan_only else scenes:
         why = missing(scene)
         if why:
@@ -194,6 +207,7 @@ def main():
                 pixel = s
             if sharing == "octet" and room:
                 lightcuts_times.append(s["seconds"]["render"])
+        save(partial=True)
         if not room:
             continue
         # Brute force's time drifts with the machine too (2.26 to 2.66 s
@@ -226,7 +240,9 @@ def main():
         lines.append(f"| {name} | {tb:.2f} ({brute_runs}) | {rb / pixels:.0f} | {tl:.3f} ({runs}) | {rl / pixels:.1f} | "
                      f"{tc:.4f} | {cb:.4f} | {cl:.4f} | {cl / cb:.2f} | {with_camera:.2f} | {tb / tl:.1f}x | {tp:.3f} | "
                      f"{rp / pixels:.1f} | {tb / tp:.1f}x |")
+        save(partial=True)
     lines += [""] + table + [""]
+    table = []
 
     # 3: Vulkan against the CPU, room 10^4, for the heap sizes that fit.
     if not a.no_vulkan:
@@ -294,8 +310,7 @@ def main():
                 lines.append("| 64, quads on both | | the device has no quad subgroup operations | | | | | |")
             lines.append("")
 
-    open(os.path.join(a.out, "speed.md"), "w").write("\n".join(lines) + "\n")
-    json.dump(results, open(os.path.join(a.out, "speed.json"), "w"), indent=1)
+    save(partial=False)
     print("\n".join(lines))
 
 
