@@ -6,6 +6,8 @@ JOBS ?= $(shell nproc)
 SCENE ?= scenes/room/room.json
 
 .PHONY: deps scenes build demo test clean
+# The packages first, whatever -j says: the scene generators need python3.
+.NOTPARALLEL:
 
 deps:
 	@./scripts/install-deps.sh
@@ -28,7 +30,7 @@ scenes/gallery/spots_1e4.csv: scripts/make_light_scenes.py
 	@python3 scripts/make_light_scenes.py --spots 10000 --out $@
 
 build: deps scenes
-	@test -f $(BUILD)/CMakeCache.txt || cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release >/dev/null
+	@test -f $(BUILD)/Makefile || cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release >/dev/null
 	@cmake --build $(BUILD) -j $(JOBS) >$(BUILD)/build.log 2>&1 || { cat $(BUILD)/build.log; exit 1; }
 
 demo: build
@@ -36,7 +38,7 @@ demo: build
 	@$(BUILD)/host/lightcuts render $(SCENE) -o out/room.exr --stats out/room-stats.json
 
 test: build
-	@cd $(BUILD) && LC_REQUIRE_VULKAN=1 ctest --output-on-failure -j $(JOBS)
+	@cd $(BUILD) && LC_REQUIRE_VULKAN=1 ctest --output-on-failure --no-tests=error -j $(JOBS)
 
 clean:
 	@rm -rf $(BUILD) out

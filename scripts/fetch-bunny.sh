@@ -16,7 +16,9 @@ fi
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 # Pinned version; npm checks the tarball against the registry's integrity hash.
-(cd "$tmp" && npm pack bunny@1.0.1 --silent --cache "$tmp/npm-cache" >/dev/null)
+# One try, its errors shown: without a network npm retried for over a minute, silently.
+(cd "$tmp" && npm pack bunny@1.0.1 --silent --fetch-retries=0 --fetch-timeout=20000 \
+   --cache "$tmp/npm-cache" >/dev/null)
 tar -xzf "$tmp"/bunny-1.0.1.tgz -C "$tmp"
 # Write next to the target and rename, so an interrupted run never leaves a
 # truncated OBJ that the check above would take for a finished one.

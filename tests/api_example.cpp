@@ -43,6 +43,10 @@ int main(int argc, char** argv) {
             const lc::CompareResult c = lc::compare_images(gpu.image, lc::render_cpu(prepared, options).image);
             std::printf("vulkan (%s): relative RMSE against the CPU %.2g\n", gpu.stats.device.c_str(),
                         c.relative_rmse);
+            if (!(c.relative_rmse < 1e-4)) {  // the two devices differ by rounding
+                std::fprintf(stderr, "error: the devices disagree\n");
+                return 1;
+            }
         } catch (const lc::NoVulkanDevice& e) {
             std::printf("no Vulkan device: %s\n", e.what());
         }
