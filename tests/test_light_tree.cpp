@@ -166,7 +166,9 @@ TEST(LightTree, InvariantsOnLargeDegenerateSets) {
         const LightTree tree = build_light_tree(*lights, 1);
         check_tree(tree, *lights);
         // Coincident lights pair up round by round: a balanced tree.
-        if (lights == &coincident) EXPECT_LE(tree_depth(tree), 20u);  // log2(50000) = 15.6
+        if (lights == &coincident) {
+            EXPECT_LE(tree_depth(tree), 20u);  // log2(50000) = 15.6
+        }
     }
 }
 
