@@ -538,8 +538,9 @@ int main(int argc, char** argv) {
         else
             std::fprintf(stderr,
                          "error: out of memory (the image's pixels and their statistics, the lights and the light "
-                         "tree, area-light samples and VPLs all grow with their settings; `lightcuts info SCENE` "
-                         "prints the buffers a scene needs)\n");
+                         "tree, area-light samples and VPLs, and each thread's cut heap, which --cut-heap and "
+                         "--max-cut size, all grow with their settings; `lightcuts info SCENE` prints the buffers a "
+                         "scene needs)\n");
         return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "error: %s\n", e.what());

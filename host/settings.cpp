@@ -27,6 +27,9 @@ std::string shortest(float v) {
 
 }  // namespace
 
+// lc_pixel_key (shaders/shared/shading.h) packs a pixel's x and y in 14 bits each.
+static_assert(kMaxImageSide <= (1u << 14), "image sides past 2^14 need another pixel key");
+
 std::string setting_problem(std::string_view key, double value) {
     constexpr double kMaxU32 = double(std::numeric_limits<std::uint32_t>::max());
     if (key == kSettingSpp) return integer_problem(value, 1, kMaxSpp);

@@ -1,6 +1,7 @@
 // The stochastic methods on the CPU (shaders/shared/sampling.h): the
 // probabilities tree descent gives the lights, and the unbiasedness of
 // --method sampled and --method stochastic against brute force.
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -411,6 +412,26 @@ TEST(Unbiased, DeterministicLightcutsIsBiasedWhereStochasticIsNot) {
 
 // The seed decides the light samples, so a render is the same for the same
 // seed (and thread count does not matter), and differs for another seed.
+// Every pixel of an image has its own random stream at each camera sample
+// (lc_pixel_key): x ^ lc_hash(y ^ ...) gave whole rows another row's
+// streams, e.g. row 4 at x and row 15448 at x ^ 9999 for every x of a
+// 16384-wide image, so their noise was alike.
+TEST(Sampling, EveryPixelHasItsOwnStream) {
+    PreparedScene p = prepare_scene(test::room_scene(mixed_lights(4, 7), 8), 1);
+    Kernel k = cpu::make_shade_kernel(p, nullptr);
+    for (std::uint32_t x = 0; x < 16384; ++x)
+        ASSERT_NE(k.lc_sample_stream(1u, x, 4u, 0u), k.lc_sample_stream(1u, x ^ 9999u, 15448u, 0u)) << x;
+    // Exhaustively over a 2048 x 2048 image, for two samples: no two pixels alike.
+    for (std::uint32_t s : {0u, 5u}) {
+        std::vector<std::uint32_t> streams;
+        streams.reserve(std::size_t(2048) * 2048);
+        for (std::uint32_t y = 0; y < 2048; ++y)
+            for (std::uint32_t x = 0; x < 2048; ++x) streams.push_back(k.lc_sample_stream(3u, x, y, s));
+        std::sort(streams.begin(), streams.end());
+        EXPECT_EQ(std::adjacent_find(streams.begin(), streams.end()), streams.end()) << s;
+    }
+}
+
 TEST(Sampling, SameSeedSameImageWhateverTheThreads) {
     PreparedScene p = prepare_scene(test::room_scene(mixed_lights(100, 2), 16), 1);
     for (const char* method : {"sampled", "stochastic"}) {

@@ -12,7 +12,7 @@
 // The random stream of camera sample `s` of pixel (x, y); a different
 // stream from the pixel jitter of lc_pixel_sample.
 uint lc_sample_stream(uint seed, uint x, uint y, uint s) {
-    return lc_hash(lc_hash(seed ^ 0x5bd1e995u) ^ lc_hash(x ^ lc_hash(y ^ lc_hash(s))));
+    return lc_hash(lc_hash(seed ^ 0x5bd1e995u) ^ lc_pixel_key(x, y, s));
 }
 
 // Sub-stream `k` of a stream: light sample k, or the cluster with node k.

@@ -30,6 +30,13 @@ LC_KCONST float kCosineAbsSlack = 1e-6f;
 // the grid of about sqrt(spp) columns (spp 8 would leave one cell of a
 // 3 x 3 grid empty, and that part of the pixel unseen: a bias), the strata
 // are spp columns of full height.
+// The key of camera sample `s` of pixel (x, y): the pixel's 28-bit index
+// (x and y below 2^14, kMaxImageSide) with the sample's hash. One pixel's
+// key for each pixel at a given sample: x ^ lc_hash(y ^ ...), x having 14
+// bits, gave rows of pixels the same keys as other rows (505 pairs of rows
+// at 16384 x 16384), so their random numbers, and their noise, were alike.
+uint lc_pixel_key(uint x, uint y, uint s) { return lc_hash(((y << 14u) | x) ^ lc_hash(s)); }
+
 vec2 lc_pixel_sample(uint x, uint y, uint s, uint spp, uint seed) {
     if (spp <= 1u) return vec2(float(x) + 0.5f, float(y) + 0.5f);
     uint cols = uint(ceil(sqrt(float(spp))));
@@ -38,7 +45,7 @@ vec2 lc_pixel_sample(uint x, uint y, uint s, uint spp, uint seed) {
         cols = spp;
         rows = 1u;
     }
-    uint h = lc_hash(seed ^ lc_hash(x ^ lc_hash(y ^ lc_hash(s))));
+    uint h = lc_hash(seed ^ lc_pixel_key(x, y, s));
     float jx = lc_unit_float(h);
     float jy = lc_unit_float(lc_hash(h));
     return vec2(float(x) + (float(s % cols) + jx) / float(cols),
