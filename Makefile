@@ -30,7 +30,7 @@ scenes/gallery/spots_1e4.csv: scripts/make_light_scenes.py
 	@python3 scripts/make_light_scenes.py --spots 10000 --out $@
 
 build: deps scenes
-	@test -f $(BUILD)/Makefile || cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release >/dev/null
+	@test -f $(BUILD)/Makefile || test -f $(BUILD)/build.ninja || cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release >/dev/null
 	@cmake --build $(BUILD) -j $(JOBS) >$(BUILD)/build.log 2>&1 || { cat $(BUILD)/build.log; exit 1; }
 
 demo: build

@@ -485,17 +485,24 @@ void best_partners(const MetricKeys& k, std::uint32_t* best, std::size_t begin, 
 // origin, passes float's range inside the scenes the loader accepts (an
 // extent of 10^18, or 10^33 per light over 10^4 lights): costs became
 // infinite, ties broken by the Morton order alone, or NaN (infinity times
-// a zero cone term), and the tree a chain. Where it could pass 2^100, the
-// positions are scaled by 2^-e with 2^e >= r and the weights by 2^-f with
-// 2^f >= the total: exact, and every cost then below about 50. Elsewhere
-// the scales are 1, and the trees bit for bit what they were.
+// a zero cone term), and the tree a chain. So the positions are scaled by
+// the smallest power of two that brings the geometric part (12 r^2 + 4 c^2)
+// to 2^100 or less, then the weights by the smallest that brings the whole
+// to 2^120 or less: exact, and no more than overflow needs, since what it
+// scales down may meet float's lower end (the costs of lights a centimetre
+// apart beside a sun 1.5e11 away). Where nothing would overflow the scales
+// are 1, and the trees bit for bit what they were.
 void metric_scales(Build& build, glm::vec3 lo, glm::vec3 hi, double total_weight) {
     const glm::dvec3 reach = glm::max(glm::abs(glm::dvec3(lo)), glm::abs(glm::dvec3(hi)));
     const double r = std::max({reach.x, reach.y, reach.z});
-    const double largest = total_weight * (12.0 * r * r + 4.0 * build.cone_weight);
-    if (largest <= 0x1p100) return;
-    if (r > 1.0) build.position_scale = float(std::ldexp(1.0, -std::ilogb(r) - 1));
-    if (total_weight > 1.0) build.weight_scale = float(std::ldexp(1.0, -std::ilogb(total_weight) - 1));
+    double geometric = 12.0 * r * r + 4.0 * build.cone_weight;
+    if (geometric > 0x1p100) {
+        const int j = (std::ilogb(geometric) - 100) / 2 + 1;  // 2^-2j brings it to 2^100 or less
+        build.position_scale = float(std::ldexp(1.0, -j));
+        geometric = std::ldexp(geometric, -2 * j);
+    }
+    const double largest = total_weight * geometric;
+    if (largest > 0x1p120) build.weight_scale = float(std::ldexp(1.0, -(std::ilogb(largest) - 120 + 1)));
 }
 
 // Locally-ordered clustering of leaves given in Morton order (leaf_key);

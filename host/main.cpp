@@ -496,13 +496,15 @@ int main(int argc, char** argv) {
             };
             for (int i = 1; i < argc; ++i) {
                 const std::string word = argv[i];
+                if (word == "--") break;  // what follows are arguments
                 if (command == nullptr && !is_option(word)) {
                     for (const CLI::App* c : app.get_subcommands([](CLI::App*) { return true; }))
                         if (c->check_name(word)) command = c;
                     continue;
                 }
                 if (!is_option(word)) continue;
-                const std::string name = word.substr(0, word.find('='));
+                // "--name=value", and "-oFILE", a short option with its value attached.
+                const std::string name = word[1] == '-' ? word.substr(0, word.find('=')) : word.substr(0, 2);
                 const CLI::App* in = command != nullptr ? command : &app;
                 if (in->get_option_no_throw(name) == nullptr && app.get_option_no_throw(name) == nullptr) {
                     std::fprintf(stderr, "error: unknown option %s%s\nRun with --help for more information.\n",

@@ -17,7 +17,7 @@ tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
 # Pinned version; npm checks the tarball against the registry's integrity hash.
 # One try, its errors shown: without a network npm retried for over a minute, silently.
-(cd "$tmp" && npm pack bunny@1.0.1 --silent --fetch-retries=0 --fetch-timeout=20000 \
+(cd "$tmp" && npm pack bunny@1.0.1 --loglevel=error --fetch-retries=0 --fetch-timeout=20000 \
    --cache "$tmp/npm-cache" >/dev/null)
 tar -xzf "$tmp"/bunny-1.0.1.tgz -C "$tmp"
 # Write next to the target and rename, so an interrupted run never leaves a

@@ -319,6 +319,18 @@ TEST(Gltf, AnOfferedWebpImageFallsBackToItsPng) {
     const Scene s = load_scene(used);
     EXPECT_EQ(s.textures.size(), load("materials.gltf").textures.size());
     EXPECT_TRUE(has_note(s, "extensionsUsed: EXT_texture_webp is not supported"));
+    // The same WebP embedded: tinygltf decodes no image/webp data URI, and
+    // took it for a file name; no material reads it, so a note, no error.
+    nlohmann::json embedded = doc;
+    embedded["images"].back()["uri"] = "data:image/webp;base64,UklGRhoAAABXRUJQVlA4IA==";
+    const Scene with_data = load_scene(dir.write("embedded.gltf", embedded.dump()));
+    EXPECT_EQ(with_data.textures.size(), s.textures.size());
+    EXPECT_TRUE(has_note(with_data, "a data URI of a type that is not read, and no material reads it"));
+    EXPECT_FALSE(has_note(with_data, "File not found"));
+    // Read by a material, it is an error naming its type.
+    embedded["textures"][0]["source"] = embedded["images"].size() - 1;
+    const fs::path read = dir.write("read.gltf", embedded.dump());
+    EXPECT_NE(error_of(read.string()).find("a data URI of type 'image/webp', which is not read"), std::string::npos);
     doc["extensionsRequired"] = {"EXT_texture_webp"};
     const fs::path required = dir.write("required.gltf", doc.dump());
     EXPECT_EQ(error_of(required.string()),
@@ -456,7 +468,8 @@ TEST(Gltf, CameraNamingAnOrthographicOneSaysSo) {
               file.string() + ": --camera: 'ortho' is an orthographic camera; only perspective cameras are read");
 }
 
-// A buffer must hold its byteLength, in a file or a data URI: tinygltf
+// A buffer must hold its byteLength, in a file or a data URI (a file may
+// hold more): tinygltf
 // said "File size mismatch" naming no field, or "Failed to decode 'uri'"
 // with the whole data URI (1.4 MB of message for a 1 MiB buffer). And a
 // '+' in a URI, which tinygltf reads as a space, is pointed out where the
@@ -479,6 +492,24 @@ TEST(Gltf, BuffersMustHoldTheirByteLength) {
     file = dir.write("short.gltf", doc.dump());
     EXPECT_EQ(error_of(file.string()), file.string() + ": buffers[0].byteLength: " + std::to_string(length) +
                                            ", but 'a%2Bb.bin' holds " + std::to_string(length - 1) + " bytes");
+    // Longer than byteLength is allowed (glTF 2.0, "Buffers"), and loads;
+    // tinygltf wanted the file exactly byteLength long. (The data URI's
+    // bytes, decoded here, then nine more.)
+    std::string decoded;
+    std::uint32_t bits = 0;
+    int held_bits = 0;
+    for (const char c : data.substr(data.find(',') + 1)) {
+        const std::string alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        if (c == '=') break;
+        bits = bits << 6 | std::uint32_t(alphabet.find(c));
+        if ((held_bits += 6) >= 8) decoded += char(bits >> (held_bits -= 8) & 0xFFu);
+    }
+    ASSERT_EQ(decoded.size(), length);
+    decoded.append(9, 'x');
+    std::ofstream(dir.path() / "long.bin", std::ios::binary).write(decoded.data(), std::streamsize(decoded.size()));
+    doc["buffers"][0]["uri"] = "long.bin";
+    EXPECT_EQ(load_scene(dir.write("long.gltf", doc.dump())).triangles.size(),
+              load_scene(kData / "triangle.gltf").triangles.size());
     doc["buffers"][0]["uri"] = "a+b.bin";
     file = dir.write("plus.gltf", doc.dump());
     EXPECT_EQ(error_of(file.string()),

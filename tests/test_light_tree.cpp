@@ -1,5 +1,6 @@
 // Light tree invariants on random and degenerate light sets.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -210,6 +211,31 @@ TEST(LightTree, SameTreeWhereTheMetricsFloatsWouldOverflow) {
     const LightTree oriented = build_light_tree(spread, 1);
     ASSERT_EQ(oriented.nodes.size(), 2u * spread.size() - 1u);
     EXPECT_LE(tree_depth(oriented), 40u);  // log2(4000) = 12
+}
+
+// Scaled no further than overflow needs: beside a sun-like light (3e25 at
+// 1.5e11), lights a centimetre apart keep their costs (scaled to keep
+// every coordinate below 1 and the total weight below 1, theirs became 0
+// and their tree was the ties' order). The exact builder, which pairs by
+// the costs alone, gives them the tree it gives them without the sun.
+TEST(LightTree, ScalingKeepsSmallCostsBesideHugeOnes) {
+    std::vector<gpu::Light> room;
+    for (int i = 0; i < 200; ++i)
+        room.push_back(test::point_light({0.01f * float(i % 10), 0.013f * float(i / 10 % 5), 0.017f * float(i / 50)},
+                                         {1.0f + 0.01f * float(i % 7), 1.0f, 1.0f}));
+    std::vector<gpu::Light> with_sun = room;
+    with_sun.push_back(test::point_light({1.5e11f, 0.0f, 0.0f}, {3e25f, 3e25f, 3e25f}));
+    const auto interior_boxes = [](const LightTree& t, float skip_above) {
+        std::vector<std::array<float, 6>> boxes;
+        for (const gpu::LightNode& n : t.nodes)
+            if (!(n.flags & gpu::kNodeLeaf) && n.max_x < skip_above)
+                boxes.push_back({n.min_x, n.min_y, n.min_z, n.max_x, n.max_y, n.max_z});
+        std::sort(boxes.begin(), boxes.end());
+        return boxes;
+    };
+    const LightTree alone = build_light_tree(room, 1, TreeBuilder::kExact);
+    const LightTree both = build_light_tree(with_sun, 1, TreeBuilder::kExact);
+    EXPECT_EQ(interior_boxes(both, 1e10f), interior_boxes(alone, 1e10f));
 }
 
 // The exact builder's costs all infinite (six lights 9e18 apart, each of

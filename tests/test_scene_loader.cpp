@@ -262,12 +262,13 @@ TEST(SceneLoader, ObjAndMtlNumbersThatAreNotNumbersAreRefused) {
         EXPECT_EQ(message.rfind(start, 0), 0u) << message << "\n  wanted: " << start;
     }
     // What the check lets through: signs, exponents, comments, tabs, CRLF
-    // and lone CR line ends, a vertex with a w or a colour, a vertex normal
+    // and lone CR line ends, a vertex with a w or a colour, the largest
+    // float as its shortest text (above FLT_MAX as a double), a vertex normal
     // of NaNs (the face normal replaces it), and MTL keys the renderer does
     // not read, whatever they hold.
     TempDir dir;
     dir.write("m.obj", "mtllib m.mtl\r\nv -0 +0 0.0 # a comment\r\nv\t1.e0 0 0 1\rv .5 1E+0 -0e-3 1 0.5 0\n"
-                       "vt 0.5\nvn nan -nan(ind) INF\nusemtl m\nf 1//1 2//1 3//1\n");
+                       "vt 0.5\nvt 3.4028235e38 0\nvn nan -nan(ind) INF\nusemtl m\nf 1//1 2//1 3//1\n");
     dir.write("m.mtl", "newmtl m\nKd 0.5 0.5 0.5\nd -halo 1\nNs 10\nKa spectral ident.rfl 1\nTf xyz 1 1 1\nKa 0.2\n");
     const fs::path scene = dir.write("s.json", R"({"camera": {"position": [0, 0.5, 3], "look_at": [0, 0.5, 0]},
  "meshes": [{"obj": "m.obj"}], "lights": [{"type": "point", "position": [0, 2, 1], "intensity": [1, 1, 1]}]})");

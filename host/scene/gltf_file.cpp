@@ -5,6 +5,7 @@
 #include <array>
 #include <cctype>
 #include <limits>
+#include <map>
 #include <string_view>
 #include <system_error>
 #include <vector>
@@ -94,11 +95,10 @@ std::uint64_t data_uri_bytes(const std::string& uri) {
 }
 
 // What makes a data URI's base64 undecodable ("" if nothing): a character
-// outside the alphabet, or a length not a multiple of 4.
+// outside the alphabet (tinygltf decodes unpadded base64 too).
 std::string base64_problem(const std::string& uri) {
     const std::size_t comma = uri.find(',');
     if (comma == std::string::npos) return "the data URI has no ',' before its data";
-    const std::size_t digits = uri.size() - comma - 1;
     for (std::size_t i = comma + 1; i < uri.size(); ++i) {
         const unsigned char c = static_cast<unsigned char>(uri[i]);
         const bool padding = c == '=' && i + 2 >= uri.size() && (i + 1 == uri.size() || uri[i + 1] == '=');
@@ -107,9 +107,13 @@ std::string base64_problem(const std::string& uri) {
                    (std::isprint(c) ? "'" + std::string(1, char(c)) + "'" : "byte " + std::to_string(int(c))) +
                    " at character " + std::to_string(i - comma - 1) + " of its data";
     }
-    if (digits % 4 != 0)
-        return "the data URI's base64 is " + std::to_string(digits) + " characters long, not a multiple of 4";
     return "";
+}
+
+// A data URI's media type, as written ("" where it has none).
+std::string data_uri_type(const std::string& uri) {
+    const std::size_t end = uri.find_first_of(";,", 5);
+    return uri.substr(5, end == std::string::npos ? std::string::npos : end - 5);
 }
 
 // tinygltf's messages quote a data URI whole (megabytes on one line):
@@ -132,6 +136,13 @@ struct GltfImages {
     std::vector<std::string> uris;  // the file each names; "" for a data URI or a buffer view
     std::vector<bool> used;         // whether a material reads a texture of the image
     std::uint64_t texels = 0;       // of the used images decoded so far, from their headers
+    // The buffers' files longer than their byteLength, by the path tinygltf
+    // opens: glTF allows them, tinygltf wants exactly byteLength bytes, so
+    // gltf_read_file gives it those.
+    std::map<std::string, std::uint64_t> buffer_lengths;
+    // Images no material reads whose data URIs tinygltf does not decode
+    // (image/webp, say): noted once here, tinygltf's two warnings dropped.
+    std::vector<std::size_t> unread_data_images;
 };
 
 // The file tinygltf 2.7 opens for a buffer's or an image's URI: the decoded
@@ -159,7 +170,7 @@ GltfImages check_uri_files(const nlohmann::json& doc, const std::string& base, c
         for (const nlohmann::json& image : *images) {
             const auto uri = image.is_object() ? image.find("uri") : image.end();
             const bool named = image.is_object() && uri != image.end() && uri->is_string() &&
-                               !tinygltf::IsDataURI(uri->get_ref<const std::string&>());
+                               uri->get_ref<const std::string&>().rfind("data:", 0) != 0;
             image_uris.push_back(named ? uri->get<std::string>() : std::string());
         }
     // The images of the textures that the materials' read slots name
@@ -198,20 +209,38 @@ GltfImages check_uri_files(const nlohmann::json& doc, const std::string& base, c
             if (uri == entry.end() || !uri->is_string()) continue;
             const std::string& text = uri->get_ref<const std::string&>();
             const std::string field = std::string(list) + "[" + std::to_string(i) + "]";
-            // tinygltf wants a buffer of exactly byteLength bytes, and says
-            // only "Failed to decode" with the whole data URI, or "File size
-            // mismatch", where it is not.
+            // A buffer must hold at least byteLength bytes (glTF 2.0,
+            // "Buffers"); tinygltf said only "Failed to decode" with the
+            // whole data URI, or "File size mismatch", where it did not.
             const auto length = entry.find("byteLength");
             const bool has_length = buffers && length != entry.end() && length->is_number_unsigned();
+            const std::uint64_t byte_length = has_length ? length->get<std::uint64_t>() : 0;
             if (text.empty()) continue;
-            if (tinygltf::IsDataURI(text)) {
+            if (text.rfind("data:", 0) == 0) {
+                if (!tinygltf::IsDataURI(text)) {
+                    // A type tinygltf does not decode (image/webp, say): no
+                    // error for an image no material reads, which a texture
+                    // may offer beside a PNG (tinygltf notes it as missing).
+                    if (!buffers && !(i < out.used.size() && out.used[i])) {
+                        out.unread_data_images.push_back(i);
+                        continue;
+                    }
+                    throw InputError(name, field + ".uri",
+                                     "a data URI of type '" + data_uri_type(text) + "', which is not read (" +
+                                         (buffers ? "a buffer's is application/octet-stream or application/gltf-buffer"
+                                                  : "an image a material reads is a PNG or a JPEG") +
+                                         ", in base64)");
+                }
                 if (const std::string problem = base64_problem(text); !problem.empty())
                     throw InputError(name, field + ".uri", problem);
                 const std::uint64_t held = data_uri_bytes(text);
-                if (has_length && held != length->get<std::uint64_t>())
+                if (has_length && held != byte_length)
                     throw InputError(name, field + ".byteLength",
-                                     std::to_string(length->get<std::uint64_t>()) + ", but its data URI holds " +
-                                         std::to_string(held) + " bytes");
+                                     std::to_string(byte_length) + ", but its data URI holds " + std::to_string(held) +
+                                         " bytes" +
+                                         (held > byte_length ? " (the glTF loader, tinygltf, reads a data URI of "
+                                                               "exactly byteLength bytes)"
+                                                             : ""));
                 continue;
             }
             // "%00" decodes to a NUL, which would end the name where the
@@ -233,10 +262,12 @@ GltfImages check_uri_files(const nlohmann::json& doc, const std::string& base, c
             if (!problem.empty()) throw InputError(name, field + ".uri", "'" + text + "' " + problem);
             std::error_code ec;
             const std::uintmax_t bytes = fs::file_size(file, ec);
-            if (has_length && !ec && bytes != length->get<std::uint64_t>())
+            if (has_length && !ec && bytes < byte_length)
                 throw InputError(name, field + ".byteLength",
-                                 std::to_string(length->get<std::uint64_t>()) + ", but '" + text + "' holds " +
-                                     std::to_string(bytes) + " bytes");
+                                 std::to_string(byte_length) + ", but '" + text + "' holds " + std::to_string(bytes) +
+                                     " bytes");
+            if (has_length && !ec && bytes > byte_length)
+                out.buffer_lengths[file.lexically_normal().string()] = byte_length;
         }
     }
     return out;
@@ -293,6 +324,7 @@ bool load_image_checked(tinygltf::Image* image, const int index, std::string* er
 // through wordexp).
 struct GltfFolder {
     std::string prefix;  // the folder and a '/', as tinygltf joins it to a URI
+    const std::map<std::string, std::uint64_t>* buffer_lengths;  // GltfImages'
 };
 
 bool gltf_file_exists(const std::string& path, void* folder) {
@@ -301,10 +333,14 @@ bool gltf_file_exists(const std::string& path, void* folder) {
 
 std::string gltf_expand_path(const std::string& path, void*) { return path; }
 
-bool gltf_read_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void*) {
+bool gltf_read_file(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* folder) {
     try {
         const std::string bytes = read_input_file(path);
-        out->assign(bytes.begin(), bytes.end());
+        std::size_t keep = bytes.size();
+        const auto& lengths = *static_cast<const GltfFolder*>(folder)->buffer_lengths;
+        if (const auto it = lengths.find(fs::path(path).lexically_normal().string()); it != lengths.end())
+            keep = std::min<std::uint64_t>(keep, it->second);
+        out->assign(bytes.begin(), bytes.begin() + std::ptrdiff_t(keep));
         return true;
     } catch (const std::exception& e) {
         if (err != nullptr) *err = e.what();
@@ -361,7 +397,7 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
 
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(load_image_checked, &images);
-    GltfFolder folder{base.back() == '/' ? base : base + "/"};
+    GltfFolder folder{base.back() == '/' ? base : base + "/", &images.buffer_lengths};
     gltf.SetFsCallbacks({gltf_file_exists, gltf_expand_path, gltf_read_file, gltf_write_file, &folder});
     tinygltf::Model model;
     std::string err, warn;
@@ -379,11 +415,25 @@ tinygltf::Model read_gltf_file(const fs::path& file, GltfNotes& notes) {
         throw InputError(name, "", "tinygltf: " + (err.empty() ? std::string("cannot parse the file")
                                                                 : shortened_data_uris(trimmed(err))));
     warn = trimmed(warn);
+    // tinygltf takes a data URI of a type it does not decode for a file
+    // name: its "File not found" and "Failed to load" for such an unread
+    // image give way to one note.
+    const auto about_unread_data_image = [&](const std::string& line) {
+        if (line.rfind("File not found : data:", 0) == 0) return !images.unread_data_images.empty();
+        for (const std::size_t i : images.unread_data_images)
+            if (line.find("for image[" + std::to_string(i) + "]") != std::string::npos) return true;
+        return false;
+    };
     for (std::size_t from = 0; from < warn.size();) {
         const std::size_t end = std::min(warn.find('\n', from), warn.size());
-        if (end > from) notes.add("", "tinygltf: " + shortened_data_uris(warn.substr(from, end - from)));
+        const std::string line = warn.substr(from, end - from);
+        if (end > from && !about_unread_data_image(line)) notes.add("", "tinygltf: " + shortened_data_uris(line));
         from = end + 1;
     }
+    for (const std::size_t i : images.unread_data_images)
+        notes.add("images[" + std::to_string(i) + "].uri",
+                  "a data URI of a type that is not read, and no material reads it (an extension's offer beside "
+                  "a PNG or JPEG, say)");
     for (const std::string& ext : model.extensionsUsed)
         if (!supported(ext)) notes.add("extensionsUsed", ext + " is not supported; what it adds is ignored");
     if (!model.animations.empty())

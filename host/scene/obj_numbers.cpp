@@ -53,9 +53,12 @@ bool is_non_finite(std::string_view w) {
 // A number past float's range ("1e99999", "4e38"), which tinyobjloader
 // reads as 0 or as infinity without a word (a vertex at 1e99999 made its
 // triangle degenerate, and the error said only that none were left).
+// What rounds to the largest float is within it ("3.4028235e38", the
+// shortest text of it); halfway to the next power of two rounds to
+// infinity.
 bool past_float_range(std::string_view w) {
     const double value = std::strtod(std::string(w).c_str(), nullptr);
-    return !(std::abs(value) <= double(std::numeric_limits<float>::max()));
+    return !(std::abs(value) < double(std::numeric_limits<float>::max()) + 0x1p103);
 }
 
 // Words 1.. of `line` are `least` or more numbers (all of them numbers

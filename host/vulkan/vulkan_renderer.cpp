@@ -122,7 +122,7 @@ bool share_cuts(const Context& ctx, const LightTree& tree, const RenderOptions& 
             const std::uint64_t fits = offered / (gpu::kWorkgroupSize * sizeof(gpu::QuadCutEntry)) / 4u;
             why = "a quad's heap of " + std::to_string(slots) + " slots needs " + std::to_string(bytes) +
                   " bytes of shared memory per workgroup, the device offers " + std::to_string(offered) +
-                  (fits > 0 ? "; use cut_heap " + std::to_string(fits) + " or less," : ";");
+                  (fits > 0 ? "; use cut_heap " + std::to_string(fits) + " or less," : "");
         }
     }
     if (why.empty()) return true;
