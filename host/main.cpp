@@ -92,16 +92,24 @@ lc::RenderOptions render_options(const RenderArgs& a, const lc::Scene& scene) {
     return o;
 }
 
+// Whether any triangle of the scene emits light (what --area-samples samples).
+bool has_emitters(const lc::Scene& scene) {
+    return std::any_of(scene.triangles.begin(), scene.triangles.end(), [&](const lc::gpu::Triangle& t) {
+        return (scene.materials[t.material].flags & lc::gpu::kMaterialEmissive) != 0;
+    });
+}
+
 // The options given on the command line that the render does not use, as
 // one note ("" if none): a render that ignores what it was told says so,
-// and why: the method, or (the VPLs' settings) that it makes no VPLs.
-std::string unused_options_note(const RenderArgs& a, const std::string& method, bool vpls) {
+// and why: the method, that it makes no VPLs (their settings), or that
+// the scene has no emissive surface (--area-samples).
+std::string unused_options_note(const RenderArgs& a, const std::string& method, bool vpls, bool emitters) {
     const bool cuts = method == "lightcuts" || method == "stochastic";
     const bool path = method == "path";
     const struct {
         bool given, used_by_method;
         const char* name;
-        bool needs_vpls;
+        bool needs_vpls, needs_emitters = false;
     } options[] = {
         {a.relative_error.has_value(), cuts, "--error", false},
         {a.max_cut.has_value(), cuts, "--max-cut", false},
@@ -112,12 +120,12 @@ std::string unused_options_note(const RenderArgs& a, const std::string& method, 
         {!a.light_pick.empty(), method == "sampled", "--light-pick", false},
         {a.max_bounces.has_value(), path, "--max-bounces", false},
         {a.time_limit.has_value(), path, "--time-limit", false},
-        {a.area_samples.has_value(), !path, "--area-samples", false},
+        {a.area_samples.has_value(), !path, "--area-samples", false, true},
         {a.vpls.has_value(), !path, "--vpls", false},
         {a.vpl_bounces.has_value(), !path, "--vpl-bounces", true},
         {a.vpl_clamp.has_value(), !path, "--vpl-clamp", true},
     };
-    std::string by_method, by_vpls;
+    std::string by_method, by_vpls, by_emitters;
     const auto add = [](std::string& list, const char* name) { list += (list.empty() ? "" : ", ") + std::string(name); };
     for (const auto& o : options) {
         if (!o.given) continue;
@@ -125,12 +133,17 @@ std::string unused_options_note(const RenderArgs& a, const std::string& method, 
             add(by_method, o.name);
         else if (o.needs_vpls && !vpls)
             add(by_vpls, o.name);
+        else if (o.needs_emitters && !emitters)
+            add(by_emitters, o.name);
     }
     std::string note;
     if (!by_method.empty()) note = "method " + method + " does not use " + by_method;
     if (!by_vpls.empty())
         note += (note.empty() ? "" : "; ") + std::string("this render makes no VPLs (") +
                 (a.vpls ? "--vpls 0" : "no --vpls, nor render.indirect.vpls") + "): it does not use " + by_vpls;
+    if (!by_emitters.empty())
+        note += (note.empty() ? "" : "; ") + std::string("the scene has no emissive surface: it does not use ") +
+                by_emitters;
     return note;
 }
 
@@ -187,7 +200,8 @@ int run_render(RenderArgs a) {
     // Every output is checked and reserved before the render; none is left if any fails.
     lc::OutputSet outputs = lc::reserve_render_outputs(a.outputs, a.scene, options.method, scene.input_files);
     // After the checks, so that a refused command reads as one error.
-    if (const std::string note = unused_options_note(a, options.method, scene.render.indirect.vpls > 0);
+    if (const std::string note =
+            unused_options_note(a, options.method, scene.render.indirect.vpls > 0, has_emitters(scene));
         !note.empty())
         std::fprintf(stderr, "note: %s\n", note.c_str());
 
@@ -299,7 +313,8 @@ int run_info(const std::string& file, const lc::SceneOptions& options, const Inf
     as_render.area_samples = a.area_samples;
     as_render.vpls = a.vpls;
     as_render.vpl_bounces = a.vpl_bounces;
-    if (const std::string note = unused_options_note(as_render, method, scene.render.indirect.vpls > 0);
+    if (const std::string note =
+            unused_options_note(as_render, method, scene.render.indirect.vpls > 0, has_emitters(scene));
         !note.empty())
         std::fprintf(stderr, "note: %s\n", note.c_str());
     std::size_t emissive = 0;

@@ -271,6 +271,14 @@ grep -qx "note: method lightcuts does not use --light-pick; this render makes no
   >/dev/null 2>"$tmp/unused.txt" && fail "--cut-heatmap with brute force was accepted"
 [ "$(wc -l <"$tmp/unused.txt")" = 1 ] && grep -q "^error: " "$tmp/unused.txt" ||
   fail "a refused render with an unused option said: $(cat "$tmp/unused.txt")"
+# --area-samples on a scene without emissive surfaces is said to be unused;
+# on one with them it is not.
+"$exe" render "$mini" -o "$tmp/unused.exr" --no-png --device cpu --width 2 --height 2 --area-samples 100 \
+  >/dev/null 2>"$tmp/unused.txt" || fail "--area-samples without emitters: $(cat "$tmp/unused.txt")"
+grep -qx "note: the scene has no emissive surface: it does not use --area-samples" "$tmp/unused.txt" ||
+  fail "--area-samples without emitters said: $(cat "$tmp/unused.txt")"
+"$exe" info "$gltf/emissive_only.gltf" --area-samples 100 >/dev/null 2>"$tmp/unused.txt" || fail "info --area-samples"
+grep -q "does not use" "$tmp/unused.txt" && fail "--area-samples with emitters said: $(cat "$tmp/unused.txt")"
 # info names the options its method leaves unused, and the emissive
 # triangles the path tracer samples.
 "$exe" info "$gltf/emissive_only.gltf" --method path --vpls 100 >"$tmp/info_path.txt" 2>"$tmp/unused.txt" ||
