@@ -92,13 +92,6 @@ lc::RenderOptions render_options(const RenderArgs& a, const lc::Scene& scene) {
     return o;
 }
 
-// Whether any triangle of the scene emits light (what --area-samples samples).
-bool has_emitters(const lc::Scene& scene) {
-    return std::any_of(scene.triangles.begin(), scene.triangles.end(), [&](const lc::gpu::Triangle& t) {
-        return (scene.materials[t.material].flags & lc::gpu::kMaterialEmissive) != 0;
-    });
-}
-
 // The options given on the command line that the render does not use, as
 // one note ("" if none): a render that ignores what it was told says so,
 // and why: the method, that it makes no VPLs (their settings), or that
@@ -201,7 +194,8 @@ int run_render(RenderArgs a) {
     lc::OutputSet outputs = lc::reserve_render_outputs(a.outputs, a.scene, options.method, scene.input_files);
     // After the checks, so that a refused command reads as one error.
     if (const std::string note =
-            unused_options_note(a, options.method, scene.render.indirect.vpls > 0, has_emitters(scene));
+            unused_options_note(a, options.method, scene.render.indirect.vpls > 0,
+                                scene.count_emissive_triangles() > 0);
         !note.empty())
         std::fprintf(stderr, "note: %s\n", note.c_str());
 
@@ -313,13 +307,10 @@ int run_info(const std::string& file, const lc::SceneOptions& options, const Inf
     as_render.area_samples = a.area_samples;
     as_render.vpls = a.vpls;
     as_render.vpl_bounces = a.vpl_bounces;
-    if (const std::string note =
-            unused_options_note(as_render, method, scene.render.indirect.vpls > 0, has_emitters(scene));
+    const std::size_t emissive = scene.count_emissive_triangles();
+    if (const std::string note = unused_options_note(as_render, method, scene.render.indirect.vpls > 0, emissive > 0);
         !note.empty())
         std::fprintf(stderr, "note: %s\n", note.c_str());
-    std::size_t emissive = 0;
-    for (const lc::gpu::Triangle& t : scene.triangles)
-        emissive += (scene.materials[t.material].flags & lc::gpu::kMaterialEmissive) != 0;
     std::printf("%s\n", file.c_str());
     std::printf("  method             %s\n", method.c_str());
     std::printf("  triangles          %zu (%zu emissive, %zu degenerate dropped)\n", scene.triangles.size(),

@@ -179,8 +179,7 @@ RenderReport make_report(const std::string& scene_file, const RenderOptions& opt
     }
     r.triangles = prepared.scene.triangles.size();
     r.lights = prepared.tree.lights.size();
-    for (const gpu::Triangle& t : prepared.scene.triangles)
-        if (prepared.scene.materials[t.material].flags & gpu::kMaterialEmissive) ++r.emissive_triangles;
+    r.emissive_triangles = prepared.scene.count_emissive_triangles();
     r.environment_map = prepared.scene.environment.width > 0;
     r.bvh_nodes = prepared.bvh.nodes.size();
     r.black_lights = prepared.tree.black_lights;

@@ -15,6 +15,12 @@ std::size_t Scene::count_lights(std::uint32_t type) const {
         std::count_if(lights.begin(), lights.end(), [type](const gpu::Light& l) { return l.type == type; }));
 }
 
+std::size_t Scene::count_emissive_triangles() const {
+    return static_cast<std::size_t>(std::count_if(triangles.begin(), triangles.end(), [this](const gpu::Triangle& t) {
+        return (materials[t.material].flags & gpu::kMaterialEmissive) != 0u;
+    }));
+}
+
 // Lights stay out of the box: it scales the inverse-square clamp, and one
 // far light must not change the clamp of the whole image.
 void update_bounds(Scene& scene) {

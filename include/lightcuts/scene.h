@@ -88,6 +88,9 @@ struct Scene {
     glm::vec3 bounds_max{0.0f};
 
     std::size_t count_lights(std::uint32_t type) const;
+    // Triangles whose material emits: what area-light samples and the path
+    // tracer's emitters come from.
+    std::size_t count_emissive_triangles() const;
 };
 
 struct SceneOptions {
