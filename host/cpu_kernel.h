@@ -29,18 +29,18 @@ namespace lc::cpu {
 using namespace glm;
 using namespace lc::gpu;
 
-// GLSL's abs for the kernels, as GPUs do it: the sign bit cleared, one
-// instruction. glm's abs is x >= 0 ? x : -x, which keeps -0 and so compiles
-// to a compare and a branch per component; in the cluster bound those
-// branches follow the box's side of the point and were mispredicted.
-// Found before glm's by unqualified lookup in the kernel structs below (and
-// preferred to its template for vectors).
 // Whether the environment variable `name` is "1" (the benchmarks' switches).
 inline bool environment_flag(const char* name) {
     const char* value = std::getenv(name);
     return value != nullptr && std::string_view(value) == "1";
 }
 
+// GLSL's abs for the kernels, as GPUs do it: the sign bit cleared, one
+// instruction. glm's abs is x >= 0 ? x : -x, which keeps -0 and so compiles
+// to a compare and a branch per component; in the cluster bound those
+// branches follow the box's side of the point and were mispredicted.
+// Found before glm's by unqualified lookup in the kernel structs below (and
+// preferred to its template for vectors).
 inline float abs(float x) { return std::fabs(x); }
 inline vec2 abs(vec2 v) { return vec2(std::fabs(v.x), std::fabs(v.y)); }
 inline vec3 abs(vec3 v) { return vec3(std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)); }

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cpu_kernel.h"
 #include "gltf_room.h"
 #include "lightcuts/error.h"
 #include "lightcuts/render.h"
@@ -148,6 +149,17 @@ TEST(Gltf, StripsAndFansAreTriangulatedPointsAndLinesSkippedWithANote) {
     EXPECT_TRUE(has_note(s, "primitives[3].mode: LINES is not drawn"));
 }
 
+// The Disney sheen colour of a material before metallic's share takes its
+// part: what glTF's sheenColorFactor describes.
+glm::vec3 sheen_colour(const gpu::Material& m) {
+    cpu::ShadeKernel kernel{};
+    return m.sheen * glm::mix(glm::vec3(1.0f), kernel.lc_disney_tint(m), m.sheen_tint);
+}
+
+void expect_near3(glm::vec3 got, glm::vec3 want) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 1e-6f * std::max(1.0f, want[c])) << "channel " << c;
+}
+
 TEST(Gltf, MetallicRoughnessAndExtensionsBecomeDisneyParameters) {
     const Scene s = load("materials.gltf");
     ASSERT_EQ(s.triangles.size(), 3u);
@@ -162,9 +174,10 @@ TEST(Gltf, MetallicRoughnessAndExtensionsBecomeDisneyParameters) {
     EXPECT_FLOAT_EQ(m.clearcoat, 0.6f);
     EXPECT_FLOAT_EQ(m.clearcoat_gloss, 0.8f);
     EXPECT_NE(m.flags & gpu::kMaterialHasClearcoat, 0u);
-    // Sheen colour = the base colour: the largest component, fully tinted.
-    EXPECT_EQ(m.sheen, 0.5f);
+    // A sheen colour of the base colour's hue: fully tinted, and the colour
+    // the BRDF uses (before metallic's share) is the glTF one.
     EXPECT_FLOAT_EQ(m.sheen_tint, 1.0f);
+    expect_near3(sheen_colour(m), glm::vec3(0.5f, 0.25f, 0.125f));
     // emissiveFactor x emissiveStrength 8, both sides (doubleSided).
     EXPECT_EQ(glm::vec3(m.emission_r, m.emission_g, m.emission_b), glm::vec3(8.0f, 4.0f, 2.0f));
     EXPECT_NE(m.flags & gpu::kMaterialEmitsBothSides, 0u);
@@ -173,6 +186,7 @@ TEST(Gltf, MetallicRoughnessAndExtensionsBecomeDisneyParameters) {
     // Grey sheen on a white base: no tint.
     EXPECT_EQ(noted.sheen, 0.5f);
     EXPECT_EQ(noted.sheen_tint, 0.0f);
+    expect_near3(sheen_colour(noted), glm::vec3(0.5f));
     EXPECT_EQ(noted.base_color_texture, gpu::kInvalidIndex);  // TEXCOORD_1: left out
     EXPECT_EQ(noted.flags & gpu::kMaterialEmissive, 0u);
     for (const char* note : {"texCoord: uses TEXCOORD_1", "alphaMode: BLEND", "occlusionTexture",
@@ -182,6 +196,53 @@ TEST(Gltf, MetallicRoughnessAndExtensionsBecomeDisneyParameters) {
     EXPECT_FALSE(has_note(s, "KHR_texture_transform"));
     // The primitive without a material: the default one.
     EXPECT_EQ(s.materials[s.triangles[2].material].metallic, 1.0f);
+}
+
+// The kernel tints sheen by the base colour over its luminance, which is
+// brighter than the base's largest component: a blue sheen on a blue base
+// came out 13.9 times too bright when the fit took the tint as the base
+// over its largest component. Sheens of the base's hue and grey ones come
+// out exactly; one between them keeps its largest component and lies
+// between the two in every channel.
+TEST(Gltf, SheenColourIsTheFilesWhereDisneysSheenCanTakeIt) {
+    test::TempDir dir;
+    std::ifstream in(kData / "materials.gltf", std::ios::binary);
+    const nlohmann::json doc = nlohmann::json::parse(in);
+    struct Case {
+        glm::vec3 base, sheen;
+    };
+    for (const Case& c : {Case{{0.0f, 0.0f, 1.0f}, {0.0f, 0.0f, 1.0f}}, Case{{1.0f, 0.05f, 0.05f}, {1.0f, 0.05f, 0.05f}},
+                          Case{{1.0f, 0.05f, 0.05f}, {0.3f, 0.3f, 0.3f}}, Case{{0.2f, 0.6f, 0.1f}, {0.1f, 0.3f, 0.05f}},
+                          Case{{0.0f, 0.0f, 0.0f}, {0.2f, 0.4f, 0.8f}}}) {
+        nlohmann::json edited = doc;
+        nlohmann::json& material = edited["materials"][0];
+        material["pbrMetallicRoughness"]["baseColorFactor"] = {c.base.r, c.base.g, c.base.b, 1.0};
+        material["extensions"]["KHR_materials_sheen"]["sheenColorFactor"] = {c.sheen.r, c.sheen.g, c.sheen.b};
+        const Scene s = load_scene(dir.write("sheen.gltf", edited.dump()));
+        const gpu::Material& m = s.materials[s.triangles[0].material];
+        SCOPED_TRACE(testing::Message() << "base " << c.base.r << " " << c.base.g << " " << c.base.b);
+        EXPECT_GE(m.sheen, 0.0f);
+        EXPECT_LE(m.sheen, 1.0f);
+        // A black base has a white tint: the sheen's grey nearest the file's.
+        if (c.base == glm::vec3(0.0f)) {
+            expect_near3(sheen_colour(m), glm::vec3(0.8f));
+        } else {
+            expect_near3(sheen_colour(m), c.sheen);
+        }
+    }
+    // Between grey and the base's hue: the largest component is the file's,
+    // the colour partly tinted.
+    nlohmann::json edited = doc;
+    edited["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = {0.0, 0.0, 1.0, 1.0};
+    edited["materials"][0]["extensions"]["KHR_materials_sheen"]["sheenColorFactor"] = {0.5, 0.5, 1.0};
+    const Scene s = load_scene(dir.write("between.gltf", edited.dump()));
+    const gpu::Material& m = s.materials[s.triangles[0].material];
+    EXPECT_GT(m.sheen_tint, 0.0f);
+    EXPECT_LT(m.sheen_tint, 1.0f);
+    const glm::vec3 got = sheen_colour(m);
+    EXPECT_NEAR(got.b, 1.0f, 1e-6f);
+    EXPECT_NEAR(got.r, 0.5f, 1e-6f);  // the least-squares fit of (0.5, 0.5, 1) on mix(white, blue, u)
+    EXPECT_NEAR(got.g, 0.5f, 1e-6f);
 }
 
 TEST(Gltf, TexturesAreAddedOncePerImageWithTheirTexelsAndUvs) {

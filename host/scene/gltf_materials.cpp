@@ -11,6 +11,7 @@
 
 #include "lightcuts/error.h"
 #include "materials.h"
+#include "shared/color.h"
 #include "textures.h"
 
 namespace lc::loader {
@@ -123,17 +124,34 @@ bool has_any(const tinygltf::Value& ext, std::initializer_list<const char*> keys
     return false;
 }
 
-// Disney's sheen colour is mix(white, tint, sheen_tint), the tint being the
-// base colour's hue. With both colours scaled to a largest component of 1,
-// sheen_tint is the least-squares t that brings mix(white, tint, t) nearest
-// the glTF sheen colour: 0 for a grey sheen, 1 for one of the base's hue.
-float sheen_tint(glm::vec3 sheen_colour, float sheen, glm::vec3 base) {
+// Disney's sheen colour is sheen * mix(white, tint, sheen_tint), the tint
+// being the base colour over its luminance (lc_disney_tint), so a tinted
+// sheen is brighter than `sheen` in the base's strongest channel. The fit
+// matches the glTF sheen colour s in hue by least squares (both scaled to
+// a largest component of 1, where the tinted family is mix(white, c, u)
+// with c = base / max(base)), turns u into the kernel's sheen_tint t, and
+// sets sheen so that the colour's largest component is max(s): a sheen of
+// the base colour's hue, or a grey one, comes out as s exactly.
+struct SheenFit {
+    float sheen = 0.0f;
+    float tint = 0.0f;
+};
+
+SheenFit fit_sheen(glm::vec3 s, glm::vec3 base) {
+    const float s_max = std::max({s.r, s.g, s.b});
+    if (!(s_max > 0.0f)) return {};
     const float base_max = std::max({base.r, base.g, base.b});
-    const glm::vec3 tint = base_max > 0.0f ? base / base_max : glm::vec3(1.0f);
-    const glm::vec3 towards = tint - 1.0f;
+    const float luminance = gpu::lc_luminance(base);
+    if (!(base_max > 0.0f && luminance > 0.0f)) return {s_max, 0.0f};  // the tint is white
+    const glm::vec3 towards = base / base_max - 1.0f;
     const float length2 = glm::dot(towards, towards);
-    if (!(length2 > 1e-12f)) return 0.0f;
-    return std::clamp(glm::dot(sheen_colour / sheen - 1.0f, towards) / length2, 0.0f, 1.0f);
+    if (!(length2 > 1e-12f)) return {s_max, 0.0f};  // a grey base: tinting changes nothing
+    const float u = std::clamp(glm::dot(s / s_max - 1.0f, towards) / length2, 0.0f, 1.0f);
+    // mix(white, base / luminance, t) scaled to a largest component of 1 is
+    // mix(white, c, u) for u = t M / (1 + t (M - 1)), M = max(base) / luminance.
+    const float big = base_max / luminance;
+    const float t = u / (u + big * (1.0f - u));
+    return {s_max / (1.0f + t * (big - 1.0f)), t};
 }
 
 }  // namespace
@@ -159,8 +177,9 @@ DisneyParams GltfMaterials::params(const tinygltf::Material& g, const std::strin
     const std::string sheen_name = name + ".extensions.KHR_materials_sheen";
     const tinygltf::Value& sheen = extension(g, "KHR_materials_sheen");
     const glm::vec3 sheen_colour = read.colour(sheen, "sheenColorFactor", sheen_name);
-    p.sheen = std::max({sheen_colour.r, sheen_colour.g, sheen_colour.b});
-    if (p.sheen > 0.0f) p.sheen_tint = sheen_tint(sheen_colour, p.sheen, p.base_color);
+    const SheenFit fit = fit_sheen(sheen_colour, p.base_color);
+    p.sheen = fit.sheen;
+    p.sheen_tint = fit.tint;
     if (read.number(sheen, "sheenRoughnessFactor", 0.0, 1.0, sheen_name) > 0.0f)
         notes_.add(sheen_name + ".sheenRoughnessFactor", "not used (Disney's sheen has no roughness)");
     if (has_any(sheen, {"sheenColorTexture", "sheenRoughnessTexture"}))
