@@ -43,6 +43,14 @@ struct Totals {
 // H rows keep sub = 1 up to about 1.3 H^2 directions (83,000 for the
 // shipped sky's 512 x 256, rendered with 3000; a 64 x 32 map gets two
 // bands a row from about 1300).
+//
+// Columns are cut the same way, into `csub` bands of equal azimuth, where a
+// texel column is wider than a direction's square at the equator: a map 1
+// to 4 texels wide put each texel's light on its column's middle azimuth,
+// so under a constant 1 x 4096 sky a plane facing -Z got 2.9 times its
+// light and one facing +Z none, and the single texel of a `color` sky gave
+// its 3000 directions 17 azimuths, whose shadows were spokes. A 2:1 map W
+// texels wide keeps csub = 1 up to about W^2 / pi directions.
 class Splitter {
 public:
     Splitter(const Environment& map, std::uint32_t count, std::vector<gpu::Light>& out) : map_(map), out_(out) {
@@ -50,17 +58,35 @@ public:
         double tallest = 0.0;
         for (std::uint32_t y = 0; y < map.height; ++y)
             tallest = std::max(tallest, std::cos(kPi * y / map.height) - std::cos(kPi * (y + 1) / map.height));
-        const double wanted = std::ceil(tallest * std::sqrt(count / (4.0 * kPi)) - 1e-9);
+        const double side = std::sqrt(count / (4.0 * kPi));  // directions along a radian
+        const double wanted = std::ceil(tallest * side - 1e-9);
+        const double column_width = 2.0 * kPi / map.width * side;  // in directions' sides, at the equator
         // At most 2^22 rows x columns beyond the map's own (each level of the
-        // split passes over them all).
+        // split passes over them all), the rows' bands taken first.
         const double texels = double(map.width) * map.height;
-        sub_ = std::uint32_t(
-            std::clamp(std::min(wanted, std::floor(std::max(texels, 4194304.0) / texels)), 1.0, double(count)));
+        const double allowed = std::floor(std::max(texels, 4194304.0) / texels);
+        sub_ = std::uint32_t(std::clamp(std::min(wanted, allowed), 1.0, double(count)));
         // Where a texel row straddles the equator (an odd number of rows),
         // an even number of bands puts a boundary on it, the horizon of a
         // plane facing a pole.
         if (sub_ > 1 && map.height % 2 == 1) sub_ += sub_ % 2;
+        // Only where a column is at least two directions wide, and where the
+        // rows are cut too or the map has several: a column band of a single
+        // row reaches from pole to pole, and its one direction would sit on
+        // the equator (a 1 x 1 map with 2 directions lit neither an upward
+        // nor a downward plane); and a direction's part of a few bands takes
+        // their mean direction, nearer the pole than their middle (a 2 x 1
+        // map with 4 directions, cut, lit an upward plane 26% too brightly).
+        if (map.height * sub_ >= 2 && column_width >= 2.0)
+            csub_ = std::uint32_t(
+                std::clamp(std::min(std::ceil(column_width - 1e-9), std::floor(allowed / sub_)), 1.0, double(count)));
+        // Likewise a boundary at every quarter of the azimuth (u = 0, 1/4,
+        // 1/2, 3/4), the horizons of planes facing +-X and +-Z, where the
+        // room allows.
+        if (csub_ > 1)
+            while ((std::uint64_t(map.width) * csub_) % 4 != 0 && double(sub_) * (csub_ + 1) <= allowed) ++csub_;
         rows_ = map.height * sub_;
+        cols_ = map.width * csub_;
         // Each row's top and bottom (cos theta, theta), the exact solid angle
         // of a texel of it, (2 pi / W)(cos top - cos bottom), and the sines
         // and cosines of each row's and column's middle, computed as
@@ -79,7 +105,7 @@ public:
         row_sin_.resize(rows_);
         row_cos_.resize(rows_);
         for (std::uint32_t y = 0; y < rows_; ++y) {
-            row_solid_angle_[y] = 2.0 * kPi / map.width * (cos_[y] - cos_[y + 1]);
+            row_solid_angle_[y] = 2.0 * kPi / cols_ * (cos_[y] - cos_[y + 1]);
             // The texel row's middle where it is whole (as the maps of sub =
             // 1 always did); a band's middle cosine where it is cut.
             row_v_[y] = sub_ == 1 ? (y + 0.5) / rows_
@@ -88,16 +114,17 @@ public:
             row_sin_[y] = std::sin(theta);
             row_cos_[y] = std::cos(theta);
         }
-        column_sin_.resize(map.width);
-        column_cos_.resize(map.width);
-        for (std::uint32_t x = 0; x < map.width; ++x) {
-            const double phi = 2.0 * kPi * (double(float((x + 0.5) / map.width)) - 0.5);
+        column_sin_.resize(cols_);
+        column_cos_.resize(cols_);
+        for (std::uint32_t x = 0; x < cols_; ++x) {
+            const double phi = 2.0 * kPi * (double(float((x + 0.5) / cols_)) - 0.5);
             column_sin_[x] = std::sin(phi);
             column_cos_[x] = std::cos(phi);
         }
     }
 
     std::uint32_t rows() const { return rows_; }
+    std::uint32_t columns() const { return cols_; }
 
     void split(Region r, std::uint32_t samples) {
         const Totals t = totals(r);
@@ -115,10 +142,15 @@ public:
         // (Where no row is cut, in the arithmetic it always had, so that
         // those maps' lights stay the same to the last bit.)
         const double mid_theta = sub_ == 1 ? kPi * 0.5 * (r.y0 + r.y1) / rows_ : 0.5 * (theta_[r.y0] + theta_[r.y1]);
-        const double width = (r.x1 - r.x0) * 2.0 * kPi / map_.width * std::sin(mid_theta);
+        const double width = (r.x1 - r.x0) * 2.0 * kPi / cols_ * std::sin(mid_theta);
         const double height = sub_ == 1 ? (r.y1 - r.y0) * kPi / rows_ : theta_[r.y1] - theta_[r.y0];
         Region a = r, b = r;
-        if ((width >= height && r.x1 - r.x0 > 1) || r.y1 - r.y0 == 1) {
+        // (Where columns are cut, a square region is halved across its rows,
+        // so that a direction of it stays in one hemisphere: halved down
+        // its columns, a 2 x 1 map's four directions each took a pole to
+        // pole half of a column, and sat on the equator.)
+        const bool across = csub_ == 1 ? width >= height : width > height;
+        if ((across && r.x1 - r.x0 > 1) || r.y1 - r.y0 == 1) {
             a.x1 = b.x0 = (r.x0 + r.x1) / 2;
         } else {
             a.y1 = b.y0 = (r.y0 + r.y1) / 2;
@@ -146,7 +178,7 @@ private:
     }
 
     const float* texel(std::uint32_t x, std::uint32_t y) const {
-        return &map_.rgb[(std::size_t(y / sub_) * map_.width + x) * 3];
+        return &map_.rgb[(std::size_t(y / sub_) * map_.width + x / csub_) * 3];
     }
 
     glm::dvec3 brightest_direction(Region r) const {
@@ -212,7 +244,7 @@ private:
             const double share = (before + 0.5 * n) / samples;
             const double v = std::acos(std::clamp(cos_top + share * (cos_bottom - cos_top), -1.0, 1.0)) / kPi;
             for (std::uint32_t k = 0; k < n; ++k)
-                emit(texel_direction((r.x0 + (k + 0.5) / n) / map_.width, v), t.irradiance / double(samples));
+                emit(texel_direction((r.x0 + (k + 0.5) / n) / cols_, v), t.irradiance / double(samples));
             before += n;
         }
     }
@@ -228,7 +260,7 @@ private:
 
     const Environment& map_;
     std::vector<gpu::Light>& out_;
-    std::uint32_t sub_ = 1, rows_ = 0;
+    std::uint32_t sub_ = 1, rows_ = 0, csub_ = 1, cols_ = 0;
     std::vector<double> cos_, theta_, row_solid_angle_, row_v_, row_sin_, row_cos_, column_sin_, column_cos_;
 };
 
@@ -247,7 +279,7 @@ std::vector<gpu::Light> environment_lights(const Environment& map, std::uint32_t
     if (map.width == 0 || map.height == 0 || count == 0) return lights;
     lights.reserve(count);
     Splitter splitter(map, count, lights);
-    splitter.split({0, map.width, 0, splitter.rows()}, count);
+    splitter.split({0, splitter.columns(), 0, splitter.rows()}, count);
     return lights;
 }
 

@@ -255,9 +255,8 @@ void check_exr_attributes(std::string_view bytes, const EXRVersion& version, con
     }
 }
 
-}  // namespace
-
-Image read_exr(const fs::path& file, std::uint64_t max_pixels, glm::ivec2* origin) {
+// read_exr, which also gives the display window where `display` is given.
+Image read_exr_windows(const fs::path& file, std::uint64_t max_pixels, glm::ivec2* origin, EXRBox2i* display) {
     const std::string name = file.string();
     // The file is read once and decoded from memory. tinyexr's file calls
     // open it at each step (version, header, pixels), so a file changed in
@@ -291,6 +290,17 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels, glm::ivec2* origi
     const std::int64_t height = std::int64_t(window.max_y) - window.min_y + 1;
     if (width <= 0 || height <= 0) throw InputError(name, "", "image is empty");
     if (origin != nullptr) *origin = glm::ivec2(window.min_x, window.min_y);
+    if (display != nullptr) {
+        *display = header.display_window;
+        const std::int64_t display_width = std::int64_t(display->max_x) - display->min_x + 1;
+        const std::int64_t display_height = std::int64_t(display->max_y) - display->min_y + 1;
+        if (display_width <= 0 || display_height <= 0)
+            throw InputError(name, "displayWindow", "is empty");
+        if (std::uint64_t(display_width) * std::uint64_t(display_height) > max_pixels)
+            throw InputError(name, "displayWindow",
+                             "is " + std::to_string(display_width) + " x " + std::to_string(display_height) +
+                                 " pixels, more than the " + std::to_string(max_pixels) + " it may hold");
+    }
     if (std::uint64_t(width) * std::uint64_t(height) > max_pixels)
         throw InputError(name, "", "is " + std::to_string(width) + " x " + std::to_string(height) +
                                        " pixels, more than the " + std::to_string(max_pixels) + " it may hold");
@@ -372,6 +382,36 @@ Image read_exr(const fs::path& file, std::uint64_t max_pixels, glm::ivec2* origi
         if (placed != covered.size()) throw InputError(name, "tiles", "some pixels lie in no tile");
     } else {
         throw InputError(name, "", "OpenEXR file holds no pixel data");
+    }
+    return image;
+}
+
+}  // namespace
+
+Image read_exr(const fs::path& file, std::uint64_t max_pixels, glm::ivec2* origin) {
+    return read_exr_windows(file, max_pixels, origin, nullptr);
+}
+
+Image read_exr_display_window(const fs::path& file, std::uint64_t max_pixels) {
+    EXRBox2i display;
+    glm::ivec2 origin;
+    Image data = read_exr_windows(file, max_pixels, &origin, &display);
+    if (origin == glm::ivec2(display.min_x, display.min_y) &&
+        std::int64_t(data.width) == std::int64_t(display.max_x) - display.min_x + 1 &&
+        std::int64_t(data.height) == std::int64_t(display.max_y) - display.min_y + 1)
+        return data;
+    Image image(std::uint32_t(std::int64_t(display.max_x) - display.min_x + 1),
+                std::uint32_t(std::int64_t(display.max_y) - display.min_y + 1));  // black
+    for (std::uint32_t y = 0; y < data.height; ++y) {
+        const std::int64_t to_y = std::int64_t(origin.y) + y - display.min_y;
+        if (to_y < 0 || to_y >= std::int64_t(image.height)) continue;
+        for (std::uint32_t x = 0; x < data.width; ++x) {
+            const std::int64_t to_x = std::int64_t(origin.x) + x - display.min_x;
+            if (to_x < 0 || to_x >= std::int64_t(image.width)) continue;
+            for (int c = 0; c < 3; ++c)
+                image.rgb[(std::size_t(to_y) * image.width + std::size_t(to_x)) * 3 + std::size_t(c)] =
+                    data.rgb[(std::size_t(y) * data.width + x) * 3 + std::size_t(c)];
+        }
     }
     return image;
 }

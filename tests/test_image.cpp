@@ -122,6 +122,47 @@ TEST_F(ImageFiles, ExrDataWindowOriginIsReported) {
     EXPECT_EQ(origin, glm::ivec2(10, 0));
 }
 
+// Laid out over the display window, as environment maps are read: where
+// the data window does not fill it the pixels are black (an upper
+// hemisphere stored alone left the map's lower half black, not the sky
+// stretched over the sphere), and where it reaches past it they are dropped.
+TEST_F(ImageFiles, ExrDisplayWindowPlacesTheStoredPixels) {
+    lc::Image image(3, 2);
+    for (std::uint32_t y = 0; y < image.height; ++y)
+        for (std::uint32_t x = 0; x < image.width; ++x) image.set(x, y, glm::vec3(float(x + 1), float(y + 1), 7.0f));
+    const fs::path file = dir_ / "windows.exr";
+    lc::write_exr(file, image);
+    EXPECT_EQ(lc::read_exr_display_window(file).rgb, image.rgb);  // the same windows: as read_exr
+    const std::int32_t data[4] = {1, 0, 3, 1};                     // x 1 to 3 (the blocks keep their y)
+    lc::test::patch_exr_attribute(file, "dataWindow", "box2i", data, sizeof(data));
+    const std::int32_t display[4] = {0, 0, 4, 3};  // 5 x 4
+    lc::test::patch_exr_attribute(file, "displayWindow", "box2i", display, sizeof(display));
+    const lc::Image placed = lc::read_exr_display_window(file);
+    ASSERT_EQ(placed.width, 5u);
+    ASSERT_EQ(placed.height, 4u);
+    for (std::uint32_t y = 0; y < placed.height; ++y)
+        for (std::uint32_t x = 0; x < placed.width; ++x) {
+            const bool stored = x >= 1 && x <= 3 && y <= 1;
+            const glm::vec3 want = stored ? glm::vec3(float(x), float(y + 1), 7.0f) : glm::vec3(0.0f);
+            EXPECT_EQ(placed.at(x, y), want) << x << ", " << y;
+        }
+    const std::int32_t inside[4] = {2, 1, 3, 1};  // 2 x 1, inside the data window
+    lc::test::patch_exr_attribute(file, "displayWindow", "box2i", inside, sizeof(inside));
+    const lc::Image cropped = lc::read_exr_display_window(file);
+    ASSERT_EQ(cropped.width, 2u);
+    ASSERT_EQ(cropped.height, 1u);
+    EXPECT_EQ(cropped.at(0, 0), glm::vec3(2.0f, 2.0f, 7.0f));
+    EXPECT_EQ(cropped.at(1, 0), glm::vec3(3.0f, 2.0f, 7.0f));
+    const std::int32_t huge[4] = {0, 0, 99999, 99999};
+    lc::test::patch_exr_attribute(file, "displayWindow", "box2i", huge, sizeof(huge));
+    try {
+        lc::read_exr_display_window(file, 4096);
+        ADD_FAILURE() << "a display window past max_pixels was read";
+    } catch (const lc::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("displayWindow: is 100000 x 100000 pixels"), std::string::npos) << e.what();
+    }
+}
+
 TEST_F(ImageFiles, ExrStoresFloatChannelsSortedByName) {
     lc::Image image(2, 1);
     image.set(0, 0, {1.0f, 2.0f, 3.0f});

@@ -428,7 +428,7 @@ private:
         Environment env;
         if (has_file) {
             const fs::path exr = existing_file(j, path, "file");
-            const Image map = read_exr(exr, kMaxEnvironmentPixels);  // notes the file as an input
+            const Image map = read_exr_display_window(exr, kMaxEnvironmentPixels);  // notes the file as an input
             env.width = map.width;
             env.height = map.height;
             env.rgb = map.rgb;

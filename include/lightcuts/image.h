@@ -50,6 +50,12 @@ inline constexpr std::uint64_t kMaxExrPixels = std::uint64_t(16384) * 16384;
 // renderer writes them).
 Image read_exr(const std::filesystem::path& file, std::uint64_t max_pixels = kMaxExrPixels,
                glm::ivec2* origin = nullptr);
+// read_exr laid out over the file's display window, the image's extent,
+// which the data window of the pixels it stores need not fill: pixels the
+// file does not store are black, stored ones outside it are dropped.
+// max_pixels bounds both windows. Environment maps are read this way:
+// their lat-long mapping spans the display window.
+Image read_exr_display_window(const std::filesystem::path& file, std::uint64_t max_pixels = kMaxExrPixels);
 void write_png_rgb8(const std::filesystem::path& file, std::uint32_t width, std::uint32_t height,
                     const std::vector<std::uint8_t>& rgb8);
 // Tone-mapped sRGB preview: exposure * value, clamped to [0,1], sRGB-encoded.
