@@ -1,10 +1,12 @@
 // Shadow rays per second: the software BVH (shaders/shared/trace.h, as the
 // CPU path runs it) against Embree 3 on the same rays: the ones brute force
 // traces on a scene (from every camera hit to every light that can light
-// it), and the ones lightcuts traces at the defaults (recorded by the CPU
-// kernel as it selects the cuts).
+// it), and the ones lightcuts traces with a cut per pixel (recorded by the
+// CPU's scalar kernel as it selects the cuts at the default error, max_cut
+// and heap: the cuts the Vulkan kernels select; the CPU's default shares a
+// cut among an octet of pixels, whose rays this list does not hold).
 //
-//   build/bench/embree_rays SCENE [SIZE] [THREADS]
+//   build/bench/embree_rays SCENE [SIZE] [THREADS] [REPEATS]
 //
 // Brute force's rays are collected at SIZE x SIZE (default 32), lightcuts'
 // at 128 x 128 (a few hundred rays per pixel instead of one per light).
@@ -15,10 +17,13 @@
 // lightcuts could use by tracing a tile's rays to the same cluster
 // together; lightcuts' rays also with each point's rays sorted by direction
 // (what gathering a pixel's rays before tracing them could give). Embree
-// runs single rays (rtcOccluded1), packets of 8 consecutive
-// rays (rtcOccluded8) and streams (rtcOccluded1M over 256 rays). Built only
-// where Debian's libembree-dev is installed (an optional, benchmark-only
-// dependency).
+// runs single rays (rtcOccluded1), packets of 4, 8 and 16 consecutive
+// rays (rtcOccluded4/8/16, each where the device says it supports that
+// width natively: 16 needs AVX-512) and streams (rtcOccluded1M over 256
+// rays, flagged coherent and incoherent), on a scene built at
+// RTC_BUILD_QUALITY_HIGH (spatial splits, for static geometry). Every figure is the median of
+// REPEATS timed runs (default 3). Built only where Debian's libembree-dev
+// is installed (an optional, benchmark-only dependency).
 #include <embree3/rtcore.h>
 
 #include <algorithm>
@@ -44,16 +49,24 @@ struct ShadowRay {
     std::uint32_t light;  // for the light-by-light order
 };
 
+unsigned g_repeats = 3;
+
 // Runs trace(thread, begin, end) over [0, n) split into `threads`
-// contiguous parts; returns the seconds it took.
+// contiguous parts, g_repeats times; returns the median of the seconds each
+// run took (each run gives the same counts).
 double timed_parallel(std::size_t n, unsigned threads,
                       const std::function<void(unsigned, std::size_t, std::size_t)>& trace) {
-    const auto start = std::chrono::steady_clock::now();
-    std::vector<std::thread> pool;
-    for (unsigned t = 0; t < threads; ++t)
-        pool.emplace_back(trace, t, n * t / threads, n * (t + 1) / threads);
-    for (auto& th : pool) th.join();
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::vector<double> seconds;
+    for (unsigned run = 0; run < g_repeats; ++run) {
+        const auto start = std::chrono::steady_clock::now();
+        std::vector<std::thread> pool;
+        for (unsigned t = 0; t < threads; ++t)
+            pool.emplace_back(trace, t, n * t / threads, n * (t + 1) / threads);
+        for (auto& th : pool) th.join();
+        seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    }
+    std::sort(seconds.begin(), seconds.end());
+    return seconds[seconds.size() / 2];
 }
 
 RTCRay to_rtc_ray(const ShadowRay& r) {
@@ -85,11 +98,16 @@ int main(int argc, char** argv) {
 
 int run(int argc, char** argv) {
     if (argc < 2) {
-        std::fprintf(stderr, "usage: embree_rays SCENE [SIZE] [THREADS]\n");
+        std::fprintf(stderr, "usage: embree_rays SCENE [SIZE] [THREADS] [REPEATS]\n");
         return 2;
     }
     const std::uint32_t size = argc > 2 ? std::uint32_t(std::atoi(argv[2])) : 32;
     const unsigned threads = argc > 3 ? unsigned(std::atoi(argv[3])) : std::max(1u, std::thread::hardware_concurrency());
+    if (argc > 4) g_repeats = unsigned(std::max(1, std::atoi(argv[4])));
+    if (size == 0 || threads == 0) {
+        std::fprintf(stderr, "embree_rays: SIZE and THREADS must be positive numbers\n");
+        return 2;
+    }
     lc::PreparedScene p = lc::prepare_scene(lc::load_scene(argv[1]), 1);
     lc::RenderOptions o;
     o.width = o.height = size;
@@ -109,7 +127,8 @@ int run(int argc, char** argv) {
                 if (unit.x + unit.y + unit.z > 0.0f) rays.push_back({sp.p, wi, t_max, l});
             }
         }
-    // Lightcuts' rays at the defaults, pixel by pixel as it casts them.
+    // Lightcuts' rays with a cut per pixel at the default settings, pixel
+    // by pixel as the scalar kernel casts them.
     constexpr std::uint32_t kLightcutsSize = 128;
     std::vector<ShadowRay> lightcuts_rays;
     {
@@ -156,12 +175,21 @@ int run(int argc, char** argv) {
     std::stable_sort(by_light.begin(), by_light.end(),
                      [](const ShadowRay& a, const ShadowRay& b) { return a.light < b.light; });
     std::printf("%s: %zu triangles, %zu lights; %zu brute-force shadow rays at %ux%u, %zu lightcuts shadow rays "
-                "at %ux%u; %u thread(s)\n",
+                "(a cut per pixel) at %ux%u; %u thread(s); medians of %u runs\n",
                 argv[1], p.scene.triangles.size(), p.tree.lights.size(), rays.size(), size, size,
-                lightcuts_rays.size(), kLightcutsSize, kLightcutsSize, threads);
+                lightcuts_rays.size(), kLightcutsSize, kLightcutsSize, threads, g_repeats);
 
     RTCDevice device = rtcNewDevice(nullptr);
+    const bool native[3] = {rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED) != 0,
+                            rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) != 0,
+                            rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) != 0};
+    std::printf("Embree %d.%d.%d, native packets of 4 / 8 / 16: %s / %s / %s\n",
+                int(rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_VERSION_MAJOR)),
+                int(rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_VERSION_MINOR)),
+                int(rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_VERSION_PATCH)), native[0] ? "yes" : "no",
+                native[1] ? "yes" : "no", native[2] ? "yes" : "no");
     RTCScene scene = rtcNewScene(device);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
     RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
     const std::size_t tris = p.scene.triangles.size();
     auto* vertices = static_cast<float*>(
@@ -182,7 +210,7 @@ int run(int argc, char** argv) {
     const std::pair<const char*, const std::vector<ShadowRay>*> sets[] = {
         {"brute force, pixel order", &rays},
         {"brute force, light by light", &by_light},
-        {"lightcuts (error 0.02, max_cut 1000), pixel order", &lightcuts_rays},
+        {"lightcuts, a cut per pixel (error 0.02, max_cut 1000), pixel order", &lightcuts_rays},
         {"lightcuts, each point's rays sorted by direction", &lightcuts_sorted}};
     for (const auto& [order_name, list] : sets) {
         const std::vector<ShadowRay>& r = *list;
@@ -309,46 +337,57 @@ int run(int argc, char** argv) {
         });
         report("Embree rtcOccluded1", r.size(), s, total(), reference);
 
-        std::fill(hits.begin(), hits.end(), 0);
-        s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
-            RTCIntersectContext ctx;
-            rtcInitIntersectContext(&ctx);
-            std::size_t h = 0;
-            for (std::size_t i = b; i < e; i += 8) {
-                alignas(32) RTCRay8 ray{};
-                alignas(32) int valid[8];
-                for (std::size_t j = 0; j < 8; ++j) {
-                    const bool on = i + j < e;
-                    valid[j] = on ? -1 : 0;
-                    const ShadowRay& sr = r[on ? i + j : i];
-                    ray.org_x[j] = sr.org.x, ray.org_y[j] = sr.org.y, ray.org_z[j] = sr.org.z;
-                    ray.dir_x[j] = sr.dir.x, ray.dir_y[j] = sr.dir.y, ray.dir_z[j] = sr.dir.z;
-                    ray.tnear[j] = 0.0f, ray.tfar[j] = sr.t_max, ray.mask[j] = ~0u;
+        // Packets of W consecutive rays through rtcOccludedW.
+        auto embree_packets = [&]<int W, typename Packet>(const char* what, auto occluded) {
+            std::fill(hits.begin(), hits.end(), 0);
+            s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+                RTCIntersectContext ctx;
+                rtcInitIntersectContext(&ctx);
+                std::size_t h = 0;
+                for (std::size_t i = b; i < e; i += W) {
+                    alignas(64) Packet ray{};
+                    alignas(64) int valid[W];
+                    for (std::size_t j = 0; j < std::size_t(W); ++j) {
+                        const bool on = i + j < e;
+                        valid[j] = on ? -1 : 0;
+                        const ShadowRay& sr = r[on ? i + j : i];
+                        ray.org_x[j] = sr.org.x, ray.org_y[j] = sr.org.y, ray.org_z[j] = sr.org.z;
+                        ray.dir_x[j] = sr.dir.x, ray.dir_y[j] = sr.dir.y, ray.dir_z[j] = sr.dir.z;
+                        ray.tnear[j] = 0.0f, ray.tfar[j] = sr.t_max, ray.mask[j] = ~0u;
+                    }
+                    occluded(valid, scene, &ctx, &ray);
+                    for (std::size_t j = 0; j < std::size_t(W) && i + j < e; ++j) h += ray.tfar[j] < 0.0f ? 1 : 0;
                 }
-                rtcOccluded8(valid, scene, &ctx, &ray);
-                for (std::size_t j = 0; j < 8 && i + j < e; ++j) h += ray.tfar[j] < 0.0f ? 1 : 0;
-            }
-            hits[t] = h;
-        });
-        report("Embree rtcOccluded8 (packets)", r.size(), s, total(), reference);
+                hits[t] = h;
+            });
+            report(what, r.size(), s, total(), reference);
+        };
+        if (native[0]) embree_packets.template operator()<4, RTCRay4>("Embree rtcOccluded4 (packets)", rtcOccluded4);
+        if (native[1]) embree_packets.template operator()<8, RTCRay8>("Embree rtcOccluded8 (packets)", rtcOccluded8);
+        if (native[2])
+            embree_packets.template operator()<16, RTCRay16>("Embree rtcOccluded16 (packets)", rtcOccluded16);
 
-        std::fill(hits.begin(), hits.end(), 0);
-        s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
-            RTCIntersectContext ctx;
-            rtcInitIntersectContext(&ctx);
-            ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-            constexpr std::size_t kStream = 256;
-            std::vector<RTCRay> stream(kStream);
-            std::size_t h = 0;
-            for (std::size_t i = b; i < e; i += kStream) {
-                const std::size_t n = std::min(kStream, e - i);
-                for (std::size_t j = 0; j < n; ++j) stream[j] = to_rtc_ray(r[i + j]);
-                rtcOccluded1M(scene, &ctx, stream.data(), unsigned(n), sizeof(RTCRay));
-                for (std::size_t j = 0; j < n; ++j) h += stream[j].tfar < 0.0f ? 1 : 0;
-            }
-            hits[t] = h;
-        });
-        report("Embree rtcOccluded1M (streams of 256)", r.size(), s, total(), reference);
+        for (const bool coherent : {true, false}) {
+            std::fill(hits.begin(), hits.end(), 0);
+            s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+                RTCIntersectContext ctx;
+                rtcInitIntersectContext(&ctx);
+                ctx.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+                constexpr std::size_t kStream = 256;
+                std::vector<RTCRay> stream(kStream);
+                std::size_t h = 0;
+                for (std::size_t i = b; i < e; i += kStream) {
+                    const std::size_t n = std::min(kStream, e - i);
+                    for (std::size_t j = 0; j < n; ++j) stream[j] = to_rtc_ray(r[i + j]);
+                    rtcOccluded1M(scene, &ctx, stream.data(), unsigned(n), sizeof(RTCRay));
+                    for (std::size_t j = 0; j < n; ++j) h += stream[j].tfar < 0.0f ? 1 : 0;
+                }
+                hits[t] = h;
+            });
+            report(coherent ? "Embree rtcOccluded1M (streams of 256, coherent)"
+                            : "Embree rtcOccluded1M (streams of 256, incoherent)",
+                   r.size(), s, total(), reference);
+        }
     }
     rtcReleaseScene(scene);
     rtcReleaseDevice(device);

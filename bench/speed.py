@@ -11,7 +11,11 @@
    three renders of the camera rays alone, LC_CPU_CAMERA_RAYS_ONLY=1; the
    ratio with them left in is printed too) and the speedup, from the medians of brute force's
    renders (--brute-runs, 3 by default) and lightcuts', taken in turn so
-   that the machine's drift reaches both; at the defaults (the CPU's cuts shared
+   that the machine's drift reaches both; the render times leave out the
+   scene's preparation (loading, the BVH and the light tree), which a scene
+   pays once however many images it renders; the light tree's build (which
+   brute force runs too, for the lights in the tree's order) is printed
+   beside them with the speedup when each method's is counted in; at the defaults (the CPU's cuts shared
    by 4x2 octets of pixels) and with a cut per pixel (cut_sharing "pixel", as
    the Vulkan kernels cut).
 2. The K table: every shipped scene rendered with lightcuts on the CPU with a
@@ -145,11 +149,15 @@ def main():
               "force's, each in brackets. The speedup is the ratio of the medians. camera s: the median of three "
               "renders of the camera rays alone; us per ray: the render's median time less that, over its shadow "
               "rays (the issue's definition), and their ratio; with camera rays: the ratio of render time over "
-              "shadow rays. pixel s: the render with a cut per pixel and K = 64 in the "
-              "K table (as the Vulkan kernels cut), and its speedup.", "",
+              "shadow rays. The times are the renders' (`seconds.render`), without the scene's preparation; "
+              "tree s: the median of the light tree's build in lightcuts' runs, and the speedup with each "
+              "method's build added to its render (brute force builds the tree too, once, for its lights' "
+              "order). pixel s: the render with a cut per pixel and "
+              "K = 64 in the K table (as the Vulkan kernels cut), and its speedup.", "",
               "| scene | brute s | brute rays/px | lightcuts s | rays/px | camera s | us per brute ray | "
-              "us per lightcuts ray | ratio | with camera rays | speedup | pixel s | pixel rays/px | pixel speedup |",
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+              "us per lightcuts ray | ratio | with camera rays | speedup | tree s | speedup with tree | pixel s | "
+              "pixel rays/px | pixel speedup |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     table = ["## The cut heap: K slots against a heap as large as the tree needs", "",
              "Rows `pixel`: a cut per pixel, K slots per pixel (the Vulkan kernels' heap). Row `quad`: a cut "
              "per 2x2 quad with its pixels' 4 x 64 slots pooled. Row `octet`: the defaults, a cut per 4x2 "
@@ -180,10 +188,11 @@ def main():
         # This machine's speed drifts within minutes, and brute force runs
         # for a minute: the rooms' lightcuts time is the median of renders
         # before it, in the K table and after the table.
-        lightcuts_times = []
+        lightcuts_times, tree_times = [], []
         if room:  # at the defaults, whose cut heap is K = 64
             first = render(a.out, scene, name + "_before", size, "lightcuts")[1]
             lightcuts_times.append(first["seconds"]["render"])
+            tree_times.append(first["seconds"]["light_tree_build"])
         print(f"{scene}: brute force", file=sys.stderr)
         ref, bstats = render(a.out, scene, name + "_brute", size, "brute")
         pixels = size * size
@@ -216,13 +225,17 @@ def main():
         # medians of each.
         brute_times = [bstats["seconds"]["render"]]
         for run in range(max(a.brute_runs, 1)):
-            lightcuts_times.append(
-                render(a.out, scene, f"{name}_after{run}", size, "lightcuts")[1]["seconds"]["render"])
+            after = render(a.out, scene, f"{name}_after{run}", size, "lightcuts")[1]
+            lightcuts_times.append(after["seconds"]["render"])
+            tree_times.append(after["seconds"]["light_tree_build"])
             if run + 1 < a.brute_runs:
                 print(f"{scene}: brute force again", file=sys.stderr)
                 brute_times.append(
                     render(a.out, scene, f"{name}_brute{run + 1}", size, "brute")[1]["seconds"]["render"])
         tb, tl = statistics.median(brute_times), statistics.median(lightcuts_times)
+        tt = statistics.median(tree_times)
+        tree_brute = bstats["seconds"]["light_tree_build"]
+        with_tree = (tb + tree_brute) / (tl + tt)
         rb, rl = bstats["shadow_rays"], first["shadow_rays"]
         tc = camera_seconds(a.out, scene, name, size)
         cb, cl = 1e6 * (tb - tc) / rb, 1e6 * (tl - tc) / rl
@@ -233,12 +246,16 @@ def main():
                                  "lightcuts_seconds": tl, "lightcuts_runs": lightcuts_times,
                                  "lightcuts_rays": rl, "camera_seconds": tc, "us_per_brute_ray": cb,
                                  "us_per_lightcuts_ray": cl, "ratio": cl / cb,
-                                 "ratio_with_camera_rays": with_camera, "speedup": tb / tl, "pixel_seconds": tp, "pixel_rays": rp,
+                                 "ratio_with_camera_rays": with_camera, "speedup": tb / tl,
+                                 "tree_seconds": tt, "tree_runs": tree_times, "brute_tree_seconds": tree_brute,
+                                 "speedup_with_tree": with_tree,
+                                 "pixel_seconds": tp, "pixel_rays": rp,
                                  "pixel_speedup": tb / tp})
         runs = ", ".join(f"{t:.3f}" for t in lightcuts_times)
         brute_runs = ", ".join(f"{t:.2f}" for t in brute_times)
         lines.append(f"| {name} | {tb:.2f} ({brute_runs}) | {rb / pixels:.0f} | {tl:.3f} ({runs}) | {rl / pixels:.1f} | "
-                     f"{tc:.4f} | {cb:.4f} | {cl:.4f} | {cl / cb:.2f} | {with_camera:.2f} | {tb / tl:.1f}x | {tp:.3f} | "
+                     f"{tc:.4f} | {cb:.4f} | {cl:.4f} | {cl / cb:.2f} | {with_camera:.2f} | {tb / tl:.1f}x | "
+                     f"{tt:.3f} | {with_tree:.1f}x | {tp:.3f} | "
                      f"{rp / pixels:.1f} | {tb / tp:.1f}x |")
         save(partial=True)
     lines += [""] + table + [""]
