@@ -152,6 +152,10 @@ void wrap_texture_coordinates(Scene& scene) {
 }  // namespace
 
 PreparedScene prepare_scene(Scene scene, std::uint32_t seed, unsigned threads) {
+    // A scene built or changed in code gets the loaders' checks, and its
+    // bounds from its triangles (what load_scene left them, for one it read).
+    check_scene(scene);
+    update_bounds(scene);
     PreparedScene prepared;
     centre_far_scene(scene);
     wrap_texture_coordinates(scene);

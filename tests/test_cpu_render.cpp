@@ -1,9 +1,12 @@
 // The CPU reference renderer against analytic answers.
 #include <cmath>
+#include <functional>
+#include <string>
 #include <utility>
 
 #include <gtest/gtest.h>
 
+#include "lightcuts/error.h"
 #include "test_util.h"
 
 namespace lc {
@@ -36,6 +39,70 @@ TEST(CpuRender, PointLightInsideSphereGivesHalfEverywhere) {
                 ASSERT_FLOAT_EQ(c.x, c.z);
             }
     }
+}
+
+// A scene built in code gets the loaders' checks from prepare_scene, with
+// an InputError naming the field: before, a light at NaN made lightcuts'
+// CPU image black while Vulkan's kept the other light, a camera 0 pixels
+// wide rendered an empty image, one of 2^20 x 2^20 ran out of memory, and
+// a triangle's material past the scene's read past the array. Its bounds
+// come from its triangles, whether or not the caller set them.
+TEST(CpuRender, ASceneBuiltInCodeIsCheckedAsALoadedOneIs) {
+    const auto problem = [](const std::function<void(Scene&)>& change) -> std::string {
+        Scene s = test::room_scene({test::point_light({0.0f, 1.5f, 0.0f}, glm::vec3(1.0f)),
+                                    test::point_light({0.5f, 1.5f, 0.0f}, glm::vec3(1.0f))},
+                                   8);
+        change(s);
+        try {
+            prepare_scene(std::move(s), 1);
+        } catch (const InputError& e) {
+            return e.what();
+        }
+        return "";
+    };
+    EXPECT_EQ(problem([](Scene&) {}), "");
+    EXPECT_EQ(problem([](Scene& s) { s.lights[1].y = std::nanf(""); }),
+              "scene: lights[1]: position or direction is not finite");
+    EXPECT_EQ(problem([](Scene& s) { s.lights[0].g = -1.0f; }),
+              "scene: lights[0]: intensity must be finite and not negative");
+    EXPECT_EQ(problem([](Scene& s) { s.lights[0].type = 9u; }), "scene: lights[0].type: is 9, not a light type");
+    EXPECT_EQ(problem([](Scene& s) { s.lights[0].r = s.lights[1].r = 3e38f; }),
+              "scene: lights: total red intensity of the point lights exceeds the float range (3.4e38)");
+    EXPECT_EQ(problem([](Scene& s) { s.camera.width = 0; }), "scene: camera.width: must be from 1 to 16384, got 0");
+    EXPECT_EQ(problem([](Scene& s) { s.camera.height = 1u << 20; }),
+              "scene: camera.height: must be from 1 to 16384, got 1048576");
+    EXPECT_EQ(problem([](Scene& s) { s.camera.look_at = s.camera.position; }),
+              "scene: camera.look_at: must differ from camera.position");
+    EXPECT_EQ(problem([](Scene& s) { s.camera.fov_y_degrees = 180.0f; }),
+              "scene: camera.fov_y_degrees: must be above 0 and below 180");
+    EXPECT_EQ(problem([](Scene& s) { s.triangles[5].material = 3; }),
+              "scene: triangles[5].material: is 3; the scene has 3 materials");
+    EXPECT_EQ(problem([](Scene& s) { s.triangles[2].v1_y = INFINITY; }),
+              "scene: triangles[2]: a vertex is not finite");
+    const std::size_t triangles = test::room_scene({}, 8).triangles.size();
+    EXPECT_EQ(problem([](Scene& s) { s.normals.pop_back(); }),
+              "scene: normals: holds " + std::to_string(triangles - 1) + " entries for " + std::to_string(triangles) +
+                  " triangles (one per triangle)");
+    EXPECT_EQ(problem([](Scene& s) { s.materials[1].kd_g = 1.5f; }), "scene: materials[1].kd_g: must be from 0 to 1");
+    EXPECT_EQ(problem([](Scene& s) { s.materials[0].base_color_texture = 0; }),
+              "scene: materials[0].base_color_texture: is 0; the scene has 0 textures");
+    EXPECT_EQ(problem([](Scene& s) {
+                  gpu::Light spot = s.lights[0];
+                  spot.type = gpu::kLightSpot;
+                  spot.axis_y = -1.0f;
+                  spot.cos_inner = 0.5f;
+                  spot.cos_outer = 0.9f;
+                  s.lights.push_back(spot);
+              }),
+              "scene: lights[2]: a spot's cosines must satisfy -1 <= cos_outer <= cos_inner <= 1");
+
+    // Bounds left at zero by the caller: the same image as with them set.
+    Scene set = test::room_scene({test::point_light({0.0f, 1.5f, 0.0f}, glm::vec3(1.0f))}, 16);
+    Scene unset = set;
+    unset.bounds_min = unset.bounds_max = glm::vec3(0.0f);
+    const RenderResult a = render_cpu(prepare_scene(std::move(set), 1), test::options("brute", 16));
+    const RenderResult b = render_cpu(prepare_scene(std::move(unset), 1), test::options("brute", 16));
+    EXPECT_EQ(a.image.rgb, b.image.rgb);
 }
 
 // Floor plane y = 0 of albedo rho seen from above; the expected radiance is

@@ -17,6 +17,7 @@
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "camera_check.h"
 #include "csv_lights.h"
 #include "float_limits.h"
 #include "gltf_loader.h"
@@ -109,26 +110,12 @@ private:
         if (const auto v = number_setting(j, path, kSettingHeight)) cam.height = static_cast<std::uint32_t>(*v);
 
         // The camera basis is cross(forward, up): both must be usable.
-        const glm::vec3 forward = cam.look_at - cam.position;
-        const float forward_len = glm::length(forward);
-        if (!std::isfinite(forward_len))
-            in_.fail("camera.look_at", "is too far from camera.position (the square of their distance overflows "
-                                       "a float: at most about 1.8e19 apart)");
-        if (!(forward_len > 0.0f))
-            in_.fail("camera.look_at", forward == glm::vec3(0.0f)
-                                           ? "must differ from camera.position"
-                                           : "is too close to camera.position (the square of their distance "
-                                             "underflows a float: at least about 3e-23 apart)");
-        // In double: the square of a float as small as 1e-30 (or as large
-        // as 1e30) is out of float range, and up's length only sets its
-        // direction. Kept as a unit vector, so the camera's basis
-        // (prepare.cpp) is computed from floats of ordinary size.
+        if (const CameraProblem p = camera_problem(cam); !p.field.empty()) in_.fail(p.field, p.problem);
+        // Kept as a unit vector, so the camera's basis (prepare.cpp) is
+        // computed from floats of ordinary size (up's length taken in
+        // double: the square of a float as small as 1e-30 is out of range).
         const glm::dvec3 up(cam.up);
-        const double up_len = glm::length(up);
-        if (!(up_len > 0.0)) in_.fail("camera.up", "must not be zero");
-        const double sin_angle = glm::length(glm::cross(glm::dvec3(forward) / double(forward_len), up / up_len));
-        if (!(sin_angle > 1e-6)) in_.fail("camera.up", "must not be parallel to the view direction");
-        cam.up = glm::vec3(up / up_len);
+        cam.up = glm::vec3(up / glm::length(up));
     }
 
     // Ranges and problem texts come from lightcuts/settings.h, so a value is

@@ -315,6 +315,8 @@ RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& o
                            const VulkanOptions& vulkan, const Tuning& tuning) {
     if (options.method == "path")
         throw std::invalid_argument("method path (the path tracer) runs on the CPU only: use --device cpu");
+    // Before the device: a wrong option says so on a machine without one too.
+    validate_render_options(options);
     const Clock::time_point start = Clock::now();
     MessageLog log;
     RenderResult result;

@@ -120,4 +120,20 @@ std::vector<gpu::Light> load_points_csv(const std::filesystem::path& file);
 // not finite as a float or the extent along an axis passes 1e19.
 void update_bounds(Scene& scene);
 
+// Checks a scene as the loaders check what they read, for one built or
+// changed in code; prepare_scene calls it. Throws InputError naming
+// scene.file ("scene" where it is empty) and the field: a camera that is not
+// finite, has look_at at its position or up along the view, a field of view
+// outside (0, 180) degrees or a width or height outside 1 to 16384;
+// normals not one per triangle, uvs neither one per triangle nor none, a
+// triangle whose material is not one of the scene's, a vertex, normal or uv
+// that is not finite; a material value outside its range (colours and the
+// Disney parameters 0 to 1, alpha above 0 to 1, emission finite and not
+// negative) or naming a texture the scene does not have, a texture reaching
+// past the texels; a light of no known type, not finite, of negative
+// intensity, without a unit direction or axis where its type has one, a spot
+// whose cosines are out of order, or lights whose totals or extent the
+// loaders refuse (load_scene above).
+void check_scene(const Scene& scene);
+
 }  // namespace lc
