@@ -1,4 +1,4 @@
-// Shadow rays per second: the software BVH (shaders/shared/trace.h, as the
+// Shadow rays per second: the software BVH (shaders/lc_shared/trace.h, as the
 // CPU path runs it) against Embree 3 on the same rays: the ones brute force
 // traces on a scene (from every camera hit to every light that can light
 // it), and the ones lightcuts traces with a cut per pixel (recorded by the

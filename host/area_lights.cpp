@@ -14,7 +14,7 @@
 #include "scene/float_limits.h"
 #include "scene/huge_pages.h"
 #include "scene/light_records.h"
-#include "shared/color.h"
+#include "lc_shared/color.h"
 
 namespace lc {
 namespace {

@@ -11,12 +11,12 @@
 
 #include "lightcuts/light_tree.h"
 #include "lightcuts/scene.h"
-#include "shared/types.h"
+#include "lc_shared/types.h"
 
 namespace lc {
 
 // What emissive triangles emit, their materials' emissive textures applied
-// (shaders/shared/textures.h): at a point, and on average over a triangle.
+// (shaders/lc_shared/textures.h): at a point, and on average over a triangle.
 // Without uvs/textures (empty spans) emission is each material's constant.
 class TriangleEmission {
 public:

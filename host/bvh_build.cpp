@@ -395,7 +395,7 @@ void collapse_bvh(const std::vector<BvhNode>& nodes, const std::vector<gpu::Tria
 
 namespace {
 
-// A plane of a Bvh4Node as the kernels decode it (shared/trace.h,
+// A plane of a Bvh4Node as the kernels decode it (lc_shared/trace.h,
 // lc_bvh4_node): plane * scale is exact, so this is their sum bit for bit.
 float bvh4_plane(float origin, float scale, std::uint32_t plane) { return origin + float(plane) * scale; }
 
@@ -443,7 +443,7 @@ void quantize_axis(const float (&lo)[4], const float (&hi)[4], const std::int32_
 std::vector<gpu::Bvh4Node> bvh4_nodes(const std::vector<WideBvhNode>& wide_nodes,
                                       const std::vector<WideLeaf>& wide_leaves) {
     // lc_trace_any keeps a node's index and four bits in one stack word
-    // (shaders/shared/trace.h). A tree has about one wide node per three
+    // (shaders/lc_shared/trace.h). A tree has about one wide node per three
     // to four triangles (1,004 for the room's 3,492), so below build_bvh's
     // 2^29 triangles this is not reached in practice.
     if (wide_nodes.size() >= std::size_t(1) << 28)

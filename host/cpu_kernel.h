@@ -1,4 +1,4 @@
-// The shared kernel headers (shaders/shared/*.h) compiled as C++ for the CPU
+// The shared kernel headers (shaders/lc_shared/*.h) compiled as C++ for the CPU
 // reference: the same intersection, traversal, shading, bound and cut code
 // the Vulkan kernels run, here as member functions reading host arrays.
 #pragma once
@@ -19,10 +19,10 @@
 #include "lightcuts/render.h"
 #include "pair_bound.h"
 #include "wide_trace.h"
-#include "shared/types.h"
-#include "shared/color.h"
-#include "shared/octahedral.h"
-#include "shared/glsl_compat.h"
+#include "lc_shared/types.h"
+#include "lc_shared/color.h"
+#include "lc_shared/octahedral.h"
+#include "lc_shared/glsl_compat.h"
 
 namespace lc::cpu {
 
@@ -52,7 +52,7 @@ struct TraceKernel {
 
 #define LC_BVH_NODE(i) bvh_nodes[i]
 #define LC_TRIANGLE(i) triangles[i]
-#include "shared/trace.h"
+#include "lc_shared/trace.h"
 #undef LC_BVH_NODE
 #undef LC_TRIANGLE
 };
@@ -76,14 +76,14 @@ struct Trace4Kernel {
 #define LC_TRIANGLE(i) triangles[i]
 #define LC_BVH4_WORD(i, k) bvh4_word(i, k)
 #define LC_ON_TRIP() (trips != nullptr ? void(++*trips) : void())
-#include "shared/trace.h"
+#include "lc_shared/trace.h"
 #undef LC_BVH_NODE
 #undef LC_TRIANGLE
 #undef LC_BVH4_WORD
 #undef LC_ON_TRIP
 };
 
-// Texture lookups and materials at a point only (shared/textures.h): what
+// Texture lookups and materials at a point only (lc_shared/textures.h): what
 // the host needs to sample textured emitters.
 struct TextureKernel {
     const Material* materials = nullptr;
@@ -96,7 +96,7 @@ struct TextureKernel {
 #define LC_UVS(i) uvs[i]
 #define LC_TEXTURE(i) textures[i]
 #define LC_TEXEL(i) texels[i]
-#include "shared/textures.h"
+#include "lc_shared/textures.h"
 #undef LC_MATERIAL
 #undef LC_UVS
 #undef LC_TEXTURE
@@ -105,7 +105,7 @@ struct TextureKernel {
 
 // The CPU's cut-heap entry: the GPU's CutEntry (node and visibility bit,
 // error bound) and the representative's unit contribution, which the GPU
-// evaluates again instead of storing (shared/lightcuts.h, lc_entry_unit).
+// evaluates again instead of storing (lc_shared/lightcuts.h, lc_entry_unit).
 struct HeapEntry {
     uint node;
     float error;
@@ -146,7 +146,7 @@ private:
     std::vector<HeapPayload> payload_;
 };
 
-// lc_heap_smallest's answer on the CPU's heap (shared/lightcuts.h): the
+// lc_heap_smallest's answer on the CPU's heap (lc_shared/lightcuts.h): the
 // first slot of [from, to) whose error is the smallest, if that error is
 // below `bound`; kInvalidIndex if none is. A full heap is searched at most
 // refinements once cuts outgrow it (K = 64 against cuts of 150 to 250 on
@@ -259,12 +259,12 @@ struct BasicShadeKernel {
 #define LC_TRACE_ANY(o, d, t) lc_trace_shadow(o, d, t)
 #define LC_TRACE_CLOSEST(o, d, t_max, t, b1, b2) lc_trace_first_hit(o, d, t_max, t, b1, b2)
 #define LC_CHILD_ERRORS(sp, m, left, right, d2) lc_child_errors(sp, m, left, right, d2)
-#include "shared/trace.h"
-#include "shared/textures.h"
-#include "shared/shading.h"
-#include "shared/brute.h"
-#include "shared/sampling.h"
-#include "shared/lightcuts.h"
+#include "lc_shared/trace.h"
+#include "lc_shared/textures.h"
+#include "lc_shared/shading.h"
+#include "lc_shared/brute.h"
+#include "lc_shared/sampling.h"
+#include "lc_shared/lightcuts.h"
 #undef LC_BVH_NODE
 #undef LC_TRIANGLE
 #undef LC_NORMALS

@@ -7,7 +7,7 @@
 #include <glm/glm.hpp>
 
 #include "scene/light_records.h"
-#include "shared/color.h"
+#include "lc_shared/color.h"
 
 namespace lc {
 namespace {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "lightcuts/scene.h"
-#include "shared/types.h"
+#include "lc_shared/types.h"
 
 namespace lc {
 

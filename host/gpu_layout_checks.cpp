@@ -2,7 +2,7 @@
 // GLSL kernels expect: sizes and offsets of every field the shaders read.
 #include <cstddef>
 
-#include "shared/types.h"
+#include "lc_shared/types.h"
 
 namespace lc::gpu {
 
@@ -11,7 +11,7 @@ static_assert(offsetof(BvhNode, first_or_left) == 12);
 static_assert(offsetof(BvhNode, max_x) == 16);
 static_assert(offsetof(BvhNode, tri_count) == 28);
 
-// kBvh4NodeWords uvec4 words, read as such (shaders/kernel.glsl, shared/trace.h's lc_bvh4_node).
+// kBvh4NodeWords uvec4 words, read as such (shaders/kernel.glsl, lc_shared/trace.h's lc_bvh4_node).
 static_assert(sizeof(Bvh4Node) == 16 * kBvh4NodeWords);
 static_assert(offsetof(Bvh4Node, scale_x) == 12);
 static_assert(offsetof(Bvh4Node, scale_y) == 16);

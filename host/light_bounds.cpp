@@ -8,7 +8,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
-#include "shared/octahedral.h"
+#include "lc_shared/octahedral.h"
 
 namespace lc {
 namespace {

@@ -1,6 +1,6 @@
 // What the light tree needs to know of a light (pbrt-v4's LightBounds):
 // where it sits in its tree's box, and the cone of directions it emits
-// into. With the emission switch in shaders/shared/shading.h, the only
+// into. With the emission switch in shaders/lc_shared/shading.h, the only
 // place the tree looks at a light's type.
 //
 // The cone: every light's axis lies within theta_o of `axis`, and each
@@ -17,7 +17,7 @@
 #include <immintrin.h>
 #endif
 
-#include "shared/types.h"
+#include "lc_shared/types.h"
 
 namespace lc {
 

@@ -16,7 +16,7 @@
 // whose partner disappeared. O(n^2) time overall for typical inputs.
 #include "lightcuts/light_tree.h"
 
-#include "shared/color.h"
+#include "lc_shared/color.h"
 
 #include <algorithm>
 #include <atomic>

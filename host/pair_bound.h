@@ -10,7 +10,7 @@
 // then takes the quad evaluation below with the point in one lane where it
 // covers both children, else evaluates one child at a time.
 // A change to lc_cluster_bound, lc_cosine_bound, lc_box_distance2 or
-// lc_luminance (shaders/shared) must be made here too; the test fails until
+// lc_luminance (shaders/lc_shared) must be made here too; the test fails until
 // it is.
 //
 // The quad functions below do the same for one cluster at the four shaded
@@ -34,8 +34,8 @@
 
 #include <glm/glm.hpp>
 
-#include "shared/octahedral.h"
-#include "shared/types.h"
+#include "lc_shared/octahedral.h"
+#include "lc_shared/types.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -608,7 +608,7 @@ void octet_pair_errors(Kernel& kernel, const QuadLanes& q, const gpu::LightNode&
 // directional light, or the points' lanes not covered (QuadLanes). The
 // BRDF is evaluated in the lanes too, the GGX lobe's and the Disney BRDF's
 // (quad_bounds_body.h, light_values). A change to lc_light_unit,
-// lc_brdf_cos or lc_disney_brdf_cos (shaders/shared/shading.h) must be made
+// lc_brdf_cos or lc_disney_brdf_cos (shaders/lc_shared/shading.h) must be made
 // there too; the test fails until it is.
 template <class Kernel>
 bool quad_light_units(Kernel& kernel, const QuadLanes& q, const gpu::Light& light, float min_distance2,

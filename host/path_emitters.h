@@ -12,7 +12,7 @@
 
 #include "lightcuts/scene.h"
 #include "scene/float_limits.h"
-#include "shared/types.h"
+#include "lc_shared/types.h"
 
 namespace lc::path {
 

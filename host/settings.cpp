@@ -27,7 +27,7 @@ std::string shortest(float v) {
 
 }  // namespace
 
-// lc_pixel_key (shaders/shared/shading.h) packs a pixel's x and y in 14 bits each.
+// lc_pixel_key (shaders/lc_shared/shading.h) packs a pixel's x and y in 14 bits each.
 static_assert(kMaxImageSide <= (1u << 14), "image sides past 2^14 need another pixel key");
 
 std::string setting_problem(std::string_view key, double value) {

@@ -9,7 +9,7 @@
 #include "path_emitters.h"
 #include "run_on_threads.h"
 #include "scene/light_records.h"
-#include "shared/color.h"
+#include "lc_shared/color.h"
 
 namespace lc {
 namespace {

@@ -11,7 +11,7 @@
 
 #include "lightcuts/bvh.h"
 #include "lightcuts/scene.h"
-#include "shared/types.h"
+#include "lc_shared/types.h"
 
 namespace lc {
 

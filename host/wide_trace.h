@@ -4,7 +4,7 @@
 // (lc::WideBvhNode and lc::WideLeaf, collapse_bvh): one SSE slab test checks
 // a node's four children at once, one SSE triangle test a leaf's (up to)
 // four triangles. Both are the kernels' own tests (lc_hit_box and the
-// watertight lc_intersect_sheared of shaders/shared/trace.h) computed lane
+// watertight lc_intersect_sheared of shaders/lc_shared/trace.h) computed lane
 // by lane with the same operations in the same order, so the answer is the
 // binary traversal's: a triangle is tested here whenever it is there (each
 // of its boxes passes the same test), and each test gives the same result.
@@ -14,7 +14,7 @@
 // so that rounding does not make a ray miss a box around its hit point:
 // the extra tests find nothing the binary walk does not. The Bvh tests
 // check every walk against brute force.)
-// A change to lc_hit_box or lc_intersect_sheared (shaders/shared/trace.h)
+// A change to lc_hit_box or lc_intersect_sheared (shaders/lc_shared/trace.h)
 // must be made here too; the Bvh tests compare the two traversals.
 #pragma once
 

@@ -2,12 +2,12 @@
 // constant ids, workgroup size and the per-pixel statistics record.
 //
 // Compiles as GLSL (included by the kernels) and as C++ (included by
-// host/vulkan), in the same way as shared/types.h, so the host sizes its
+// host/vulkan), in the same way as lc_shared/types.h, so the host sizes its
 // dispatches and buffers from these constants.
 #ifndef LC_BINDINGS_GLSL
 #define LC_BINDINGS_GLSL
 
-#include "shared/types.h"
+#include "lc_shared/types.h"
 
 #ifdef __cplusplus
 namespace lc::gpu {

@@ -7,7 +7,7 @@
 
 #include "kernel.glsl"
 #define LC_LIGHT(i) lc_light(push.light_first + (i))
-#include "shared/brute.h"
+#include "lc_shared/brute.h"
 
 void main() {
     uint i = lc_tile_pixel();

@@ -1,4 +1,4 @@
-// The per-invocation cut heap of shared/lightcuts.h: K = kHeapSlots entries,
+// The per-invocation cut heap of lc_shared/lightcuts.h: K = kHeapSlots entries,
 // an array of the invocation's own (kHeapPrivate, the default) or in
 // workgroup shared memory. K is the smaller of render.cut_heap and the
 // tree's LightTree::cut_heap_capacity(max_cut); a cut that would outgrow it
@@ -71,8 +71,8 @@ void lc_heap_restore(uint heap_size) {
 // one lane at a time, at a constant index all the lanes at once; and it ends
 // an invocation's loops after 65535 iterations in all, which a quad's scans
 // of 128 slots a freeze had reached at the room's deepest cuts); above that
-// shared/lightcuts.h's loop. Same slots, same order, same answer.
-uint lc_heap_smallest_scan(uint from, uint to, float bound);  // shared/lightcuts.h
+// lc_shared/lightcuts.h's loop. Same slots, same order, same answer.
+uint lc_heap_smallest_scan(uint from, uint to, float bound);  // lc_shared/lightcuts.h
 
 uint lc_heap_smallest_full(uint from, uint to, float bound) {
     if (kHeapSlots > 256u) return lc_heap_smallest_scan(from, to, bound);

@@ -15,7 +15,7 @@ layout(local_size_x_id = kSpecWorkgroupSize) in;
 
 // Switched off for scenes that do not need them, so the compiler drops the
 // GGX lobe, the shadow-ray traversal, the Disney BRDF or its sheen and
-// clearcoat lobes (shared/shading.h reads these).
+// clearcoat lobes (lc_shared/shading.h reads these).
 layout(constant_id = kSpecEnableGgx) const bool kEnableGgx = true;
 layout(constant_id = kSpecEnableShadows) const bool kEnableShadows = true;
 layout(constant_id = kSpecEnableOriented) const bool kEnableOriented = true;
@@ -134,12 +134,12 @@ LightNode lc_light_node(uint i) {
 #define LC_ENVIRONMENT_TEXEL(i) vec3(lc_environment(3u * (i)), lc_environment(3u * (i) + 1u), lc_environment(3u * (i) + 2u))
 // LC_LIGHT is defined by each kernel (brute force offsets it by light_first).
 
-#include "shared/glsl_compat.h"
-#include "shared/color.h"
-#include "shared/octahedral.h"
-#include "shared/trace.h"
-#include "shared/textures.h"
-#include "shared/shading.h"
+#include "lc_shared/glsl_compat.h"
+#include "lc_shared/color.h"
+#include "lc_shared/octahedral.h"
+#include "lc_shared/trace.h"
+#include "lc_shared/textures.h"
+#include "lc_shared/shading.h"
 
 // Index of this invocation's pixel inside the tile, or kInvalidIndex for the
 // invocations of the last block that lie past the tile. Workgroups take the

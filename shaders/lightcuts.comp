@@ -2,7 +2,7 @@
 // G-buffer point of every tile pixel; the result is added to the pixel's sum.
 // With kStochastic (--method stochastic, Yuksel 2019) the cut is selected
 // the same way and then each of its clusters that is not a single light is
-// shaded again with a representative drawn afresh (shared/lightcuts.h,
+// shaded again with a representative drawn afresh (lc_shared/lightcuts.h,
 // lc_shade_stochastic).
 //
 // One dispatch normally runs each cut from the roots to the end. Where the
@@ -16,8 +16,8 @@
 #include "kernel.glsl"
 #include "heap.glsl"
 #define LC_LIGHT(i) lc_light(i)
-#include "shared/sampling.h"
-#include "shared/lightcuts.h"
+#include "lc_shared/sampling.h"
+#include "lc_shared/lightcuts.h"
 
 layout(constant_id = kSpecStochastic) const bool kStochastic = false;
 

@@ -28,8 +28,8 @@
 #define LC_HEAP_ORDER key
 #include "heap.glsl"
 #define LC_LIGHT(i) lc_light(i)
-#include "shared/sampling.h"
-#include "shared/lightcuts.h"
+#include "lc_shared/sampling.h"
+#include "lc_shared/lightcuts.h"
 
 layout(std430, binding = kBindingCutState) buffer CutStates { CutState cut_states[]; };
 

@@ -1,7 +1,7 @@
 // Light sampling (--method sampled): light samples
 // [push.light_first, push.light_first + push.light_count) of the
 // frame.light_samples drawn at the G-buffer point of every tile pixel
-// (shared/sampling.h), one shadow ray each; their sum, each divided by
+// (lc_shared/sampling.h), one shadow ray each; their sum, each divided by
 // frame.light_samples, is added to the pixel's sum. The host covers all
 // light samples in one dispatch, or in several ranges where the driver
 // limits the loop iterations.
@@ -10,7 +10,7 @@
 
 #include "kernel.glsl"
 #define LC_LIGHT(i) lc_light(i)
-#include "shared/sampling.h"
+#include "lc_shared/sampling.h"
 
 void main() {
     uint i = lc_tile_pixel();

@@ -1,4 +1,4 @@
-// BVH build and the shared traversal (shaders/shared/trace.h, run on the CPU
+// BVH build and the shared traversal (shaders/lc_shared/trace.h, run on the CPU
 // through lc::cpu::TraceKernel), checked against brute force over every
 // triangle with the same intersection routine.
 #include <algorithm>

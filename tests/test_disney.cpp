@@ -1,4 +1,4 @@
-// The Disney BRDF (shaders/shared/shading.h) against a reference written
+// The Disney BRDF (shaders/lc_shared/shading.h) against a reference written
 // independently in double precision from Burley's formulas, its physical
 // properties, and its per-lobe Lightcuts bounds (docs/disney-bounds.md).
 #include <algorithm>

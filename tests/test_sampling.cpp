@@ -1,4 +1,4 @@
-// The stochastic methods on the CPU (shaders/shared/sampling.h): the
+// The stochastic methods on the CPU (shaders/lc_shared/sampling.h): the
 // probabilities tree descent gives the lights, and the unbiasedness of
 // --method sampled and --method stochastic against brute force.
 #include <algorithm>

@@ -1,5 +1,5 @@
 // The BRDF against analytic truth. The CPU and Vulkan paths share
-// shaders/shared/shading.h, so comparing them cannot catch a wrong formula:
+// shaders/lc_shared/shading.h, so comparing them cannot catch a wrong formula:
 // these tests check the formula itself against closed forms written
 // differently from the kernel's.
 #include <algorithm>

@@ -1,4 +1,4 @@
-// Textures (shaders/shared/textures.h, host/scene/textures.h): lookups
+// Textures (shaders/lc_shared/textures.h, host/scene/textures.h): lookups
 // against hand-made textures with known texels (texel centres, bilinear
 // weights, wrapping, sRGB decoding), mipmap chains and the levels a ray
 // cone's footprint reads, the material at a point, normal maps,

@@ -11,7 +11,7 @@
 
 #include "lightcuts/error.h"
 #include "materials.h"
-#include "shared/color.h"
+#include "lc_shared/color.h"
 #include "textures.h"
 
 namespace lc::loader {

@@ -9,7 +9,7 @@
 
 #include <glm/glm.hpp>
 
-#include "shared/types.h"
+#include "lc_shared/types.h"
 
 namespace lc::loader {
 

@@ -6,7 +6,7 @@
 
 #include <glm/glm.hpp>
 
-#include "shared/types.h"
+#include "lc_shared/types.h"
 
 namespace tinyobj {
 struct material_t;
@@ -27,7 +27,7 @@ gpu::Material make_material(glm::vec3 kd, glm::vec3 ks, float alpha);
 // unless both_sides; black emission leaves the material as it is.
 void set_emission(gpu::Material& m, glm::vec3 radiance, bool both_sides);
 
-// The Disney BRDF's parameters (shared/types.h, Material), with Burley's
+// The Disney BRDF's parameters (lc_shared/types.h, Material), with Burley's
 // defaults; each in [0, 1].
 struct DisneyParams {
     glm::vec3 base_color{kDefaultAlbedo};

@@ -1,4 +1,4 @@
-// Textures the materials sample (shaders/shared/textures.h): decoded once to
+// Textures the materials sample (shaders/lc_shared/textures.h): decoded once to
 // RGBA8 and appended to Scene::texels, one TextureInfo each.
 #pragma once
 

@@ -64,7 +64,7 @@ public:
               std::uint32_t cut_heap, std::uint32_t shared_memory_bytes, bool stochastic, bool quads)
         : stochastic_(stochastic), quads_(quads) {
         // Walter 2005 §4 keeps a max-heap of the refinable clusters of the
-        // cut, here bounded by K = render.cut_heap (shared/lightcuts.h,
+        // cut, here bounded by K = render.cut_heap (lc_shared/lightcuts.h,
         // lc_heap_push); the tree bounds it too, whatever max_cut says. A
         // quad's shared cut pools its four points' K, as on the CPU
         // (host/cpu_renderer.cpp), and each of its lanes holds all of it

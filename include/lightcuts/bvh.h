@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "shared/types.h"
+#include "lc_shared/types.h"
 
 namespace lc {
 

@@ -10,7 +10,7 @@
 
 #include <glm/glm.hpp>
 
-#include "shared/color.h"
+#include "lc_shared/color.h"
 
 namespace lc {
 

@@ -13,7 +13,7 @@
 #include <utility>
 #include <vector>
 
-#include "shared/types.h"
+#include "lc_shared/types.h"
 
 namespace lc {
 

@@ -1,5 +1,5 @@
 // Scene description: camera, triangles, materials, lights, render settings.
-// The vectors hold exactly the records the GPU reads (shaders/shared/types.h).
+// The vectors hold exactly the records the GPU reads (shaders/lc_shared/types.h).
 #pragma once
 
 #include <cstddef>
@@ -11,7 +11,7 @@
 #include <glm/glm.hpp>
 
 #include "settings.h"
-#include "shared/types.h"
+#include "lc_shared/types.h"
 
 namespace lc {
 

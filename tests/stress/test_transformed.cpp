@@ -7,7 +7,7 @@
 //    at every magnitude, so the only change is the rounding of each
 //    coordinate to its nearest float (2^-24 relative), far below anything
 //    visible. Shading points are offset off their surface by a distance
-//    relative to the triangle's coordinates (shaders/shared/trace.h), so
+//    relative to the triangle's coordinates (shaders/lc_shared/trace.h), so
 //    that also scales. Measured below; limits at about 3x that.
 //  - Translated by 1e5: coordinates near 1e5 are floats spaced 2^-7 =
 //    0.0078 apart, so every vertex and light moves by up to 0.0039 per

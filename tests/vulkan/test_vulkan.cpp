@@ -223,7 +223,7 @@ TEST(TuningFromEnvironment, TakesTheNamedValuesAndRefusesOthers) {
 // height h straight above the point the centre pixel sees, on a Lambert
 // plane of albedo 0.5, gives radiance kd/pi * I * cos / d^2 = 0.5 there.
 // The shaded point sits kHitOffsetRelative (2^-20) of the triangle's largest
-// coordinate (2) above the plane (shaders/shared/trace.h, against
+// coordinate (2) above the plane (shaders/lc_shared/trace.h, against
 // self-intersection), which raises 1/d^2 by 2.5e-6 relative: the expected
 // value is 0.5 (h / (h - offset))^2, within 1e-7 (two float steps at 0.5;
 // measured 2e-8).
@@ -292,7 +292,7 @@ TEST_F(Vulkan, BruteMatchesCpuOnRandomScenes) {
 }
 
 // The kernels' brute force keeps every light too (compensated summation,
-// shaders/shared/brute.h): 65,536 lights each about 2^-27 of the sum of
+// shaders/lc_shared/brute.h): 65,536 lights each about 2^-27 of the sum of
 // eight bright ones, which a plain float sum rounds away (5e-4 of the
 // light, 15 times the tolerance), match the CPU's double sum
 // (BruteForce.ManyDimLightsBesideBrightOnesAllCount) to the tolerance of

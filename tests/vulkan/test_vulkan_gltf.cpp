@@ -54,7 +54,7 @@ TEST_F(Vulkan, TexturedGltfSceneMatchesTheCpu) {
 
 // The same with the textures sampled every other way: clamped, mirrored,
 // nearest and through a rotating, scaling uv transform (glTF samplers and
-// KHR_texture_transform; shaders/shared/textures.h).
+// KHR_texture_transform; shaders/lc_shared/textures.h).
 TEST_F(Vulkan, TexturedGltfSceneWithOtherSamplersMatchesTheCpu) {
     Scene s = load_scene(LC_SOURCE_DIR "/scenes/gltf/textured.gltf");
     s.render.area_light_samples = 1024;

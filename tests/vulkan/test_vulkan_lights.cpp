@@ -155,7 +155,7 @@ TEST_P(VulkanLights, ZeroErrorLightcutsIsBruteForce) {
 }
 
 // The stochastic methods on both devices with the same seed: the same
-// random numbers (shared/sampling.h hashes the seed, pixel and sample) give
+// random numbers (lc_shared/sampling.h hashes the seed, pixel and sample) give
 // the same lights. A descent step whose random number falls within rounding
 // of its branch probability may go the other way on one device, so a few
 // pixels may differ by a light's contribution; they are only counted.

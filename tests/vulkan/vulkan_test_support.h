@@ -4,7 +4,7 @@
 // and seeded random scenes.
 //
 // Tolerances. The kernels are the same source on both sides
-// (shaders/shared/*.h), but the GPU compiler may contract a*b+c into one
+// (shaders/lc_shared/*.h), but the GPU compiler may contract a*b+c into one
 // FMA and has its own sqrt/inversesqrt/acos, while the CPU build rounds
 // every operation; brute force split over light ranges (docs/vulkan.md)
 // also adds the ranges' sums instead of one sum. So values differ by a few

@@ -2,7 +2,7 @@
 // (--method sampled) and the fresh representatives of Stochastic Lightcuts
 // (--method stochastic). Shared by the CPU reference and the Vulkan
 // kernels; needs trace.h and shading.h first. The includer defines
-// LC_LIGHT_NODE(i) -> LightNode as for shared/lightcuts.h.
+// LC_LIGHT_NODE(i) -> LightNode as for lc_shared/lightcuts.h.
 //
 // Every random number is a hash of (seed, pixel, camera sample, stream), so
 // a render is deterministic for its seed and the same on both devices, and

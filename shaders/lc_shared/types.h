@@ -159,7 +159,7 @@ struct Material {
 // One texture as a material samples it (40 bytes): an image of width x
 // height texels, row 0 at the top (v = 0), RGBA8 packed one per uint (R in
 // the low byte) from texel `offset` of the texel buffer, and how it is
-// sampled (`sampling`, below; shared/textures.h). Textures that sample one
+// sampled (`sampling`, below; lc_shared/textures.h). Textures that sample one
 // image in different ways share its texels.
 //
 // sampling: bits 0-1 the wrapping along u, bits 2-3 along v (kTextureWrap*),
@@ -243,7 +243,7 @@ struct GBufferTexel {
 // and its error bound. The representative's unscaled contribution
 // (material * geometry * visibility) is not stored: bit 31 of `node` keeps
 // the visibility its shadow ray found, and the contribution is evaluated
-// again from it when needed (lc_entry_unit, shared/lightcuts.h), which costs
+// again from it when needed (lc_entry_unit, lc_shared/lightcuts.h), which costs
 // no ray. The child with the same representative inherits the bit.
 struct CutEntry {
     uint node;    // light-node index in bits 0-30, kCutEntryVisible
