@@ -65,7 +65,7 @@ TEST(CpuRender, ASceneBuiltInCodeIsCheckedAsALoadedOneIs) {
               "scene: lights[1]: position or direction is not finite");
     EXPECT_EQ(problem([](Scene& s) { s.lights[0].g = -1.0f; }),
               "scene: lights[0]: intensity must be finite and not negative");
-    EXPECT_EQ(problem([](Scene& s) { s.lights[0].type = 9u; }), "scene: lights[0].type: is 9, not a light type");
+    EXPECT_EQ(problem([](Scene& s) { s.lights[0].type = 9u; }), "scene: lights[0].type: is not a light type (kLightPoint ... kLightVpl, kLightTwoSided)");
     EXPECT_EQ(problem([](Scene& s) { s.lights[0].r = s.lights[1].r = 3e38f; }),
               "scene: lights: total red intensity of the point lights exceeds the float range (3.4e38)");
     EXPECT_EQ(problem([](Scene& s) { s.camera.width = 0; }), "scene: camera.width: must be from 1 to 16384, got 0");

@@ -2,6 +2,7 @@
 #include "lightcuts/scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -93,6 +94,33 @@ namespace {
 bool finite3(float x, float y, float z) { return std::isfinite(x) && std::isfinite(y) && std::isfinite(z); }
 bool in_unit(float v) { return v >= 0.0f && v <= 1.0f; }
 
+// What is wrong with a light on its own: a field to add to "lights[i]" and
+// the problem; a null problem where nothing is.
+struct LightFault {
+    const char* field = "";
+    const char* problem = nullptr;
+};
+
+LightFault light_problem(const gpu::Light& l) {
+    const std::uint32_t type = l.type & gpu::kLightTypeMask;
+    if (type >= gpu::kLightTypeCount || (l.type & ~(gpu::kLightTypeMask | gpu::kLightTwoSided)) != 0u)
+        return {".type", "is not a light type (kLightPoint ... kLightVpl, kLightTwoSided)"};
+    if (!finite3(l.x, l.y, l.z)) return {"", "position or direction is not finite"};
+    if (!(l.r >= 0.0f && l.g >= 0.0f && l.b >= 0.0f && finite3(l.r, l.g, l.b)))
+        return {"", "intensity must be finite and not negative"};
+    const auto unit = [](float x, float y, float z) {
+        return std::abs(std::sqrt(double(x) * x + double(y) * y + double(z) * z) - 1.0) <= 1e-3;
+    };
+    if (type == gpu::kLightDirectional && !unit(l.x, l.y, l.z))
+        return {"", "a directional light's x, y, z is the unit vector towards it"};
+    if ((type == gpu::kLightSpot || type == gpu::kLightOriented || type == gpu::kLightVpl) &&
+        !unit(l.axis_x, l.axis_y, l.axis_z))
+        return {".axis", "must be a unit vector"};
+    if (type == gpu::kLightSpot && !(l.cos_outer >= -1.0f && l.cos_outer <= l.cos_inner && l.cos_inner <= 1.0f))
+        return {"", "a spot's cosines must satisfy -1 <= cos_outer <= cos_inner <= 1"};
+    return {};
+}
+
 }  // namespace
 
 void check_scene(const Scene& scene) {
@@ -165,27 +193,31 @@ void check_scene(const Scene& scene) {
             if (!std::isfinite(v)) fail(name + ".uv_transform", "must be finite");
     }
 
-    // The lights as the loaders make them, and the totals they check.
-    loader::LightLimits limits(geometry_box(scene));
+    // The lights as the loaders make them, and the totals they check: in
+    // one pass that names nothing (10^7 lights from a file, which the loader
+    // has checked already, take about 0.12 s of the 8 to 10 s their render
+    // takes; 0.38 s when each light's name was made as it was checked), and
+    // where it finds a fault, again light by light to name the first.
+    const loader::Box geometry = geometry_box(scene);
+    std::array<glm::dvec3, gpu::kLightTypeCount> totals{};
+    loader::Box box = geometry;
+    bool fine = true;
+    for (const gpu::Light& l : scene.lights) {
+        if (light_problem(l).problem != nullptr) {
+            fine = false;
+            break;
+        }
+        const std::uint32_t type = l.type & gpu::kLightTypeMask;
+        totals[type] += glm::dvec3(l.r, l.g, l.b);
+        if (type != gpu::kLightDirectional) box.grow(glm::dvec3(l.x, l.y, l.z));
+    }
+    for (const glm::dvec3& t : totals) fine = fine && loader::fits_float(t);
+    if (fine && loader::extent_problem(box).empty()) return;
+    loader::LightLimits limits(geometry);
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         const gpu::Light& l = scene.lights[i];
         const std::string name = "lights[" + std::to_string(i) + "]";
-        const std::uint32_t type = l.type & gpu::kLightTypeMask;
-        if (type >= gpu::kLightTypeCount || (l.type & ~(gpu::kLightTypeMask | gpu::kLightTwoSided)) != 0u)
-            fail(name + ".type", "is " + std::to_string(l.type) + ", not a light type");
-        if (!finite3(l.x, l.y, l.z)) fail(name, "position or direction is not finite");
-        if (!(l.r >= 0.0f && l.g >= 0.0f && l.b >= 0.0f && finite3(l.r, l.g, l.b)))
-            fail(name, "intensity must be finite and not negative");
-        const auto unit = [](float x, float y, float z) {
-            return std::abs(std::sqrt(double(x) * x + double(y) * y + double(z) * z) - 1.0) <= 1e-3;
-        };
-        if (type == gpu::kLightDirectional && !unit(l.x, l.y, l.z))
-            fail(name, "a directional light's x, y, z is the unit vector towards it");
-        if ((type == gpu::kLightSpot || type == gpu::kLightOriented || type == gpu::kLightVpl) &&
-            !unit(l.axis_x, l.axis_y, l.axis_z))
-            fail(name + ".axis", "must be a unit vector");
-        if (type == gpu::kLightSpot && !(l.cos_outer >= -1.0f && l.cos_outer <= l.cos_inner && l.cos_inner <= 1.0f))
-            fail(name, "a spot's cosines must satisfy -1 <= cos_outer <= cos_inner <= 1");
+        if (const LightFault f = light_problem(l); f.problem != nullptr) fail(name + f.field, f.problem);
         if (const loader::LightLimits::Problem p = limits.add(l); p.fault != loader::LightLimits::Fault::none)
             fail(p.fault == loader::LightLimits::Fault::total ? "lights" : name, p.text);
     }
