@@ -272,6 +272,7 @@ int run(int argc, char** argv) {
         std::fill(hits.begin(), hits.end(), 0);
         std::vector<std::uint64_t> trips(threads, 0);
         s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+            trips[t] = 0;  // counted afresh by each of the timed runs
             lc::cpu::Trace4Kernel k4{p.bvh.nodes.data(), p.scene.triangles.data(), p.bvh.kernel_nodes.data(),
                                      &trips[t]};
             std::size_t h = 0;

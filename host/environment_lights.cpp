@@ -45,12 +45,14 @@ struct Totals {
 // bands a row from about 1300).
 //
 // Columns are cut the same way, into `csub` bands of equal azimuth, where a
-// texel column is wider than a direction's square at the equator: a map 1
+// texel column is at least two directions' squares wide at the equator (and
+// the map has more than one row or band): a map 1
 // to 4 texels wide put each texel's light on its column's middle azimuth,
 // so under a constant 1 x 4096 sky a plane facing -Z got 2.9 times its
 // light and one facing +Z none, and the single texel of a `color` sky gave
 // its 3000 directions 17 azimuths, whose shadows were spokes. A 2:1 map W
-// texels wide keeps csub = 1 up to about W^2 / pi directions.
+// texels wide keeps csub = 1 up to about 4 W^2 / pi directions (334,000
+// for the shipped sky).
 class Splitter {
 public:
     Splitter(const Environment& map, std::uint32_t count, std::vector<gpu::Light>& out) : map_(map), out_(out) {

@@ -12,7 +12,7 @@
 // Every value is computed with the same operations in the same order as
 // the scalar lc_cluster_bound, lc_ggx_bound, lc_disney_bound,
 // lc_emission_bound, lc_light_unit, lc_brdf_cos and lc_disney_brdf_cos
-// (shaders/shared), so the results are theirs bit for bit
+// (shaders/lc_shared), so the results are theirs bit for bit
 // (tests/test_quad_cut.cpp). Those bounds form no angles (no acos, asin or
 // cos) for this: sqrt, like the rest, is rounded the same way in every lane.
 // No include guard: included once per vector width.

@@ -84,8 +84,25 @@ TEST(CpuRender, ASceneBuiltInCodeIsCheckedAsALoadedOneIs) {
               "scene: normals: holds " + std::to_string(triangles - 1) + " entries for " + std::to_string(triangles) +
                   " triangles (one per triangle)");
     EXPECT_EQ(problem([](Scene& s) { s.materials[1].kd_g = 1.5f; }), "scene: materials[1].kd_g: must be from 0 to 1");
-    EXPECT_EQ(problem([](Scene& s) { s.materials[0].base_color_texture = 0; }),
+    EXPECT_EQ(problem([](Scene& s) { s.materials[0].base_color_texture = 0; }), "");  // not textured: not read
+    EXPECT_EQ(problem([](Scene& s) {
+                  s.materials[0].base_color_texture = 0;
+                  s.materials[0].flags |= gpu::kMaterialTextured;
+              }),
               "scene: materials[0].base_color_texture: is 0; the scene has 0 textures");
+    EXPECT_EQ(problem([](Scene& s) {
+                  s.environment.width = 4;
+                  s.environment.height = 2;
+                  s.environment.rgb.assign(4 * 2 * 3 - 1, 1.0f);
+              }),
+              "scene: environment.rgb: holds 23 values for 4 x 2 pixels (three each)");
+    EXPECT_EQ(problem([](Scene& s) {
+                  s.environment.width = s.environment.height = 1;
+                  s.environment.rgb = {1.0f, -1.0f, 1.0f};
+              }),
+              "scene: environment.rgb[1]: radiance must be finite and not negative");
+    EXPECT_NE(problem([](Scene& s) { s.render.indirect.vpls = 1u << 30; }).find("scene: render.indirect.vpls: "),
+              std::string::npos);
     EXPECT_EQ(problem([](Scene& s) {
                   gpu::Light spot = s.lights[0];
                   spot.type = gpu::kLightSpot;

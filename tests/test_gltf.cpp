@@ -490,6 +490,22 @@ TEST(Gltf, FilePastFourGibibytesIsRefusedBeforeItIsRead) {
                                                        "4294967295 (GLB's lengths are 32-bit)");
 }
 
+// Without a camera the loader frames the geometry; where no float camera
+// can (the geometry 1e8 out along z, where floats lie 8 apart, so the
+// camera's position rounded onto the centre), the error says so, naming
+// the file; the scene rendered with a NaN view before.
+TEST(Gltf, ADefaultFramingThatFloatsCannotHoldIsRefused) {
+    test::TempDir dir;
+    std::ifstream in(kData / "triangle.gltf", std::ios::binary);
+    nlohmann::json doc = nlohmann::json::parse(in);
+    doc["nodes"][0]["translation"] = {0.0, 0.0, 1e8};
+    doc["nodes"][1]["translation"] = {0.2, 0.2, 1e8 + 16.0};
+    const fs::path file = dir.write("far.gltf", doc.dump());
+    EXPECT_EQ(error_of(file.string()),
+              file.string() + ": cameras: no perspective camera, and a default one cannot frame this geometry in float "
+                              "(camera.look_at must differ from camera.position): add a camera");
+}
+
 // Without a `scene` the first of the scenes is drawn, as viewers do (every
 // root node was, the scenes' overlaid, and nodes of no scene too); a file
 // with no scenes draws its root nodes.

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "camera_check.h"
 #include "float_limits.h"
 #include "gltf_loader.h"
 #include "input_file.h"
@@ -31,6 +32,13 @@ Camera default_framing(const Scene& scene, const std::string& name) {
     c.position = glm::vec3(position);
     c.look_at = glm::vec3(centre);
     c.up = glm::vec3(0.0f, 1.0f, 0.0f);
+    // Geometry far out along z, or about 1e19 across, leaves no float
+    // camera that frames it (the position rounds onto the centre, or their
+    // distance's square overflows): it rendered with a NaN view.
+    if (const CameraProblem p = camera_problem(c); !p.field.empty())
+        throw InputError(name, "cameras",
+                         "no perspective camera, and a default one cannot frame this geometry in float (" + p.field +
+                             " " + p.problem + "): add a camera");
     return c;
 }
 

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <tuple>
 
 #include "camera_check.h"
 #include "float_limits.h"
@@ -171,15 +172,19 @@ void check_scene(const Scene& scene) {
                                        {m.sheen_tint, "sheen_tint"}, {m.clearcoat, "clearcoat"},
                                        {m.clearcoat_gloss, "clearcoat_gloss"}})
             if (!in_unit(v)) fail(name + field, "must be from 0 to 1");
-        if (!(m.alpha > 0.0f && m.alpha <= 1.0f)) fail(name + "alpha", "must be above 0 and at most 1");
+        // The GGX and Disney lobes' width; a Lambert material has none.
+        const bool glossy = (m.flags & (gpu::kMaterialHasSpecular | gpu::kMaterialDisney)) != 0u;
+        if (glossy && !(m.alpha > 0.0f && m.alpha <= 1.0f)) fail(name + "alpha", "must be above 0 and at most 1");
         for (const auto& [v, field] :
              {std::pair{m.emission_r, "emission_r"}, {m.emission_g, "emission_g"}, {m.emission_b, "emission_b"}})
             if (!(v >= 0.0f && std::isfinite(v))) fail(name + field, "must be finite and not negative");
         if (!std::isfinite(m.normal_scale)) fail(name + "normal_scale", "must be finite");
+        // The kernels read a material's textures only where it is textured.
+        const bool textured = (m.flags & gpu::kMaterialTextured) != 0u;
         for (const auto& [t, field] : {std::pair{m.base_color_texture, "base_color_texture"},
                                        {m.metallic_roughness_texture, "metallic_roughness_texture"},
                                        {m.emissive_texture, "emissive_texture"}, {m.normal_texture, "normal_texture"}})
-            if (t != gpu::kInvalidIndex && t >= scene.textures.size())
+            if (textured && t != gpu::kInvalidIndex && t >= scene.textures.size())
                 fail(name + field, "is " + std::to_string(t) + "; the scene has " +
                                        std::to_string(scene.textures.size()) + " textures");
     }
@@ -192,6 +197,38 @@ void check_scene(const Scene& scene) {
         for (const float v : t.uv_transform)
             if (!std::isfinite(v)) fail(name + ".uv_transform", "must be finite");
     }
+
+    // What prepare_scene makes lights of: the environment, and the counts
+    // of the render block it reads (the rest are checked at each render).
+    const Environment& env = scene.environment;
+    if (env.present()) {
+        const std::uint64_t pixels = std::uint64_t(env.width) * env.height;
+        if (pixels > kMaxEnvironmentPixels)
+            fail("environment", "is " + std::to_string(env.width) + " x " + std::to_string(env.height) +
+                                    " pixels, more than the " + std::to_string(kMaxEnvironmentPixels) + " it may hold");
+        if (env.rgb.size() != pixels * 3)
+            fail("environment.rgb", "holds " + std::to_string(env.rgb.size()) + " values for " +
+                                        std::to_string(env.width) + " x " + std::to_string(env.height) +
+                                        " pixels (three each)");
+        for (std::size_t i = 0; i < env.rgb.size(); ++i)
+            if (!(env.rgb[i] >= 0.0f && std::isfinite(env.rgb[i])))
+                fail("environment.rgb[" + std::to_string(i) + "]", "radiance must be finite and not negative");
+        // 0: no lights made of it (what the command line asks for the path
+        // tracer, which samples the map itself).
+        if (const std::string p = setting_problem(kSettingDirections, env.directions);
+            env.directions != 0 && !p.empty())
+            fail("environment.directions", p);
+    }
+    // (area_light_samples 0: none made, as for the path tracer.)
+    const IndirectSettings& indirect = scene.render.indirect;
+    for (const auto& [key, value, field] :
+         {std::tuple{kSettingAreaLightSamples, double(scene.render.area_light_samples), "render.area_light_samples"},
+          {kSettingVpls, double(indirect.vpls), "render.indirect.vpls"},
+          {kSettingMaxBounces, double(indirect.max_bounces), "render.indirect.max_bounces"},
+          {kSettingClamp, double(indirect.clamp), "render.indirect.clamp"}})
+        if (const std::string p = setting_problem(key, value);
+            !p.empty() && !(key == kSettingAreaLightSamples && value == 0.0))
+            fail(field, p);
 
     // The lights as the loaders make them, and the totals they check: in
     // one pass that names nothing (10^7 lights from a file, which the loader

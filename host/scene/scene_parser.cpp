@@ -36,10 +36,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// An environment map holds at most 2^27 pixels (a 16384 x 8192 lat-long
-// map: 1.5 GiB as RGB floats), the limit all textures share (kMaxTexels).
-constexpr std::uint64_t kMaxEnvironmentPixels = std::uint64_t(1) << 27;
-
 class SceneParser {
 public:
     SceneParser(const fs::path& file, unsigned threads)

@@ -50,11 +50,15 @@ struct RenderSettings {
     double time_limit = 0.0;        // path: seconds, the sample passes sized to end near it; 0: none
 };
 
+// An environment map holds at most 2^27 pixels (a 16384 x 8192 lat-long
+// map: 1.5 GiB as RGB floats), the limit all textures share (kMaxTexels).
+inline constexpr std::uint64_t kMaxEnvironmentPixels = std::uint64_t(1) << 27;
+
 // An environment: lat-long RGB radiance, +Y up (docs/scene-format.md). A
 // constant sky is a 1 x 1 map. Lights the scene as `directions` directional
 // lights and is what camera rays that leave the scene see.
 struct Environment {
-    std::uint32_t width = 0, height = 0;  // 0: no environment
+    std::uint32_t width = 0, height = 0;  // 0: no environment; at most kMaxEnvironmentPixels
     std::vector<float> rgb;               // row 0 at the top, the scene's scale applied
     std::uint32_t directions = 3000;
     bool present() const { return width > 0 && height > 0; }
@@ -128,12 +132,16 @@ void update_bounds(Scene& scene);
 // normals not one per triangle, uvs neither one per triangle nor none, a
 // triangle whose material is not one of the scene's, a vertex, normal or uv
 // that is not finite; a material value outside its range (colours and the
-// Disney parameters 0 to 1, alpha above 0 to 1, emission finite and not
-// negative) or naming a texture the scene does not have, a texture reaching
-// past the texels; a light of no known type, not finite, of negative
-// intensity, without a unit direction or axis where its type has one, a spot
-// whose cosines are out of order, or lights whose totals or extent the
-// loaders refuse (load_scene above).
+// Disney parameters 0 to 1, emission finite and not negative, alpha above 0
+// to 1 where there is a GGX or Disney lobe) or, where it is textured
+// (kMaterialTextured), naming a texture the scene does not have, a texture
+// reaching past the texels; an environment whose rgb is not three values a
+// pixel, finite and not negative, of more than kMaxEnvironmentPixels, or
+// whose directions are out of range, and render counts prepare_scene uses
+// (area_light_samples, indirect) out of range; a light of no known type, not
+// finite, of negative intensity, without a unit direction or axis where its
+// type has one, a spot whose cosines are out of order, or lights whose
+// totals or extent the loaders refuse (load_scene above).
 void check_scene(const Scene& scene);
 
 }  // namespace lc
