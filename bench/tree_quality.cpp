@@ -6,7 +6,6 @@
 //   tree_quality SCENE [SIZE]     (SIZE x SIZE pixels, default 64; the CPU's defaults)
 #include <chrono>
 #include <cstdio>
-#include <numeric>
 #include <string>
 #include <vector>
 
@@ -48,8 +47,14 @@ int main(int argc, char** argv) {
             if (v.builder == lc::TreeBuilder::kExact && lights.size() > 20000) continue;
             prepared.tree = lc::build_light_tree(lights, 1, v.builder, v.cone_scale);
             lc::RenderResult r = lc::render_cpu(prepared, o);
-            double mean = std::accumulate(r.stats.cut_size.begin(), r.stats.cut_size.end(), 0.0) /
-                          double(r.stats.cut_size.size());
+            // Over the pixels that shade a surface, as the report counts it
+            // (a pixel of background has no cut: counted as 0, the sky's
+            // mean was a pixel-count average).
+            double sum = 0.0;
+            std::size_t shaded = 0;
+            for (const float c : r.stats.cut_size)
+                if (c > 0.0f) sum += c, ++shaded;
+            const double mean = shaded > 0 ? sum / double(shaded) : 0.0;
             std::printf("%-14s %12.3f %14.2f %10.1f\n", v.name, prepared.tree.build_seconds, mean,
                         double(r.stats.shadow_rays) / double(size * size));
         }
