@@ -99,7 +99,9 @@ struct CompareResult {
 };
 
 // Relative luminance error per pixel: |Y(a) - Y(r)| / max(Y(r), 1e-3 * mean Y(r)).
-// Throws std::invalid_argument if the sizes differ.
+// Throws std::invalid_argument if the sizes differ. A pixel that is not
+// finite makes the metrics NaN or infinite (`lightcuts compare` refuses
+// such images first, naming the pixel).
 CompareResult compare_images(const Image& image, const Image& reference);
 
 // False-colour PNG of values in [0, max_value] (above max is clamped) with a
