@@ -38,6 +38,12 @@ Scene load(const std::string& name, const std::string& camera = "") {
     return load_scene(kData / name, options);
 }
 
+// A test file's glTF JSON, to edit and write elsewhere.
+nlohmann::json json_of(const std::string& name) {
+    std::ifstream in(kData / name, std::ios::binary);
+    return nlohmann::json::parse(in);
+}
+
 // The InputError message of loading `name`; fails the test when it loads.
 std::string error_of(const std::string& name, const std::string& camera = "") {
     try {
@@ -206,8 +212,7 @@ TEST(Gltf, MetallicRoughnessAndExtensionsBecomeDisneyParameters) {
 // between the two in every channel.
 TEST(Gltf, SheenColourIsTheFilesWhereDisneysSheenCanTakeIt) {
     test::TempDir dir;
-    std::ifstream in(kData / "materials.gltf", std::ios::binary);
-    const nlohmann::json doc = nlohmann::json::parse(in);
+    const nlohmann::json doc = json_of("materials.gltf");
     struct Case {
         glm::vec3 base, sheen;
     };
@@ -358,8 +363,7 @@ TEST(Gltf, UnusedImagesAreNotDecoded) {
 // materials.gltf with a WebP image its texture offers through
 // EXT_texture_webp, its PNG the fallback, as the extension's example does.
 nlohmann::json with_webp_offered(const fs::path& folder) {
-    std::ifstream in(kData / "materials.gltf", std::ios::binary);
-    nlohmann::json doc = nlohmann::json::parse(in);
+    nlohmann::json doc = json_of("materials.gltf");
     for (const nlohmann::json& image : doc["images"])
         if (image.contains("uri") && !image["uri"].get<std::string>().starts_with("data:"))
             fs::copy_file(kData / image["uri"].get<std::string>(), folder / image["uri"].get<std::string>());
@@ -496,8 +500,7 @@ TEST(Gltf, FilePastFourGibibytesIsRefusedBeforeItIsRead) {
 // the file; the scene rendered with a NaN view before.
 TEST(Gltf, ADefaultFramingThatFloatsCannotHoldIsRefused) {
     test::TempDir dir;
-    std::ifstream in(kData / "triangle.gltf", std::ios::binary);
-    nlohmann::json doc = nlohmann::json::parse(in);
+    nlohmann::json doc = json_of("triangle.gltf");
     doc["nodes"][0]["translation"] = {0.0, 0.0, 1e8};
     doc["nodes"][1]["translation"] = {0.2, 0.2, 1e8 + 16.0};
     const fs::path file = dir.write("far.gltf", doc.dump());
@@ -511,8 +514,7 @@ TEST(Gltf, ADefaultFramingThatFloatsCannotHoldIsRefused) {
 // with no scenes draws its root nodes.
 TEST(Gltf, WithoutADefaultSceneTheFirstIsDrawn) {
     test::TempDir dir;
-    std::ifstream in(kData / "triangle.gltf", std::ios::binary);
-    nlohmann::json doc = nlohmann::json::parse(in);
+    nlohmann::json doc = json_of("triangle.gltf");
     doc.erase("scene");
     doc["nodes"].push_back({{"mesh", 0}, {"translation", {3.0, 0.0, 0.0}}});
     doc["scenes"].push_back({{"nodes", {1, 2}}});
@@ -533,8 +535,7 @@ TEST(Gltf, WithoutADefaultSceneTheFirstIsDrawn) {
 // file had no cameras).
 TEST(Gltf, CameraNamingAnOrthographicOneSaysSo) {
     test::TempDir dir;
-    std::ifstream in(kData / "triangle.gltf", std::ios::binary);
-    nlohmann::json doc = nlohmann::json::parse(in);
+    nlohmann::json doc = json_of("triangle.gltf");
     doc["cameras"] = {{{"type", "orthographic"},
                        {"name", "ortho"},
                        {"orthographic", {{"xmag", 1.0}, {"ymag", 1.0}, {"znear", 0.1}, {"zfar", 10.0}}}}};
@@ -553,8 +554,7 @@ TEST(Gltf, CameraNamingAnOrthographicOneSaysSo) {
 // file with the '+' is there.
 TEST(Gltf, BuffersMustHoldTheirByteLength) {
     test::TempDir dir;
-    std::ifstream in(kData / "triangle.gltf", std::ios::binary);
-    nlohmann::json doc = nlohmann::json::parse(in);
+    nlohmann::json doc = json_of("triangle.gltf");
     const std::string data = doc["buffers"][0]["uri"].get<std::string>();
     ASSERT_TRUE(data.starts_with("data:"));
     const std::uint64_t length = doc["buffers"][0]["byteLength"].get<std::uint64_t>();
