@@ -13,6 +13,7 @@
 #include "vpls.h"
 #include "scene/float_limits.h"
 #include "scene/huge_pages.h"
+#include "scene/scene_check.h"
 #include "scene/textures.h"
 #include "lightcuts/error.h"
 #include "lightcuts/render.h"
@@ -154,8 +155,9 @@ void wrap_texture_coordinates(Scene& scene) {
 PreparedScene prepare_scene(Scene scene, std::uint32_t seed, unsigned threads) {
     // A scene built or changed in code gets the loaders' checks, and its
     // bounds from its triangles (what load_scene left them, for one it read).
-    check_scene(scene);
-    update_bounds(scene);
+    const loader::Box geometry = loader::check_scene_geometry(scene);
+    scene.bounds_min = glm::vec3(geometry.lo);
+    scene.bounds_max = glm::vec3(geometry.hi);
     PreparedScene prepared;
     centre_far_scene(scene);
     wrap_texture_coordinates(scene);

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "camera_check.h"
+#include "scene_check.h"
 #include "float_limits.h"
 #include "gltf_loader.h"
 #include "input_file.h"

@@ -7,7 +7,7 @@
 #include <string>
 #include <tuple>
 
-#include "camera_check.h"
+#include "scene_check.h"
 #include "float_limits.h"
 #include "input_file.h"
 #include "lightcuts/error.h"
@@ -124,7 +124,9 @@ LightFault light_problem(const gpu::Light& l) {
 
 }  // namespace
 
-void check_scene(const Scene& scene) {
+void check_scene(const Scene& scene) { loader::check_scene_geometry(scene); }
+
+loader::Box loader::check_scene_geometry(const Scene& scene) {
     const std::string file = scene.file.empty() ? "scene" : loader::display(scene.file);
     const auto fail = [&](const std::string& field, const std::string& problem) {
         throw InputError(file, field, problem);
@@ -150,8 +152,6 @@ void check_scene(const Scene& scene) {
             fail("triangles[" + std::to_string(i) + "].material",
                  "is " + std::to_string(m) + "; the scene has " + std::to_string(scene.materials.size()) +
                      " materials");
-    }
-    for (std::size_t i = 0; i < triangles; ++i) {
         const gpu::TriangleNormals& n = scene.normals[i];
         if (!finite3(n.n0_x, n.n0_y, n.n0_z) || !finite3(n.n1_x, n.n1_y, n.n1_z) || !finite3(n.n2_x, n.n2_y, n.n2_z))
             fail("normals[" + std::to_string(i) + "]", "must be finite");
@@ -249,7 +249,7 @@ void check_scene(const Scene& scene) {
         if (type != gpu::kLightDirectional) box.grow(glm::dvec3(l.x, l.y, l.z));
     }
     for (const glm::dvec3& t : totals) fine = fine && loader::fits_float(t);
-    if (fine && loader::extent_problem(box).empty()) return;
+    if (fine && loader::extent_problem(box).empty()) return geometry;
     loader::LightLimits limits(geometry);
     for (std::size_t i = 0; i < scene.lights.size(); ++i) {
         const gpu::Light& l = scene.lights[i];
@@ -258,6 +258,7 @@ void check_scene(const Scene& scene) {
         if (const loader::LightLimits::Problem p = limits.add(l); p.fault != loader::LightLimits::Fault::none)
             fail(p.fault == loader::LightLimits::Fault::total ? "lights" : name, p.text);
     }
+    return geometry;
 }
 
 }  // namespace lc

@@ -17,7 +17,7 @@
 #include <glm/gtc/matrix_inverse.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "camera_check.h"
+#include "scene_check.h"
 #include "csv_lights.h"
 #include "float_limits.h"
 #include "gltf_loader.h"

@@ -1,8 +1,9 @@
-// The camera checks that the scene loaders and check_scene share.
+// The scene checks that the loaders, check_scene and prepare_scene share.
 #pragma once
 
 #include <string>
 
+#include "float_limits.h"
 #include "lightcuts/scene.h"
 
 namespace lc::loader {
@@ -17,5 +18,10 @@ struct CameraProblem {
 };
 
 CameraProblem camera_problem(const Camera& camera);
+
+// check_scene (lightcuts/scene.h), giving the box around the triangles that
+// it computes on the way (what update_bounds would set): prepare_scene
+// takes the bounds from it without a second pass over the triangles.
+Box check_scene_geometry(const Scene& scene);
 
 }  // namespace lc::loader
