@@ -109,7 +109,7 @@ Pipeline compute_pipeline(const Context& ctx, VkPipelineLayout layout, const Ker
     info.stage.pSpecializationInfo = on_host ? nullptr : &spec_info;
     info.layout = layout;
     VkPipeline pipeline = VK_NULL_HANDLE;
-    VK_CHECK(vkd.vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline));
+    VK_CHECK(vkd.vkCreateComputePipelines(device, ctx.pipeline_cache(), 1, &info, nullptr, &pipeline));
     return own<Pipeline>(ctx.device(), pipeline, name);
 }
 
@@ -137,8 +137,8 @@ Kernels::Kernels(const Context& ctx, VkPipelineLayout layout, const ShadingMetho
     // about 0.20 s for Lightcuts' kernel once the host has specialized it,
     // 0.86 s when the driver specializes it, LC_VK_SPECIALIZE_ON_HOST=off)
     // gets a core for each, and so does the host's specialization.
-    // vkCreateComputePipelines may run on several threads without a
-    // pipeline cache.
+    // vkCreateComputePipelines may run on several threads, with a pipeline
+    // cache too (one made without the externally-synchronized flag).
     std::future<Pipeline> primary = std::async(std::launch::async, [&] {
         return compute_pipeline(ctx, layout,
                                 {lc_spirv_primary, sizeof lc_spirv_primary, "primary.comp (camera rays)"}, spec,

@@ -317,6 +317,13 @@ std::size_t MessageLog::count() const {
     return messages_.size();
 }
 
+std::vector<std::string> MessageLog::take() {
+    std::lock_guard lock(mutex_);
+    std::vector<std::string> taken;
+    taken.swap(messages_);
+    return taken;
+}
+
 std::uint64_t validation_message_total() { return g_message_total.load(); }
 
 void load_vulkan_loader() {
@@ -406,6 +413,11 @@ Context::Context(const VulkanOptions& options, MessageLog* log) {
 
     device_.fn().vkGetDeviceQueue(device, physical_.compute_family, 0, &queue_);
     device_.set_name(queue_, "compute queue");
+
+    auto cache_info = vk_struct<VkPipelineCacheCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO);
+    VkPipelineCache cache = VK_NULL_HANDLE;
+    VK_CHECK(device_.fn().vkCreatePipelineCache(device, &cache_info, nullptr, &cache));
+    pipeline_cache_ = own<PipelineCache>(device_, cache, "pipeline cache");
 }
 
 }  // namespace lc::vk

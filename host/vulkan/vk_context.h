@@ -19,6 +19,8 @@ public:
     void add(std::string message);
     std::vector<std::string> messages() const;
     std::size_t count() const;
+    // The messages so far, and an empty log.
+    std::vector<std::string> take();
 
 private:
     mutable std::mutex mutex_;
@@ -66,6 +68,11 @@ public:
     // (VK_EXT_external_memory_host, enabled on CPU devices); 0: none.
     VkDeviceSize host_import_alignment() const { return host_import_alignment_; }
     VkQueue queue() const { return queue_; }
+    // The pipelines' cache, kept as long as the context: a renderer that
+    // keeps its context (lc::VulkanRenderer) gives the driver the
+    // pipelines of its earlier renders to reuse, where the driver keeps
+    // them (lavapipe in Mesa 22.3 does not).
+    VkPipelineCache pipeline_cache() const { return pipeline_cache_.get(); }
     std::uint32_t queue_family() const { return physical_.compute_family; }
     // Nanoseconds per timestamp tick, and the valid bits (0: no timestamps).
     double timestamp_period() const { return physical_.properties.limits.timestampPeriod; }
@@ -77,6 +84,7 @@ private:
     Instance instance_;
     DebugMessenger messenger_;
     Device device_;
+    PipelineCache pipeline_cache_;
     PhysicalDeviceInfo physical_;
     VkPhysicalDeviceMemoryProperties memory_{};
     VkDeviceSize max_allocation_size_ = 0;

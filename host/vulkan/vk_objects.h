@@ -117,6 +117,7 @@ using DeviceHandle = UniqueHandle<Handle, DeviceDeleter<Handle, Destroy>>;
 using ShaderModule = DeviceHandle<VkShaderModule, &VolkDeviceTable::vkDestroyShaderModule>;
 using PipelineLayout = DeviceHandle<VkPipelineLayout, &VolkDeviceTable::vkDestroyPipelineLayout>;
 using Pipeline = DeviceHandle<VkPipeline, &VolkDeviceTable::vkDestroyPipeline>;
+using PipelineCache = DeviceHandle<VkPipelineCache, &VolkDeviceTable::vkDestroyPipelineCache>;
 using BufferView = DeviceHandle<VkBufferView, &VolkDeviceTable::vkDestroyBufferView>;
 using DescriptorSetLayout =
     DeviceHandle<VkDescriptorSetLayout, &VolkDeviceTable::vkDestroyDescriptorSetLayout>;
@@ -181,6 +182,7 @@ template <> constexpr VkObjectType object_type<VkDeviceMemory>() { return VK_OBJ
 template <> constexpr VkObjectType object_type<VkShaderModule>() { return VK_OBJECT_TYPE_SHADER_MODULE; }
 template <> constexpr VkObjectType object_type<VkPipelineLayout>() { return VK_OBJECT_TYPE_PIPELINE_LAYOUT; }
 template <> constexpr VkObjectType object_type<VkPipeline>() { return VK_OBJECT_TYPE_PIPELINE; }
+template <> constexpr VkObjectType object_type<VkPipelineCache>() { return VK_OBJECT_TYPE_PIPELINE_CACHE; }
 template <> constexpr VkObjectType object_type<VkDescriptorSetLayout>() { return VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT; }
 template <> constexpr VkObjectType object_type<VkDescriptorPool>() { return VK_OBJECT_TYPE_DESCRIPTOR_POOL; }
 template <> constexpr VkObjectType object_type<VkDescriptorSet>() { return VK_OBJECT_TYPE_DESCRIPTOR_SET; }

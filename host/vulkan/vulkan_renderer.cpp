@@ -10,8 +10,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstdio>
 #include <cstring>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -311,12 +314,43 @@ Tuning Tuning::from_environment() {
     return tuning;
 }
 
-RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& options,
-                           const VulkanOptions& vulkan, const Tuning& tuning) {
+namespace {
+
+// Checks what a render must have before a device looks at it: method
+// "path" is the CPU's alone, and the options (a wrong one says so on a
+// machine without a device too).
+void check_before_device(const RenderOptions& options) {
     if (options.method == "path")
         throw std::invalid_argument("method path (the path tracer) runs on the CPU only: use --device cpu");
-    // Before the device: a wrong option says so on a machine without one too.
     validate_render_options(options);
+}
+
+// Throws failure `e` again with the messages the validation layer gave
+// during its work (where it gave none, the caller rethrows `e` itself):
+// NoVulkanDevice stays NoVulkanDevice, so that callers still tell "no
+// device" from a failure (with no driver at all the loader's own messages
+// are in the log); anything else becomes std::runtime_error.
+[[noreturn]] void rethrow_with(const std::exception& e, const std::vector<std::string>& messages) {
+    std::string message = e.what();
+    for (const std::string& m : messages) message += "\n  validation " + m;
+    if (dynamic_cast<const NoVulkanDevice*>(&e)) throw NoVulkanDevice(message);
+    throw std::runtime_error(message);
+}
+
+// A render that succeeded but during which the validation layer said
+// `messages` fails with them.
+void fail_on(const std::vector<std::string>& messages) {
+    if (messages.empty()) return;
+    std::string message = "Vulkan validation reported " + std::to_string(messages.size()) + " message(s):";
+    for (const std::string& m : messages) message += "\n  " + m;
+    throw std::runtime_error(message);
+}
+
+}  // namespace
+
+RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& options,
+                           const VulkanOptions& vulkan, const Tuning& tuning) {
+    check_before_device(options);
     const Clock::time_point start = Clock::now();
     MessageLog log;
     RenderResult result;
@@ -327,19 +361,9 @@ RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& o
         result = render(context, prepared, options, tuning);
     } catch (const std::exception& e) {
         if (log.count() == 0) throw;
-        std::string message = e.what();
-        for (const std::string& m : log.messages()) message += "\n  validation " + m;
-        // With no driver at all the loader's own messages are in the log;
-        // callers still need to tell "no device" from a failure.
-        if (dynamic_cast<const NoVulkanDevice*>(&e)) throw NoVulkanDevice(message);
-        throw std::runtime_error(message);
+        rethrow_with(e, log.take());
     }
-    if (log.count() > 0) {
-        std::string message = "Vulkan validation reported " + std::to_string(log.count()) +
-                              " message(s):";
-        for (const std::string& m : log.messages()) message += "\n  " + m;
-        throw std::runtime_error(message);
-    }
+    fail_on(log.take());
     result.stats.seconds_total = std::chrono::duration<double>(Clock::now() - start).count();
     return result;
 }
@@ -351,6 +375,53 @@ namespace lc {
 RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& options,
                            const VulkanOptions& vulkan) {
     return vk::render_vulkan(prepared, options, vulkan, vk::Tuning::from_environment());
+}
+
+// The device and what its renders share. The log is made before the
+// context and outlives it: the context reports into it until it is gone.
+struct VulkanRenderer::Impl {
+    explicit Impl(const VulkanOptions& vulkan) : tuning(vk::Tuning::from_environment()), context(open(vulkan)) {}
+    ~Impl() {
+        context.reset();
+        for (const std::string& m : log.take())
+            std::fprintf(stderr, "lightcuts: Vulkan validation as the device closed: %s\n", m.c_str());
+    }
+
+    std::unique_ptr<vk::Context> open(const VulkanOptions& vulkan) {
+        try {
+            return std::make_unique<vk::Context>(vulkan, &log);
+        } catch (const std::exception& e) {
+            if (log.count() == 0) throw;
+            vk::rethrow_with(e, log.take());
+        }
+    }
+
+    vk::Tuning tuning;
+    vk::MessageLog log;
+    std::unique_ptr<vk::Context> context;
+    std::mutex mutex;  // one render at a time: the queue and the log are the render's
+};
+
+VulkanRenderer::VulkanRenderer(const VulkanOptions& vulkan) : impl_(std::make_unique<Impl>(vulkan)) {}
+
+VulkanRenderer::~VulkanRenderer() = default;
+
+std::string VulkanRenderer::device_name() const { return impl_->context->device_name(); }
+
+RenderResult VulkanRenderer::render(const PreparedScene& prepared, const RenderOptions& options) {
+    vk::check_before_device(options);
+    std::lock_guard lock(impl_->mutex);
+    const auto start = std::chrono::steady_clock::now();
+    RenderResult result;
+    try {
+        result = vk::render(*impl_->context, prepared, options, impl_->tuning);
+    } catch (const std::exception& e) {
+        if (impl_->log.count() == 0) throw;
+        vk::rethrow_with(e, impl_->log.take());
+    }
+    vk::fail_on(impl_->log.take());
+    result.stats.seconds_total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
 }
 
 }  // namespace lc

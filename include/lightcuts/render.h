@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <future>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -158,9 +159,49 @@ struct NoVulkanDevice : std::runtime_error {
 };
 
 // Throws NoVulkanDevice when no Vulkan device exists, std::runtime_error on
-// other failures.
+// other failures. One render on a VulkanRenderer of its own: the device is
+// opened and closed by the call.
 RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& options,
                            const VulkanOptions& vulkan = {});
+
+// A Vulkan device kept open for several renders: the instance, the device
+// and the pipelines' cache are made once, by the constructor, and each
+// render makes only its scene's buffers, its kernels' pipelines (from the
+// cache, where the driver keeps pipelines there) and its passes. Each
+// render() is what render_vulkan gives for the same arguments: the same
+// image and stats, but for `seconds_total`, which leaves out opening the
+// device. What that saves depends on the driver: on lavapipe (Mesa 22.3)
+// opening the device takes 0.08 to 0.1 s the first time in a process,
+// most of it loading LLVM, and little later (the driver stays loaded), and
+// its pipeline cache keeps nothing, so there renders through a
+// VulkanRenderer take as long as render_vulkan's after the first
+// (bench/vulkan_renders). Any PreparedScene and options, one render at a
+// time: render() holds a lock for its whole call, so renders from several
+// threads run one after another. The Vulkan settings (LC_VK_*,
+// docs/vulkan.md) are read once, by the constructor. With validation on, a
+// validation message during a render is that render's error
+// (std::runtime_error); messages when the device closes, which the
+// destructor cannot throw, go to standard error.
+class VulkanRenderer {
+public:
+    // Throws NoVulkanDevice when no usable Vulkan device exists,
+    // std::runtime_error on other failures, among them a vulkan.gpu that
+    // names none of the devices (as render_vulkan does).
+    explicit VulkanRenderer(const VulkanOptions& vulkan = {});
+    ~VulkanRenderer();
+    VulkanRenderer(const VulkanRenderer&) = delete;
+    VulkanRenderer& operator=(const VulkanRenderer&) = delete;
+
+    // The device's name, as the render's stats give it.
+    std::string device_name() const;
+    // render_vulkan's render on this device; the same errors, but for
+    // NoVulkanDevice.
+    RenderResult render(const PreparedScene& prepared, const RenderOptions& options);
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
 
 // The Vulkan devices present, found by one Vulkan instance: the loader
 // loads every installed driver for it (on a machine without a GPU, Mesa's

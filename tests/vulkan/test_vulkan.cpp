@@ -80,6 +80,63 @@ TEST_F(Vulkan, NoMatchingDeviceListsTheDevicesAndWhy) {
     EXPECT_THROW(render_vulkan(p, options("brute", 8, 8), v), std::runtime_error);
 }
 
+// A VulkanRenderer keeps its device open across renders: each render is
+// render_vulkan's, image and stats, whatever came before it on the device
+// (another scene, another method, a render that failed), and renders from
+// two threads at once come out as they do one by one.
+TEST_F(Vulkan, RendererKeptOpenRendersAsRenderVulkanDoes) {
+    PreparedScene lit = prepare_scene(random_scene(5, 40, 3, 24, 16), 7);
+    PreparedScene other = prepare_scene(random_scene(6, 9, 2, 16, 16), 3);
+    VulkanOptions v;
+    v.validation = true;
+    VulkanRenderer renderer(v);
+    const RenderOptions cuts = options("lightcuts", 24, 16, 2);
+    const RenderOptions brute = options("brute", 16, 16);
+    const RenderResult cuts_once = render_vulkan(lit, cuts, v);
+    const RenderResult brute_once = render_vulkan(other, brute, v);
+    EXPECT_EQ(renderer.device_name(), cuts_once.stats.device);
+
+    const auto expect_same = [](const RenderResult& r, const RenderResult& once, const char* what) {
+        EXPECT_EQ(r.image.width, once.image.width) << what;
+        EXPECT_EQ(r.image.rgb, once.image.rgb) << what;
+        EXPECT_EQ(r.stats.shadow_rays, once.stats.shadow_rays) << what;
+        EXPECT_EQ(r.stats.cut_size, once.stats.cut_size) << what;
+        EXPECT_EQ(r.stats.device, once.stats.device) << what;
+    };
+    expect_same(renderer.render(lit, cuts), cuts_once, "first render");
+    expect_same(renderer.render(other, brute), brute_once, "another scene and method");
+    RenderOptions bad = cuts;
+    bad.relative_error = -1.0f;
+    EXPECT_THROW(renderer.render(lit, bad), std::invalid_argument);
+    RenderOptions path = cuts;
+    path.method = "path";
+    EXPECT_THROW(renderer.render(lit, path), std::invalid_argument);
+    expect_same(renderer.render(lit, cuts), cuts_once, "after refused options");
+
+    std::future<RenderResult> a = std::async(std::launch::async, [&] { return renderer.render(lit, cuts); });
+    std::future<RenderResult> b = std::async(std::launch::async, [&] { return renderer.render(other, brute); });
+    expect_same(a.get(), cuts_once, "from one of two threads");
+    expect_same(b.get(), brute_once, "from the other thread");
+}
+
+// A gpu that names no device is the caller's mistake, as for render_vulkan:
+// an error, not "no device" (which the CLI's device "auto" takes as a cue
+// to render on the CPU).
+TEST_F(Vulkan, RendererForAGpuNamingNoDeviceRefusesIt) {
+    VulkanOptions v;
+    v.gpu = "no-such-device-anywhere";
+    try {
+        VulkanRenderer renderer(v);
+        FAIL() << "expected an exception";
+    } catch (const NoVulkanDevice& e) {
+        FAIL() << "not NoVulkanDevice: " << e.what();
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("no Vulkan device matches 'no-such-device-anywhere'"),
+                  std::string::npos)
+            << e.what();
+    }
+}
+
 // Device "auto" decides from an answer of probe_gpus given early (the CLI
 // asks while the scene loads) instead of asking again: told of no device,
 // of a software one only, or of no GPU device file (no driver loaded), it
