@@ -80,7 +80,8 @@ public:
     std::string device_name() const { return physical_.properties.deviceName; }
 
 private:
-    // Member order is destruction order, reversed: device, messenger, instance.
+    // Member order is destruction order, reversed: pipeline cache, device,
+    // messenger, instance.
     Instance instance_;
     DebugMessenger messenger_;
     Device device_;

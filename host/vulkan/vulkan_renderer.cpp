@@ -22,6 +22,7 @@
 
 #include "lightcuts/error.h"
 #include "render_setup.h"
+#include "vk_check.h"
 #include "tile_scheduler.h"
 
 namespace lc::vk {
@@ -380,7 +381,11 @@ RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& o
 // The device and what its renders share. The log is made before the
 // context and outlives it: the context reports into it until it is gone.
 struct VulkanRenderer::Impl {
-    explicit Impl(const VulkanOptions& vulkan) : tuning(vk::Tuning::from_environment()), context(open(vulkan)) {}
+    explicit Impl(const VulkanOptions& vulkan) : tuning(vk::Tuning::from_environment()), context(open(vulkan)) {
+        // Messages of the device's opening are the constructor's failure,
+        // not the first render's.
+        vk::fail_on(log.take());
+    }
     ~Impl() {
         context.reset();
         for (const std::string& m : log.take())
@@ -400,22 +405,33 @@ struct VulkanRenderer::Impl {
     vk::MessageLog log;
     std::unique_ptr<vk::Context> context;
     std::mutex mutex;  // one render at a time: the queue and the log are the render's
+    std::string lost;  // why the device is lost ("" while it is not): a render failed with it
 };
 
 VulkanRenderer::VulkanRenderer(const VulkanOptions& vulkan) : impl_(std::make_unique<Impl>(vulkan)) {}
 
 VulkanRenderer::~VulkanRenderer() = default;
+VulkanRenderer::VulkanRenderer(VulkanRenderer&&) noexcept = default;
+VulkanRenderer& VulkanRenderer::operator=(VulkanRenderer&&) noexcept = default;
 
 std::string VulkanRenderer::device_name() const { return impl_->context->device_name(); }
 
 RenderResult VulkanRenderer::render(const PreparedScene& prepared, const RenderOptions& options) {
     vk::check_before_device(options);
     std::lock_guard lock(impl_->mutex);
+    if (!impl_->lost.empty())
+        throw std::runtime_error("the Vulkan device " + device_name() + " was lost in an earlier render (" +
+                                 impl_->lost + "): make a new VulkanRenderer");
     const auto start = std::chrono::steady_clock::now();
     RenderResult result;
     try {
         result = vk::render(*impl_->context, prepared, options, impl_->tuning);
     } catch (const std::exception& e) {
+        // A device lost, or one that never finished a submission, renders
+        // nothing more; any other failure leaves it as it was.
+        if (const auto* v = dynamic_cast<const vk::VulkanError*>(&e);
+            v != nullptr && (v->result() == VK_ERROR_DEVICE_LOST || v->result() == VK_TIMEOUT))
+            impl_->lost = e.what();
         if (impl_->log.count() == 0) throw;
         vk::rethrow_with(e, impl_->log.take());
     }

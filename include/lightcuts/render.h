@@ -159,8 +159,9 @@ struct NoVulkanDevice : std::runtime_error {
 };
 
 // Throws NoVulkanDevice when no Vulkan device exists, std::runtime_error on
-// other failures. One render on a VulkanRenderer of its own: the device is
-// opened and closed by the call.
+// other failures. The device is opened for the render and closed after it
+// (VulkanRenderer keeps one open); validation messages while it closes are
+// errors too.
 RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& options,
                            const VulkanOptions& vulkan = {});
 
@@ -177,11 +178,18 @@ RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& o
 // VulkanRenderer take as long as render_vulkan's after the first
 // (bench/vulkan_renders). Any PreparedScene and options, one render at a
 // time: render() holds a lock for its whole call, so renders from several
-// threads run one after another. The Vulkan settings (LC_VK_*,
-// docs/vulkan.md) are read once, by the constructor. With validation on, a
-// validation message during a render is that render's error
-// (std::runtime_error); messages when the device closes, which the
-// destructor cannot throw, go to standard error.
+// threads run one after another (and none may still run when the renderer
+// is destroyed). A render that fails leaves the renderer as it was, but
+// for a device lost (or one that never finished a submission): every later
+// render then says so, and a new VulkanRenderer is needed. The Vulkan
+// settings (LC_VK_*, docs/vulkan.md) are read once, by the constructor.
+// The pipeline cache keeps what a driver puts there for the renderer's
+// life, a set of kernels for each kind of scene and options rendered. With
+// validation on, a message while the device opens is the constructor's
+// error and one during a render that render's (std::runtime_error);
+// messages when the device closes, which the destructor cannot throw, are
+// written to standard error. A moved-from VulkanRenderer may only be
+// destroyed or assigned to.
 class VulkanRenderer {
 public:
     // Throws NoVulkanDevice when no usable Vulkan device exists,
@@ -189,8 +197,8 @@ public:
     // names none of the devices (as render_vulkan does).
     explicit VulkanRenderer(const VulkanOptions& vulkan = {});
     ~VulkanRenderer();
-    VulkanRenderer(const VulkanRenderer&) = delete;
-    VulkanRenderer& operator=(const VulkanRenderer&) = delete;
+    VulkanRenderer(VulkanRenderer&&) noexcept;
+    VulkanRenderer& operator=(VulkanRenderer&&) noexcept;
 
     // The device's name, as the render's stats give it.
     std::string device_name() const;

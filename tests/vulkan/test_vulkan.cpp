@@ -82,8 +82,8 @@ TEST_F(Vulkan, NoMatchingDeviceListsTheDevicesAndWhy) {
 
 // A VulkanRenderer keeps its device open across renders: each render is
 // render_vulkan's, image and stats, whatever came before it on the device
-// (another scene, another method, a render that failed), and renders from
-// two threads at once come out as they do one by one.
+// (another scene, another method, a render that failed), and renders asked
+// for from two threads at once come out as they do one by one.
 TEST_F(Vulkan, RendererKeptOpenRendersAsRenderVulkanDoes) {
     PreparedScene lit = prepare_scene(random_scene(5, 40, 3, 24, 16), 7);
     PreparedScene other = prepare_scene(random_scene(6, 9, 2, 16, 16), 3);
@@ -111,6 +111,10 @@ TEST_F(Vulkan, RendererKeptOpenRendersAsRenderVulkanDoes) {
     RenderOptions path = cuts;
     path.method = "path";
     EXPECT_THROW(renderer.render(lit, path), std::invalid_argument);
+    // Refused on the device, with its command pool and fence made.
+    RenderOptions octets = cuts;
+    octets.cut_sharing = "octet";
+    EXPECT_THROW(renderer.render(lit, octets), std::invalid_argument);
     expect_same(renderer.render(lit, cuts), cuts_once, "after refused options");
 
     std::future<RenderResult> a = std::async(std::launch::async, [&] { return renderer.render(lit, cuts); });
