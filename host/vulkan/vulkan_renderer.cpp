@@ -338,8 +338,8 @@ void check_before_device(const RenderOptions& options) {
     throw std::runtime_error(message);
 }
 
-// A render that succeeded but during which the validation layer said
-// `messages` fails with them.
+// Work that succeeded (a render, a device's opening) but during which the
+// validation layer said `messages` fails with them.
 void fail_on(const std::vector<std::string>& messages) {
     if (messages.empty()) return;
     std::string message = "Vulkan validation reported " + std::to_string(messages.size()) + " message(s):";
