@@ -6,8 +6,7 @@
 // without opening the device) and its kernels' (seconds_primary +
 // seconds_shading). One mode a process: a device kept open also keeps
 // its driver's libraries loaded, which spares render_vulkan's later
-// renders in the same process their loading (lavapipe's LLVM: about
-// 0.1 s). The device is the one render_vulkan picks (VK_DRIVER_FILES, say).
+// renders in the same process their loading (lavapipe's LLVM). The device is the one render_vulkan picks (VK_DRIVER_FILES, say).
 //
 //   vulkan_renders once|kept SCENE [SIZE] [ROUNDS]   (SIZE x SIZE pixels, default 256; ROUNDS default 5)
 #include <chrono>

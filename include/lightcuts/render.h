@@ -170,8 +170,8 @@ RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& o
 // render makes only its scene's buffers, its kernels' pipelines (from the
 // cache, where the driver keeps pipelines there) and its passes. Each
 // render() is what render_vulkan gives for the same arguments: the same
-// image and stats, but for `seconds_total`, which leaves out opening the
-// device. What that saves depends on the driver: on lavapipe (Mesa 22.3)
+// image and counts, its times its own, `seconds_total` without the
+// device's opening. What that saves depends on the driver: on lavapipe (Mesa 22.3)
 // opening the device takes 0.08 to 0.1 s the first time in a process,
 // most of it loading LLVM, and little later (the driver stays loaded), and
 // its pipeline cache keeps nothing, so there renders through a
