@@ -370,7 +370,7 @@ TEST(Mipmaps, ConeFootprintOnATriangle) {
                     slanted, "scaled");
 }
 
-TEST(TextureLookup, MaterialAtAppliesEveryTexture) {
+TEST(TextureLookup, MaterialAtAppliesTheTexturesOfReflection) {
     TextureScene t;
     const std::uint32_t colour = t.add(1, 1, {rgba(188, 255, 0)});
     const std::uint32_t mr = t.add(1, 1, {rgba(0, 128, 64)});
@@ -393,9 +393,11 @@ TEST(TextureLookup, MaterialAtAppliesEveryTexture) {
     EXPECT_NEAR(at.roughness, 0.6 * 128.0 / 255.0, 1e-6);  // green
     EXPECT_NEAR(at.metallic, 0.9 * 64.0 / 255.0, 1e-6);    // blue
     EXPECT_NEAR(at.alpha, at.roughness * at.roughness, 1e-7);
-    EXPECT_NEAR(at.emission_r, 2.0, 1e-6);
-    EXPECT_NEAR(at.emission_g, 4.0 * c188, 1e-5);
-    EXPECT_EQ(at.emission_b, 0.0f);
+    // The emission is the record's: lc_surface_emission applies the
+    // emissive texture where a surface's emission is asked for.
+    EXPECT_EQ(at.emission_r, 2.0f);
+    EXPECT_EQ(at.emission_g, 4.0f);
+    EXPECT_EQ(at.emission_b, 8.0f);
     // A black roughness texel cannot take alpha below the floor.
     t.scene.texels[t.scene.textures[mr].offset] = rgba(0, 0, 0);
     EXPECT_EQ(t.kernel().lc_material_at(0, {0.3f, 0.7f}, glm::vec4(0.0f)).alpha, 1e-3f);

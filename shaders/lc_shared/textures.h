@@ -229,11 +229,17 @@ vec2 lc_triangle_uv(uint tri_index, float b1, float b2) {
     return b0 * vec2(t.u0, t.v0) + b1 * vec2(t.u1, t.v1) + b2 * vec2(t.u2, t.v2);
 }
 
-// Material `index` at texture coordinates uv, its textures seen through
-// `footprint` (lc_texture_sample): its factors times its textures. Base colour scales kd (both kinds); metallic-roughness scales
-// roughness by G and metallic by B (glTF), and alpha follows roughness;
-// the emissive texture scales emission. The normal map is applied where the
-// shading normal is made (lc_surface_point).
+// Material `index` as it reflects light at texture coordinates uv, its
+// textures seen through `footprint` (lc_texture_sample): its factors times
+// its textures. Base colour scales kd (both kinds); metallic-roughness
+// scales roughness by G and metallic by B (glTF), and alpha follows
+// roughness. The normal map is applied where the shading normal is made
+// (lc_surface_point). The emission is left as the record has it: what a
+// surface emits is lc_surface_emission's, which reads the emissive
+// texture itself, and nothing that takes a material from here reads its
+// emission. (This looked the emissive texture up too, for nothing; the
+// renders of the textured glTF scene took as long without it, on both
+// devices, and gave the same images.)
 Material lc_material_at(uint index, vec2 uv, vec4 footprint) {
     Material m = LC_MATERIAL(index);
     if (!kEnableTextures || (m.flags & kMaterialTextured) == 0u) return m;
@@ -248,12 +254,6 @@ Material lc_material_at(uint index, vec2 uv, vec4 footprint) {
         m.roughness *= c.y;
         m.metallic *= c.z;
         m.alpha = max(m.roughness * m.roughness, kMinGgxAlpha);
-    }
-    if (lc_has_texture(m, m.emissive_texture)) {
-        vec4 c = lc_texture_sample(m.emissive_texture, uv, true, footprint);
-        m.emission_r *= c.x;
-        m.emission_g *= c.y;
-        m.emission_b *= c.z;
     }
     return m;
 }
