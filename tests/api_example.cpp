@@ -1,8 +1,10 @@
 // The library without the command line: load a scene, build its BVH and
 // light tree once, render it with lightcuts on the CPU and through Vulkan
-// where there is a device, and compare the two. docs/api.md walks through
+// where there is a device, compare the two, and render it again on a
+// Vulkan device kept open. docs/api.md walks through
 // it; ctest runs it (api_example) on the room of 1000 lights.
 //   api_example SCENE.json OUT.exr
+#include <cstdint>
 #include <cstdio>
 #include <exception>
 
@@ -46,6 +48,19 @@ int main(int argc, char** argv) {
             if (!(c.relative_rmse < 1e-4)) {  // the two devices differ by rounding
                 std::fprintf(stderr, "error: the devices disagree\n");
                 return 1;
+            }
+
+            // Several renders on one device: a VulkanRenderer opens it once.
+            // Each render is render_vulkan's for the same options.
+            lc::VulkanRenderer renderer;
+            for (const std::uint32_t spp : {1u, 4u}) {
+                options.spp = spp;
+                const lc::RenderResult kept = renderer.render(prepared, options);
+                std::printf("vulkan, device kept open, %u spp: %.4f s\n", spp, kept.stats.seconds_total);
+                if (spp == 1u && kept.image.rgb != gpu.image.rgb) {
+                    std::fprintf(stderr, "error: the kept device's render differs from render_vulkan's\n");
+                    return 1;
+                }
             }
         } catch (const lc::NoVulkanDevice& e) {
             std::printf("no Vulkan device: %s\n", e.what());
