@@ -326,12 +326,13 @@ void check_before_device(const RenderOptions& options) {
     validate_render_options(options);
 }
 
-// Throws failure `e` again with the messages the validation layer gave
-// during its work (where it gave none, the caller rethrows `e` itself):
+// Called while failure `e` is handled: throws it again, as it is where the
+// validation layer gave no `messages` during its work, else with them:
 // NoVulkanDevice stays NoVulkanDevice, so that callers still tell "no
 // device" from a failure (with no driver at all the loader's own messages
 // are in the log); anything else becomes std::runtime_error.
 [[noreturn]] void rethrow_with(const std::exception& e, const std::vector<std::string>& messages) {
+    if (messages.empty()) throw;
     std::string message = e.what();
     for (const std::string& m : messages) message += "\n  validation " + m;
     if (dynamic_cast<const NoVulkanDevice*>(&e)) throw NoVulkanDevice(message);
@@ -361,7 +362,6 @@ RenderResult render_vulkan(const PreparedScene& prepared, const RenderOptions& o
         Context context(vulkan, &log);
         result = render(context, prepared, options, tuning);
     } catch (const std::exception& e) {
-        if (log.count() == 0) throw;
         rethrow_with(e, log.take());
     }
     fail_on(log.take());
@@ -396,7 +396,6 @@ struct VulkanRenderer::Impl {
         try {
             return std::make_unique<vk::Context>(vulkan, &log);
         } catch (const std::exception& e) {
-            if (log.count() == 0) throw;
             vk::rethrow_with(e, log.take());
         }
     }
@@ -432,7 +431,6 @@ RenderResult VulkanRenderer::render(const PreparedScene& prepared, const RenderO
         if (const auto* v = dynamic_cast<const vk::VulkanError*>(&e);
             v != nullptr && (v->result() == VK_ERROR_DEVICE_LOST || v->result() == VK_TIMEOUT))
             impl_->lost = e.what();
-        if (impl_->log.count() == 0) throw;
         vk::rethrow_with(e, impl_->log.take());
     }
     vk::fail_on(impl_->log.take());
