@@ -7,7 +7,9 @@
 #include <cstddef>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -124,26 +126,33 @@ struct HeapEntry {
 // of one in the line that held the other's last slots, and rendering on two
 // threads ran at 1.4 to 1.7 times one thread's speed; padded, at 1.9 to 2.2
 // times (docs/results/speed.md).
+//
+// The arrays are not zeroed (as BlockHeap's, host/quad_cut.h): the cut
+// writes each slot before it reads it, so a heap far larger than its cuts
+// (--cut-heap as large as the tree) takes only the pages its cuts touch.
 struct HeapPayload {
     uint node;
     vec3 unit;
 };
+static_assert(std::is_trivially_default_constructible_v<HeapPayload>, "new HeapPayload[n] leaves the slots unwritten");
 
 class CutHeap {
 public:
     explicit CutHeap(std::size_t slots = 0)
-        : slots_(uint(slots)), error_(slots + 2 * kErrorPad), payload_(slots + 2 * kPayloadPad) {}
+        : slots_(uint(slots)),
+          error_(new float[slots + 2 * kErrorPad]),
+          payload_(new HeapPayload[slots + 2 * kPayloadPad]) {}
     uint slots() const { return slots_; }
-    float* error() { return error_.data() + kErrorPad; }
-    HeapPayload* payload() { return payload_.data() + kPayloadPad; }
+    float* error() { return error_.get() + kErrorPad; }
+    HeapPayload* payload() { return payload_.get() + kPayloadPad; }
 
 private:
     static constexpr std::size_t kCacheLine = 64;
     static constexpr std::size_t kErrorPad = kCacheLine / sizeof(float);
     static constexpr std::size_t kPayloadPad = kCacheLine / sizeof(HeapPayload);
     uint slots_;
-    std::vector<float> error_;
-    std::vector<HeapPayload> payload_;
+    std::unique_ptr<float[]> error_;
+    std::unique_ptr<HeapPayload[]> payload_;
 };
 
 // lc_heap_smallest's answer on the CPU's heap (lc_shared/lightcuts.h): the
