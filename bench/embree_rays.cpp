@@ -1,10 +1,12 @@
 // Shadow rays per second: the software BVH (shaders/lc_shared/trace.h, as the
 // CPU path runs it) against Embree 3 on the same rays: the ones brute force
 // traces on a scene (from every camera hit to every light that can light
-// it), and the ones lightcuts traces with a cut per pixel (recorded by the
+// it), the ones lightcuts traces with a cut per pixel (recorded by the
 // CPU's scalar kernel as it selects the cuts at the default error, max_cut
-// and heap: the cuts the Vulkan kernels select; the CPU's default shares a
-// cut among an octet of pixels, whose rays this list does not hold).
+// and heap: the cuts the Vulkan kernels select), and the ones the CPU path
+// traces at its defaults, each cut shared by an octet of pixels (recorded
+// with the packets the renderer traces them in: an octet's eight points'
+// or a quad's four points' rays to one light).
 //
 //   build/bench/embree_rays SCENE [SIZE] [THREADS] [REPEATS]
 //
@@ -16,7 +18,8 @@
 // every pixel to one light, then the next light), which is the coherence
 // lightcuts could use by tracing a tile's rays to the same cluster
 // together; lightcuts' rays also with each point's rays sorted by direction
-// (what gathering a pixel's rays before tracing them could give). Embree
+// (what gathering a pixel's rays before tracing them could give); the
+// octets' rays also in the renderer's own packets. Embree
 // runs single rays (rtcOccluded1), packets of 4, 8 and 16 consecutive
 // rays (rtcOccluded4/8/16, each where the device says it supports that
 // width natively: 16 needs AVX-512) and streams (rtcOccluded1M over 256
@@ -37,6 +40,8 @@
 #include <vector>
 
 #include "cpu_kernel.h"
+#include "quad_cut.h"
+#include "tile_pool.h"
 #include "wide_trace.h"
 #include "lightcuts/scene.h"
 
@@ -148,6 +153,70 @@ int run(int argc, char** argv) {
             }
         for (const auto& r : log) lightcuts_rays.push_back({r.org, r.dir, r.t_max, 0u});
     }
+    // Lightcuts' rays at the CPU's defaults, as render_cpu casts them
+    // (host/cpu_renderer.cpp, shade_tile_by_octets): tile by tile, each
+    // tile's octets in rows, an octet's eight points sharing one cut, and
+    // after an octet whose cut reached max_cut the tile's next blocks cut as
+    // two quads until both stay below it. Each packet the cuts trace, and
+    // each single ray (the roots' representatives), is a packet here.
+    std::vector<ShadowRay> octet_rays;
+    std::vector<lc::cpu::RayPacketRecord> octet_packets;
+    {
+        lc::RenderOptions lo;
+        lo.width = lo.height = kLightcutsSize;
+        const lc::gpu::FrameParams lf = lc::make_frame_params(p, lo);
+        std::vector<lc::cpu::ShadowRayRecord> log;
+        std::vector<lc::cpu::RayPacketRecord> packets;
+        auto recorder = lc::cpu::make_shade_kernel<true>(p, nullptr);
+        recorder.ray_log = &log;
+        recorder.packet_log = &packets;
+        using Recorder = decltype(recorder);
+        lc::cpu::OctetHeap octet_heap(p.tree.cut_heap_slots(lo.max_cut, lc::shared_cut_heap(lo.cut_heap, 8u)));
+        lc::cpu::QuadHeap quad_heap(p.tree.cut_heap_slots(lo.max_cut, lc::shared_cut_heap(lo.cut_heap, 4u)));
+        // The block of N points at (x0, y0), as render_cpu's shade_block
+        // places them; whether its cut reached max_cut.
+        const auto block = [&]<std::uint32_t N>(lc::cpu::BlockHeap<N>& heap, std::uint32_t x0, std::uint32_t y0) {
+            lc::cpu::BlockCut<Recorder, N> cut(recorder, heap, lf);
+            Recorder::SurfacePoint sp[N];
+            unsigned active = 0u;
+            for (std::uint32_t q = 0; q < N; ++q) {
+                const std::uint32_t x = x0 + (q & 1u) + 2u * (q >> 2u), y = y0 + (q >> 1u & 1u);
+                glm::vec3 seen;
+                if (x < lf.width && y < lf.height && recorder.lc_camera_sample(lf, x, y, 0u, sp[q], seen))
+                    active |= 1u << q;
+            }
+            if (active == 0u) return false;
+            glm::vec3 radiance[N];
+            Recorder::ShadeStats stats[N];
+            cut.shade(sp, active, radiance, stats);
+            bool hit = false;
+            for (std::uint32_t q = 0; q < N; ++q) hit = hit || ((active >> q & 1u) != 0u && stats[q].hit_max_cut != 0u);
+            return hit;
+        };
+        for (std::uint32_t y0 = 0; y0 < kLightcutsSize; y0 += lc::kTile)
+            for (std::uint32_t x0 = 0; x0 < kLightcutsSize; x0 += lc::kTile) {
+                bool as_quads = false;
+                for (std::uint32_t y = y0; y < y0 + lc::kTile; y += 2u)
+                    for (std::uint32_t x = x0; x < x0 + lc::kTile; x += 4u) {
+                        if (as_quads) {
+                            const bool left = block.template operator()<4u>(quad_heap, x, y);
+                            const bool right = block.template operator()<4u>(quad_heap, x + 2u, y);
+                            as_quads = left || right;
+                        } else {
+                            as_quads = block.template operator()<8u>(octet_heap, x, y);
+                        }
+                    }
+            }
+        for (const auto& r : log) octet_rays.push_back({r.org, r.dir, r.t_max, 0u});
+        // The packets, and a packet of one for each ray between them.
+        std::size_t next = 0;
+        for (const lc::cpu::RayPacketRecord& packet : packets) {
+            for (; next < packet.first; ++next) octet_packets.push_back({next, 1u});
+            octet_packets.push_back(packet);
+            next = packet.first + packet.count;
+        }
+        for (; next < log.size(); ++next) octet_packets.push_back({next, 1u});
+    }
     // Lightcuts' rays with each point's rays sorted by direction (a Morton
     // order of the unit direction), the coherence a pixel's cut offers if
     // its rays were gathered before tracing.
@@ -175,9 +244,11 @@ int run(int argc, char** argv) {
     std::stable_sort(by_light.begin(), by_light.end(),
                      [](const ShadowRay& a, const ShadowRay& b) { return a.light < b.light; });
     std::printf("%s: %zu triangles, %zu lights; %zu brute-force shadow rays at %ux%u, %zu lightcuts shadow rays "
-                "(a cut per pixel) at %ux%u; %u thread(s); medians of %u runs\n",
+                "(a cut per pixel) and %zu (the CPU's defaults, in %zu packets) at %ux%u; %u thread(s); medians of "
+                "%u runs\n",
                 argv[1], p.scene.triangles.size(), p.tree.lights.size(), rays.size(), size, size,
-                lightcuts_rays.size(), kLightcutsSize, kLightcutsSize, threads, g_repeats);
+                lightcuts_rays.size(), octet_rays.size(), octet_packets.size(), kLightcutsSize, kLightcutsSize,
+                threads, g_repeats);
 
     RTCDevice device = rtcNewDevice(nullptr);
     const bool native[3] = {rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_NATIVE_RAY4_SUPPORTED) != 0,
@@ -211,7 +282,8 @@ int run(int argc, char** argv) {
         {"brute force, pixel order", &rays},
         {"brute force, light by light", &by_light},
         {"lightcuts, a cut per pixel (error 0.02, max_cut 1000), pixel order", &lightcuts_rays},
-        {"lightcuts, each point's rays sorted by direction", &lightcuts_sorted}};
+        {"lightcuts, each point's rays sorted by direction", &lightcuts_sorted},
+        {"lightcuts at the CPU's defaults (cuts shared by octets), as they are cast", &octet_rays}};
     for (const auto& [order_name, list] : sets) {
         const std::vector<ShadowRay>& r = *list;
         std::printf(" %s:\n", order_name);
@@ -321,6 +393,27 @@ int run(int argc, char** argv) {
             };
             packets.template operator()<4>("software 8-wide BVH, packets of 4", walk);
             packets.template operator()<8>("software 8-wide BVH, packets of 8", walk);
+            // The octets' rays in the renderer's packets (each of up to
+            // eight rays, down the tree together as render_cpu sends them).
+            if (list == &octet_rays) {
+                std::fill(hits.begin(), hits.end(), 0);
+                s = timed_parallel(octet_packets.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+                    lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
+                    std::size_t h = 0;
+                    for (std::size_t i = b; i < e; ++i) {
+                        const lc::cpu::RayPacketRecord& record = octet_packets[i];
+                        lc::cpu::RayPacket8 packet;
+                        for (std::uint32_t j = 0; j < record.count; ++j) {
+                            const ShadowRay& sr = r[record.first + j];
+                            packet.org[j] = sr.org, packet.dir[j] = sr.dir, packet.t_max[j] = sr.t_max;
+                            packet.valid |= 1u << j;
+                        }
+                        h += unsigned(__builtin_popcount(walk(tk, packet)));
+                    }
+                    hits[t] = h;
+                });
+                report("software 8-wide BVH, the renderer's packets", r.size(), s, total(), reference);
+            }
         }
 #endif
 
@@ -367,6 +460,33 @@ int run(int argc, char** argv) {
         if (native[1]) embree_packets.template operator()<8, RTCRay8>("Embree rtcOccluded8 (packets)", rtcOccluded8);
         if (native[2])
             embree_packets.template operator()<16, RTCRay16>("Embree rtcOccluded16 (packets)", rtcOccluded16);
+        // The octets' rays in the renderer's packets, each through
+        // rtcOccluded8.
+        if (list == &octet_rays && native[1]) {
+            std::fill(hits.begin(), hits.end(), 0);
+            s = timed_parallel(octet_packets.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
+                RTCIntersectContext ctx;
+                rtcInitIntersectContext(&ctx);
+                std::size_t h = 0;
+                for (std::size_t i = b; i < e; ++i) {
+                    const lc::cpu::RayPacketRecord& record = octet_packets[i];
+                    alignas(64) RTCRay8 ray{};
+                    alignas(64) int valid[8];
+                    for (std::uint32_t j = 0; j < 8u; ++j) {
+                        const bool on = j < record.count;
+                        valid[j] = on ? -1 : 0;
+                        const ShadowRay& sr = r[record.first + (on ? j : 0u)];
+                        ray.org_x[j] = sr.org.x, ray.org_y[j] = sr.org.y, ray.org_z[j] = sr.org.z;
+                        ray.dir_x[j] = sr.dir.x, ray.dir_y[j] = sr.dir.y, ray.dir_z[j] = sr.dir.z;
+                        ray.tnear[j] = 0.0f, ray.tfar[j] = sr.t_max, ray.mask[j] = ~0u;
+                    }
+                    rtcOccluded8(valid, scene, &ctx, &ray);
+                    for (std::uint32_t j = 0; j < record.count; ++j) h += ray.tfar[j] < 0.0f ? 1 : 0;
+                }
+                hits[t] = h;
+            });
+            report("Embree rtcOccluded8, the renderer's packets", r.size(), s, total(), reference);
+        }
 
         for (const bool coherent : {true, false}) {
             std::fill(hits.begin(), hits.end(), 0);

@@ -191,6 +191,12 @@ struct ShadowRayRecord {
     float t_max;
 };
 
+// A packet of shadow rays in a ray log: its first ray and how many.
+struct RayPacketRecord {
+    std::size_t first;
+    uint count;
+};
+
 // Everything a pixel needs. `heap_error` and `heap_payload` hold the cut
 // heap's `heap_slots` entries (a CutHeap of LightTree::cut_heap_slots
 // slots, bind_heap); one kernel object per thread (make_shade_kernel binds
@@ -218,6 +224,11 @@ struct BasicShadeKernel {
     HeapPayload* heap_payload = nullptr;
     uint heap_slots = 1u;
     std::vector<ShadowRayRecord>* ray_log = nullptr;  // kRecordRays only
+    // kRecordRays only, where set: each packet of lc_visible4 or
+    // lc_visible8 (the rays a quad's or an octet's points cast to one light
+    // together) as its first ray in ray_log and its count, so that the
+    // packets can be traced again as the renderer traces them.
+    std::vector<RayPacketRecord>* packet_log = nullptr;
 
     // The CPU reference always runs the full kernel; the GPU switches parts
     // off only where the scene cannot use them.
@@ -446,21 +457,10 @@ struct BasicShadeKernel {
     // the 4-wide one as a packet (trace_any_wide4), else one at a time (the
     // ray recorder).
     unsigned lc_visible4(const RayPacket4& packet) {
-        const unsigned valid = packet.valid & 0xFu;
-        if (!kEnableShadows) return valid;
-#if defined(LC_WIDE8_TRACE)
-        if (!kRecordRays && wide8_nodes != nullptr)
-            return valid & ~trace_any_wide8_packet(*this, wide8_nodes, wide8_leaves, packet);
-#endif
-        if (!kRecordRays && wide_nodes != nullptr) return valid & ~trace_any_wide4(*this, wide_nodes, wide_leaves, packet);
-        unsigned visible = 0u;
-        for (unsigned r = 0; r < 4u; ++r) {
-            if ((valid >> r & 1u) == 0u) continue;
-            SurfacePoint at;
-            at.p = packet.org[r];
-            if (lc_visible(at, packet.dir[r], packet.t_max[r])) visible |= 1u << r;
-        }
-        return visible;
+        if constexpr (kRecordRays)
+            if (packet_log != nullptr && (packet.valid & 0xFu) != 0u)
+                packet_log->push_back({ray_log->size(), uint(__builtin_popcount(packet.valid & 0xFu))});
+        return visible4(packet);
     }
 
     // lc_visible4 for up to eight rays (an octet's points' rays to one
@@ -474,6 +474,8 @@ struct BasicShadeKernel {
         if (!kRecordRays && wide8_nodes != nullptr)
             return valid & ~trace_any_wide8_packet(*this, wide8_nodes, wide8_leaves, packet);
 #endif
+        if constexpr (kRecordRays)
+            if (packet_log != nullptr && valid != 0u) packet_log->push_back({ray_log->size(), uint(__builtin_popcount(valid))});
         unsigned visible = 0u;
         for (unsigned h = 0; h < 2u; ++h) {
             RayPacket4 half;
@@ -483,7 +485,27 @@ struct BasicShadeKernel {
                 half.t_max[r] = packet.t_max[4u * h + r];
             }
             half.valid = valid >> 4u * h & 0xFu;
-            if (half.valid != 0u) visible |= lc_visible4(half) << 4u * h;
+            if (half.valid != 0u) visible |= visible4(half) << 4u * h;
+        }
+        return visible;
+    }
+
+private:
+    // lc_visible4 without the packet's entry in packet_log.
+    unsigned visible4(const RayPacket4& packet) {
+        const unsigned valid = packet.valid & 0xFu;
+        if (!kEnableShadows) return valid;
+#if defined(LC_WIDE8_TRACE)
+        if (!kRecordRays && wide8_nodes != nullptr)
+            return valid & ~trace_any_wide8_packet(*this, wide8_nodes, wide8_leaves, packet);
+#endif
+        if (!kRecordRays && wide_nodes != nullptr) return valid & ~trace_any_wide4(*this, wide_nodes, wide_leaves, packet);
+        unsigned visible = 0u;
+        for (unsigned r = 0; r < 4u; ++r) {
+            if ((valid >> r & 1u) == 0u) continue;
+            SurfacePoint at;
+            at.p = packet.org[r];
+            if (lc_visible(at, packet.dir[r], packet.t_max[r])) visible |= 1u << r;
         }
         return visible;
     }
