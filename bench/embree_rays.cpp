@@ -157,12 +157,14 @@ int run(int argc, char** argv) {
     // (host/cpu_renderer.cpp, shade_tile_by_octets): tile by tile, each
     // tile's octets in rows, an octet's eight points sharing one cut, and
     // after an octet whose cut reached max_cut the tile's next blocks cut as
-    // two quads until both stay below it. Each packet the cuts trace, and
-    // each single ray (the roots' representatives), is a packet here.
+    // two quads until both stay below it; the scene's own settings (its
+    // render block), each pixel's first camera sample. Each packet the cuts
+    // trace, and each single ray (the roots' representatives), is a packet
+    // here.
     std::vector<ShadowRay> octet_rays;
     std::vector<lc::cpu::RayPacketRecord> octet_packets;
     {
-        lc::RenderOptions lo;
+        lc::RenderOptions lo = lc::scene_render_options(p.scene);
         lo.width = lo.height = kLightcutsSize;
         const lc::gpu::FrameParams lf = lc::make_frame_params(p, lo);
         std::vector<lc::cpu::ShadowRayRecord> log;
@@ -196,11 +198,11 @@ int run(int argc, char** argv) {
         for (std::uint32_t y0 = 0; y0 < kLightcutsSize; y0 += lc::kTile)
             for (std::uint32_t x0 = 0; x0 < kLightcutsSize; x0 += lc::kTile) {
                 bool as_quads = false;
-                for (std::uint32_t y = y0; y < y0 + lc::kTile; y += 2u)
-                    for (std::uint32_t x = x0; x < x0 + lc::kTile; x += 4u) {
+                for (std::uint32_t y = y0; y < std::min(y0 + lc::kTile, kLightcutsSize); y += 2u)
+                    for (std::uint32_t x = x0; x < std::min(x0 + lc::kTile, kLightcutsSize); x += 4u) {
                         if (as_quads) {
                             const bool left = block.template operator()<4u>(quad_heap, x, y);
-                            const bool right = block.template operator()<4u>(quad_heap, x + 2u, y);
+                            const bool right = x + 2u < kLightcutsSize && block.template operator()<4u>(quad_heap, x + 2u, y);
                             as_quads = left || right;
                         } else {
                             as_quads = block.template operator()<8u>(octet_heap, x, y);
