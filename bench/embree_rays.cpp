@@ -177,12 +177,16 @@ int run(int argc, char** argv) {
         lc::cpu::QuadHeap quad_heap(p.tree.cut_heap_slots(lo.max_cut, lc::shared_cut_heap(lo.cut_heap, 4u)));
         // The block of N points at (x0, y0), as render_cpu's shade_block
         // places them; whether its cut reached max_cut.
-        const auto block = [&]<std::uint32_t N>(lc::cpu::BlockHeap<N>& heap, std::uint32_t x0, std::uint32_t y0) {
-            lc::cpu::BlockCut<Recorder, N> cut(recorder, heap, lf);
+        const auto block = [&](auto points, std::uint32_t x0, std::uint32_t y0, std::uint32_t) {
+            constexpr std::uint32_t N = decltype(points)::value;
+            lc::cpu::BlockHeap<N>* heap;
+            if constexpr (N == 8u) heap = &octet_heap;
+            else heap = &quad_heap;
+            lc::cpu::BlockCut<Recorder, N> cut(recorder, *heap, lf);
             Recorder::SurfacePoint sp[N];
             unsigned active = 0u;
             for (std::uint32_t q = 0; q < N; ++q) {
-                const std::uint32_t x = x0 + (q & 1u) + 2u * (q >> 2u), y = y0 + (q >> 1u & 1u);
+                const std::uint32_t x = x0 + lc::block_x(q), y = y0 + lc::block_y(q);
                 glm::vec3 seen;
                 if (x < lf.width && y < lf.height && recorder.lc_camera_sample(lf, x, y, 0u, sp[q], seen))
                     active |= 1u << q;
@@ -196,19 +200,9 @@ int run(int argc, char** argv) {
             return hit;
         };
         for (std::uint32_t y0 = 0; y0 < kLightcutsSize; y0 += lc::kTile)
-            for (std::uint32_t x0 = 0; x0 < kLightcutsSize; x0 += lc::kTile) {
-                bool as_quads = false;
-                for (std::uint32_t y = y0; y < std::min(y0 + lc::kTile, kLightcutsSize); y += 2u)
-                    for (std::uint32_t x = x0; x < std::min(x0 + lc::kTile, kLightcutsSize); x += 4u) {
-                        if (as_quads) {
-                            const bool left = block.template operator()<4u>(quad_heap, x, y);
-                            const bool right = x + 2u < kLightcutsSize && block.template operator()<4u>(quad_heap, x + 2u, y);
-                            as_quads = left || right;
-                        } else {
-                            as_quads = block.template operator()<8u>(octet_heap, x, y);
-                        }
-                    }
-            }
+            for (std::uint32_t x0 = 0; x0 < kLightcutsSize; x0 += lc::kTile)
+                lc::for_each_block_of_tile(x0, y0, kLightcutsSize, kLightcutsSize, block,
+                                           [](std::uint32_t, std::uint32_t) {});
         for (const auto& r : log) octet_rays.push_back({r.org, r.dir, r.t_max, 0u});
         // The packets, and a packet of one for each ray between them.
         std::size_t next = 0;

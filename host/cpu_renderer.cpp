@@ -98,12 +98,9 @@ PixelResult shade_pixel(cpu::ShadeKernel& k, const gpu::FrameParams& frame, Meth
 
 // The block of N pixels at (x0, y0) (those inside the image), its samples
 // shaded by one shared cut (host/quad_cut.h): a 2x2 quad for N = 4, two
-// quads side by side (a 4x2 octet) for N = 8. Point q is pixel (x0 +
-// block_x(q), y0 + block_y(q)): each quad's four in the order of the
-// quad's subgroup lanes (shaders/quadcuts.comp), the left quad's first.
-// Returns whether some sample's cut stopped at max_cut.
-constexpr std::uint32_t block_x(std::uint32_t q) { return (q & 1u) + 2u * (q >> 2u); }
-constexpr std::uint32_t block_y(std::uint32_t q) { return q >> 1u & 1u; }
+// quads side by side (a 4x2 octet) for N = 8, point q at pixel (x0 +
+// block_x(q), y0 + block_y(q)) (host/tile_pool.h). Returns whether some
+// sample's cut stopped at max_cut.
 
 template <std::uint32_t N>
 bool shade_block(cpu::ShadeKernel& k, const gpu::FrameParams& frame, std::uint32_t x0, std::uint32_t y0, Worker& t,
@@ -153,28 +150,25 @@ bool shade_block(cpu::ShadeKernel& k, const gpu::FrameParams& frame, std::uint32
 // cut alike, relative RMSE against brute force 0.0384 -> 0.0425 and 17.6%
 // -> 22.1% of its pixels above 5% (128x128). So after an octet whose cut
 // reached max_cut the tile's next blocks are cut as two quads, until both
-// stay below it (0.0403 and 18.5%, at 0.80 of the quads' time). Tiles are
-// shaded in a fixed order, so the image does not depend on the threads.
-// store(x, y, result) takes each pixel's result.
+// stay below it (0.0403 and 18.5%, at 0.80 of the quads' time;
+// for_each_block_of_tile, host/tile_pool.h). Tiles are shaded in a fixed
+// order, so the image does not depend on the threads. store(x, y, result)
+// takes each pixel's result.
 template <class Store>
 void shade_tile_by_octets(cpu::ShadeKernel& k, const gpu::FrameParams& frame, std::uint32_t x0, std::uint32_t y0,
                           Worker& t, const Store& store) {
-    bool as_quads = false;
-    for (std::uint32_t y = y0; y < std::min(y0 + kTile, frame.height); y += 2u)
-        for (std::uint32_t x = x0; x < std::min(x0 + kTile, frame.width); x += 4u) {
-            PixelResult px[8];
-            if (as_quads) {
-                const bool left = shade_block<4>(k, frame, x, y, t, px);
-                const bool right = x + 2u < frame.width && shade_block<4>(k, frame, x + 2u, y, t, px + 4);
-                as_quads = left || right;
-            } else {
-                as_quads = shade_block<8>(k, frame, x, y, t, px);
-            }
+    PixelResult px[8];
+    for_each_block_of_tile(
+        x0, y0, frame.width, frame.height,
+        [&](auto points, std::uint32_t x, std::uint32_t y, std::uint32_t first) {
+            return shade_block<decltype(points)::value>(k, frame, x, y, t, px + first);
+        },
+        [&](std::uint32_t x, std::uint32_t y) {
             for (std::uint32_t q = 0; q < 8u; ++q) {
                 const std::uint32_t qx = x + block_x(q), qy = y + block_y(q);
                 if (qx < frame.width && qy < frame.height) store(qx, qy, px[q]);
             }
-        }
+        });
 }
 
 }  // namespace
