@@ -2,7 +2,7 @@
 // CPU path runs it) against Embree 3 on the same rays: the ones brute force
 // traces on a scene (from every camera hit to every light that can light
 // it), the ones lightcuts traces with a cut per pixel (recorded by the
-// CPU's scalar kernel as it selects the cuts at the default error, max_cut
+// CPU's scalar kernel as it selects the cuts at the scene's error, max_cut
 // and heap: the cuts the Vulkan kernels select), and the ones the CPU path
 // traces at its defaults, each cut shared by an octet of pixels (recorded
 // with the packets the renderer traces them in: an octet's eight points'
@@ -132,12 +132,14 @@ int run(int argc, char** argv) {
                 if (unit.x + unit.y + unit.z > 0.0f) rays.push_back({sp.p, wi, t_max, l});
             }
         }
-    // Lightcuts' rays with a cut per pixel at the default settings, pixel
-    // by pixel as the scalar kernel casts them.
+    // Lightcuts' rays with a cut per pixel at the scene's settings (its
+    // render block, else the defaults), pixel by pixel as the scalar kernel
+    // casts them.
     constexpr std::uint32_t kLightcutsSize = 128;
+    const lc::RenderOptions scene_options = lc::scene_render_options(p.scene);
     std::vector<ShadowRay> lightcuts_rays;
     {
-        lc::RenderOptions lo;
+        lc::RenderOptions lo = scene_options;
         lo.width = lo.height = kLightcutsSize;
         const lc::gpu::FrameParams lf = lc::make_frame_params(p, lo);
         std::vector<lc::cpu::ShadowRayRecord> log;
@@ -164,7 +166,7 @@ int run(int argc, char** argv) {
     std::vector<ShadowRay> octet_rays;
     std::vector<lc::cpu::RayPacketRecord> octet_packets;
     {
-        lc::RenderOptions lo = lc::scene_render_options(p.scene);
+        lc::RenderOptions lo = scene_options;
         lo.width = lo.height = kLightcutsSize;
         const lc::gpu::FrameParams lf = lc::make_frame_params(p, lo);
         std::vector<lc::cpu::ShadowRayRecord> log;
@@ -274,10 +276,13 @@ int run(int argc, char** argv) {
     rtcReleaseGeometry(geom);
     rtcCommitScene(scene);
 
+    char per_pixel_name[96];
+    std::snprintf(per_pixel_name, sizeof per_pixel_name, "lightcuts, a cut per pixel (error %g, max_cut %u), pixel order",
+                  double(scene_options.relative_error), unsigned(scene_options.max_cut));
     const std::pair<const char*, const std::vector<ShadowRay>*> sets[] = {
         {"brute force, pixel order", &rays},
         {"brute force, light by light", &by_light},
-        {"lightcuts, a cut per pixel (error 0.02, max_cut 1000), pixel order", &lightcuts_rays},
+        {per_pixel_name, &lightcuts_rays},
         {"lightcuts, each point's rays sorted by direction", &lightcuts_sorted},
         {"lightcuts at the CPU's defaults (cuts shared by octets), as they are cast", &octet_rays}};
     for (const auto& [order_name, list] : sets) {
