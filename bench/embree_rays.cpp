@@ -82,6 +82,32 @@ RTCRay to_rtc_ray(const ShadowRay& r) {
     return ray;
 }
 
+// Rays [first, first + count) as a packet of the software BVH (count at
+// most R).
+template <unsigned R>
+lc::cpu::RayPacket<R> to_packet(const ShadowRay* first, std::size_t count) {
+    lc::cpu::RayPacket<R> packet;
+    for (std::size_t j = 0; j < count; ++j) {
+        packet.org[j] = first[j].org, packet.dir[j] = first[j].dir, packet.t_max[j] = first[j].t_max;
+        packet.valid |= 1u << j;
+    }
+    return packet;
+}
+
+// Rays [first, first + count) in Embree's packet of W (count from 1 to W),
+// valid[j] set for each; the lanes beyond repeat the first ray, off.
+template <int W, typename Packet>
+void to_rtc_packet(const ShadowRay* first, std::size_t count, Packet& ray, int* valid) {
+    for (std::size_t j = 0; j < std::size_t(W); ++j) {
+        const bool on = j < count;
+        valid[j] = on ? -1 : 0;
+        const ShadowRay& sr = first[on ? j : 0u];
+        ray.org_x[j] = sr.org.x, ray.org_y[j] = sr.org.y, ray.org_z[j] = sr.org.z;
+        ray.dir_x[j] = sr.dir.x, ray.dir_y[j] = sr.dir.y, ray.dir_z[j] = sr.dir.z;
+        ray.tnear[j] = 0.0f, ray.tfar[j] = sr.t_max, ray.mask[j] = ~0u;
+    }
+}
+
 void report(const char* what, std::size_t rays, double seconds, std::size_t occluded, std::size_t reference) {
     std::printf("  %-38s %6.2f Mrays/s  (%.3f s; %zu occluded, %+lld against the software BVH)\n", what,
                 double(rays) / seconds * 1e-6, seconds, occluded,
@@ -364,14 +390,8 @@ int run(int argc, char** argv) {
             s = timed_parallel(r.size(), threads, [&](unsigned t, std::size_t b, std::size_t e) {
                 lc::cpu::TraceKernel tk{p.bvh.nodes.data(), p.scene.triangles.data()};
                 std::size_t h = 0;
-                for (std::size_t i = b; i < e; i += R) {
-                    lc::cpu::RayPacket<R> packet;
-                    for (std::size_t j = 0; j < R && i + j < e; ++j) {
-                        packet.org[j] = r[i + j].org, packet.dir[j] = r[i + j].dir, packet.t_max[j] = r[i + j].t_max;
-                        packet.valid |= 1u << j;
-                    }
-                    h += unsigned(__builtin_popcount(trace(tk, packet)));
-                }
+                for (std::size_t i = b; i < e; i += R)
+                    h += unsigned(__builtin_popcount(trace(tk, to_packet<R>(&r[i], std::min<std::size_t>(R, e - i)))));
                 hits[t] = h;
             });
             report(what, r.size(), s, total(), reference);
@@ -403,13 +423,7 @@ int run(int argc, char** argv) {
                     std::size_t h = 0;
                     for (std::size_t i = b; i < e; ++i) {
                         const lc::cpu::RayPacketRecord& record = octet_packets[i];
-                        lc::cpu::RayPacket8 packet;
-                        for (std::uint32_t j = 0; j < record.count; ++j) {
-                            const ShadowRay& sr = r[record.first + j];
-                            packet.org[j] = sr.org, packet.dir[j] = sr.dir, packet.t_max[j] = sr.t_max;
-                            packet.valid |= 1u << j;
-                        }
-                        h += unsigned(__builtin_popcount(walk(tk, packet)));
+                        h += unsigned(__builtin_popcount(walk(tk, to_packet<8>(&r[record.first], record.count))));
                     }
                     hits[t] = h;
                 });
@@ -442,14 +456,7 @@ int run(int argc, char** argv) {
                 for (std::size_t i = b; i < e; i += W) {
                     alignas(64) Packet ray{};
                     alignas(64) int valid[W];
-                    for (std::size_t j = 0; j < std::size_t(W); ++j) {
-                        const bool on = i + j < e;
-                        valid[j] = on ? -1 : 0;
-                        const ShadowRay& sr = r[on ? i + j : i];
-                        ray.org_x[j] = sr.org.x, ray.org_y[j] = sr.org.y, ray.org_z[j] = sr.org.z;
-                        ray.dir_x[j] = sr.dir.x, ray.dir_y[j] = sr.dir.y, ray.dir_z[j] = sr.dir.z;
-                        ray.tnear[j] = 0.0f, ray.tfar[j] = sr.t_max, ray.mask[j] = ~0u;
-                    }
+                    to_rtc_packet<W>(&r[i], std::min<std::size_t>(W, e - i), ray, valid);
                     occluded(valid, scene, &ctx, &ray);
                     for (std::size_t j = 0; j < std::size_t(W) && i + j < e; ++j) h += ray.tfar[j] < 0.0f ? 1 : 0;
                 }
@@ -473,14 +480,7 @@ int run(int argc, char** argv) {
                     const lc::cpu::RayPacketRecord& record = octet_packets[i];
                     alignas(64) RTCRay8 ray{};
                     alignas(64) int valid[8];
-                    for (std::uint32_t j = 0; j < 8u; ++j) {
-                        const bool on = j < record.count;
-                        valid[j] = on ? -1 : 0;
-                        const ShadowRay& sr = r[record.first + (on ? j : 0u)];
-                        ray.org_x[j] = sr.org.x, ray.org_y[j] = sr.org.y, ray.org_z[j] = sr.org.z;
-                        ray.dir_x[j] = sr.dir.x, ray.dir_y[j] = sr.dir.y, ray.dir_z[j] = sr.dir.z;
-                        ray.tnear[j] = 0.0f, ray.tfar[j] = sr.t_max, ray.mask[j] = ~0u;
-                    }
+                    to_rtc_packet<8>(&r[record.first], record.count, ray, valid);
                     rtcOccluded8(valid, scene, &ctx, &ray);
                     for (std::uint32_t j = 0; j < record.count; ++j) h += ray.tfar[j] < 0.0f ? 1 : 0;
                 }
